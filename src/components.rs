@@ -1,0 +1,87 @@
+//! Component columns of the ECS world.
+//!
+//! Material points and grid nodes are entities of one `hecs::World`. Each component below is
+//! one column; systems borrow whole columns of an archetype as plain slices
+//! ([`columns`](crate::columns)). A point carries only what its material and loads need: a
+//! [`PlasticStrain`] column exists only for plastic materials, a [`PointLoad`] only on points
+//! that carry a load. Grid nodes all share one archetype, spawned in id order, so a node
+//! column slice is indexed by node id.
+
+use crate::tensor::Sym3;
+
+/// Current position of a material point (m).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Position<V>(pub V);
+
+/// Velocity of a material point (m/s).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Velocity<V>(pub V);
+
+/// Total displacement of a material point since the start (m).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Displacement<V>(pub V);
+
+/// Mass of a material point (kg; per metre of thickness in plane strain).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Mass(pub f64);
+
+/// Current volume of a material point (m³; m² × 1 m in plane strain).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Volume(pub f64);
+
+/// Cauchy stress of a material point (Pa, tension positive).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Stress(pub Sym3);
+
+/// Velocity gradient L = ∂v/∂x of the last step (1/s), input of the stress and volume update.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct VelocityGradient<M>(pub M);
+
+/// Index of the point's material in the simulation's material table.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct MaterialId(pub u16);
+
+/// Accumulated equivalent plastic strain (dimensionless); only on plastic points.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct PlasticStrain(pub f64);
+
+/// A concentrated force carried by a point, applied to the grid each step (N).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PointLoad<V>(pub V);
+
+/// Mass lumped at a grid node (kg).
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct NodeMass(pub f64);
+
+/// Momentum mapped to a grid node (kg·m/s).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NodeMomentum<V>(pub V);
+
+/// Out-of-balance force at a node, external plus internal, without damping (N).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NodeForce<V>(pub V);
+
+/// External force at a node: gravity and point loads (N).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NodeExternalForce<V>(pub V);
+
+/// Nodal acceleration of the current step, damping included (m/s²).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NodeAcceleration<V>(pub V);
+
+/// The nodal velocity that moves the points and strains them this step (m/s): the updated
+/// velocity in USL, the remapped one in MUSL, the mapped one (for strain) in USF.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NodeVelocity<V>(pub V);
+
+/// Fixed velocity components of a node: bit `a` set means axis `a` is held at zero.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub struct NodeFixity(pub u8);
+
+impl NodeFixity {
+    /// True when axis `a` is fixed.
+    #[inline(always)]
+    pub fn is_fixed(self, axis: usize) -> bool {
+        self.0 & (1 << axis) != 0
+    }
+}

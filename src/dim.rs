@@ -1,0 +1,207 @@
+//! The spatial dimension as a type parameter.
+//!
+//! Every solver type is generic over [`Dim`], implemented by [`Dim2`] (plane strain, unit
+//! thickness) and [`Dim3`]. A 2D scene therefore stores two-component vectors, visits four
+//! nodes per point with linear shape functions and never touches a third axis; the only
+//! 3D quantity it keeps is the out-of-plane normal stress, which plane strain requires.
+
+use crate::tensor::Sym3;
+use glam::{DMat2, DMat3, DVec2, DVec3};
+use std::fmt::Debug;
+use std::ops::{Add, AddAssign, Mul, Neg, Sub, SubAssign};
+
+/// Operations the solver needs from a position/velocity vector (m, m/s, N, ...).
+pub trait Vector:
+    Copy
+    + Send
+    + Sync
+    + Debug
+    + PartialEq
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<f64, Output = Self>
+    + Neg<Output = Self>
+    + AddAssign
+    + SubAssign
+    + 'static
+{
+    /// The zero vector.
+    const ZERO: Self;
+    /// Component `axis` (0 = x, 1 = y, 2 = z).
+    fn get(self, axis: usize) -> f64;
+    /// Sets component `axis`.
+    fn set(&mut self, axis: usize, value: f64);
+    /// Scalar product.
+    fn dot(self, other: Self) -> f64;
+    /// True when every component is finite.
+    fn is_finite(self) -> bool;
+}
+
+impl Vector for DVec2 {
+    const ZERO: Self = DVec2::ZERO;
+    #[inline(always)]
+    fn get(self, axis: usize) -> f64 {
+        self[axis]
+    }
+    #[inline(always)]
+    fn set(&mut self, axis: usize, value: f64) {
+        self[axis] = value;
+    }
+    #[inline(always)]
+    fn dot(self, other: Self) -> f64 {
+        DVec2::dot(self, other)
+    }
+    #[inline(always)]
+    fn is_finite(self) -> bool {
+        DVec2::is_finite(self)
+    }
+}
+
+impl Vector for DVec3 {
+    const ZERO: Self = DVec3::ZERO;
+    #[inline(always)]
+    fn get(self, axis: usize) -> f64 {
+        self[axis]
+    }
+    #[inline(always)]
+    fn set(&mut self, axis: usize, value: f64) {
+        self[axis] = value;
+    }
+    #[inline(always)]
+    fn dot(self, other: Self) -> f64 {
+        DVec3::dot(self, other)
+    }
+    #[inline(always)]
+    fn is_finite(self) -> bool {
+        DVec3::is_finite(self)
+    }
+}
+
+/// A spatial dimension: its vector and velocity-gradient types and the few operations that
+/// differ between plane strain and 3D.
+pub trait Dim: Copy + Send + Sync + Debug + Default + 'static {
+    /// Number of spatial axes (2 or 3).
+    const N: usize;
+    /// Position, velocity, force (m, m/s, N).
+    type Vec: Vector;
+    /// Velocity gradient L_ij = ∂v_i/∂x_j (1/s), column-major glam matrix.
+    type Mat: Copy + Send + Sync + Debug + PartialEq + 'static;
+
+    /// The zero velocity gradient.
+    const MAT_ZERO: Self::Mat;
+
+    /// Builds a vector from the first `N` entries of `xyz` (extra entries are ignored).
+    fn vec_from(xyz: [f64; 3]) -> Self::Vec;
+    /// The vector padded with zeros to three components.
+    fn vec_to3(v: Self::Vec) -> [f64; 3];
+    /// `m += a ⊗ b`, i.e. m_ij += a_i b_j.
+    fn add_outer(m: &mut Self::Mat, a: Self::Vec, b: Self::Vec);
+    /// σ·n for the in-plane components of the stress (N/m² · m² = N per unit of n).
+    fn stress_dot(s: &Sym3, n: Self::Vec) -> Self::Vec;
+    /// Strain increment sym(L)·dt and spin increment skew(L)·dt embedded in 3D
+    /// (plane strain: zero out-of-plane components). Spin is (W_yz, W_zx, W_xy).
+    fn strain_spin(l: &Self::Mat, dt: f64) -> (Sym3, [f64; 3]);
+    /// det(I + L·dt): the volume ratio of one step.
+    fn volume_ratio(l: &Self::Mat, dt: f64) -> f64;
+}
+
+/// Plane strain, unit thickness (m).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Dim2;
+
+/// Three dimensions.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Dim3;
+
+impl Dim for Dim2 {
+    const N: usize = 2;
+    type Vec = DVec2;
+    type Mat = DMat2;
+    const MAT_ZERO: DMat2 = DMat2::ZERO;
+
+    #[inline(always)]
+    fn vec_from(xyz: [f64; 3]) -> DVec2 {
+        DVec2::new(xyz[0], xyz[1])
+    }
+    #[inline(always)]
+    fn vec_to3(v: DVec2) -> [f64; 3] {
+        [v.x, v.y, 0.0]
+    }
+    #[inline(always)]
+    fn add_outer(m: &mut DMat2, a: DVec2, b: DVec2) {
+        m.x_axis += a * b.x;
+        m.y_axis += a * b.y;
+    }
+    #[inline(always)]
+    fn stress_dot(s: &Sym3, n: DVec2) -> DVec2 {
+        DVec2::new(s.xx * n.x + s.xy * n.y, s.xy * n.x + s.yy * n.y)
+    }
+    #[inline(always)]
+    fn strain_spin(l: &DMat2, dt: f64) -> (Sym3, [f64; 3]) {
+        // glam is column-major: l.col(j)[i] = L_ij.
+        let (l00, l10, l01, l11) = (l.x_axis.x, l.x_axis.y, l.y_axis.x, l.y_axis.y);
+        let strain = Sym3 {
+            xx: l00 * dt,
+            yy: l11 * dt,
+            xy: 0.5 * (l01 + l10) * dt,
+            ..Sym3::ZERO
+        };
+        (strain, [0.0, 0.0, 0.5 * (l01 - l10) * dt])
+    }
+    #[inline(always)]
+    fn volume_ratio(l: &DMat2, dt: f64) -> f64 {
+        (DMat2::IDENTITY + *l * dt).determinant()
+    }
+}
+
+impl Dim for Dim3 {
+    const N: usize = 3;
+    type Vec = DVec3;
+    type Mat = DMat3;
+    const MAT_ZERO: DMat3 = DMat3::ZERO;
+
+    #[inline(always)]
+    fn vec_from(xyz: [f64; 3]) -> DVec3 {
+        DVec3::from_array(xyz)
+    }
+    #[inline(always)]
+    fn vec_to3(v: DVec3) -> [f64; 3] {
+        v.to_array()
+    }
+    #[inline(always)]
+    fn add_outer(m: &mut DMat3, a: DVec3, b: DVec3) {
+        m.x_axis += a * b.x;
+        m.y_axis += a * b.y;
+        m.z_axis += a * b.z;
+    }
+    #[inline(always)]
+    fn stress_dot(s: &Sym3, n: DVec3) -> DVec3 {
+        DVec3::new(
+            s.xx * n.x + s.xy * n.y + s.zx * n.z,
+            s.xy * n.x + s.yy * n.y + s.yz * n.z,
+            s.zx * n.x + s.yz * n.y + s.zz * n.z,
+        )
+    }
+    #[inline(always)]
+    fn strain_spin(l: &DMat3, dt: f64) -> (Sym3, [f64; 3]) {
+        let c = |i: usize, j: usize| l.col(j)[i];
+        let strain = Sym3 {
+            xx: c(0, 0) * dt,
+            yy: c(1, 1) * dt,
+            zz: c(2, 2) * dt,
+            xy: 0.5 * (c(0, 1) + c(1, 0)) * dt,
+            yz: 0.5 * (c(1, 2) + c(2, 1)) * dt,
+            zx: 0.5 * (c(2, 0) + c(0, 2)) * dt,
+        };
+        let spin = [
+            0.5 * (c(1, 2) - c(2, 1)) * dt,
+            0.5 * (c(2, 0) - c(0, 2)) * dt,
+            0.5 * (c(0, 1) - c(1, 0)) * dt,
+        ];
+        (strain, spin)
+    }
+    #[inline(always)]
+    fn volume_ratio(l: &DMat3, dt: f64) -> f64 {
+        (DMat3::IDENTITY + *l * dt).determinant()
+    }
+}

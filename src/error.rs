@@ -1,0 +1,98 @@
+//! Typed errors of the library. The binary reports them once, readably.
+
+use std::path::PathBuf;
+use thiserror::Error;
+
+/// A scene that cannot be read, parsed or accepted.
+#[derive(Debug, Error)]
+pub enum SceneError {
+    /// The file could not be read.
+    #[error("cannot read scene file {path}: {source}")]
+    Read {
+        /// The scene file.
+        path: PathBuf,
+        /// The I/O error.
+        source: std::io::Error,
+    },
+    /// The text is not valid RON or does not match the scene schema.
+    #[error("{path}:{line}:{column}: {message}")]
+    Syntax {
+        /// The scene file.
+        path: PathBuf,
+        /// Line of the fault (1-based).
+        line: usize,
+        /// Column of the fault (1-based).
+        column: usize,
+        /// What is wrong.
+        message: String,
+    },
+    /// A value breaks a rule (non-physical, inconsistent, unknown reference, ...).
+    #[error("{path}:{line}:{column}: field `{field}`: {rule}")]
+    Invalid {
+        /// The scene file.
+        path: PathBuf,
+        /// Line of the field (1-based; 0 when the field is absent from the text).
+        line: usize,
+        /// Column of the field (1-based).
+        column: usize,
+        /// Dotted path of the field, e.g. `materials.soil.youngs_modulus`.
+        field: String,
+        /// The rule it breaks and the value found.
+        rule: String,
+    },
+    /// A `--set` override that cannot be applied.
+    #[error("override `{0}`: {1}")]
+    Override(String, String),
+}
+
+/// A failure while stepping: the run stops, and what was written so far stays valid.
+#[derive(Debug, Error)]
+pub enum StepError {
+    /// A point left the background grid.
+    #[error("step {step}, system `{system}`: point {point} left the grid at {position:?}")]
+    PointLeftGrid {
+        /// Step number (1-based) in which it happened.
+        step: u64,
+        /// System that detected it.
+        system: &'static str,
+        /// Index of the point in storage order.
+        point: usize,
+        /// Where it went (m).
+        position: [f64; 3],
+    },
+    /// A NaN or infinite value appeared.
+    #[error("step {step}, system `{system}`: non-finite {what} at {location}")]
+    NonFinite {
+        /// Step number.
+        step: u64,
+        /// System that detected it.
+        system: &'static str,
+        /// The quantity.
+        what: &'static str,
+        /// The point or node involved.
+        location: String,
+    },
+    /// A point load found no node with mass to act on.
+    #[error("step {step}: point load {point} at {position:?} has no node with mass to act on")]
+    LoadLost {
+        /// Step number.
+        step: u64,
+        /// Index of the loaded point.
+        point: usize,
+        /// Its position (m).
+        position: [f64; 3],
+    },
+    /// Writing output failed.
+    #[error("writing output: {0}")]
+    Io(#[from] std::io::Error),
+    /// A user system failed.
+    #[error("step {step}, system `{system}`: {message}")]
+    User {
+        /// Step number.
+        step: u64,
+        /// System name.
+        system: String,
+        /// Its message.
+        message: String,
+    },
+}

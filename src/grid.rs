@@ -1,0 +1,151 @@
+//! The structured background grid: geometry and node numbering.
+//!
+//! Nodes sit at `origin + h·(i, j, k)` for `i ≤ cells[0]` and so on; node `(i, j, k)` has id
+//! `i + nx·(j + ny·k)` where `nx = cells[0] + 1`. In 2D the third count is zero, so a 2D grid
+//! has one layer of nodes.
+
+use crate::dim::{Dim, Vector};
+
+/// A face of the grid's bounding box.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+pub enum Face {
+    /// x = x_min.
+    XMin,
+    /// x = x_max.
+    XMax,
+    /// y = y_min.
+    YMin,
+    /// y = y_max.
+    YMax,
+    /// z = z_min (3D only).
+    ZMin,
+    /// z = z_max (3D only).
+    ZMax,
+}
+
+impl Face {
+    /// The axis normal to the face and whether it is the upper end.
+    pub fn axis_side(self) -> (usize, bool) {
+        match self {
+            Face::XMin => (0, false),
+            Face::XMax => (0, true),
+            Face::YMin => (1, false),
+            Face::YMax => (1, true),
+            Face::ZMin => (2, false),
+            Face::ZMax => (2, true),
+        }
+    }
+}
+
+/// Geometry of a uniform background grid of square (cubic) cells.
+#[derive(Clone, Debug)]
+pub struct Grid<D: Dim> {
+    /// Position of node (0, 0, 0) (m).
+    pub origin: D::Vec,
+    /// Cell edge length h (m).
+    pub cell_size: f64,
+    /// 1 / h (1/m).
+    pub inv_h: f64,
+    /// Cells along each axis (unused axes: 0).
+    pub cells: [usize; 3],
+    /// Nodes along each axis (`cells + 1`; unused axes: 1).
+    pub nodes: [usize; 3],
+}
+
+impl<D: Dim> Grid<D> {
+    /// A grid with `cells` cells of size `cell_size` starting at `origin`.
+    pub fn new(origin: D::Vec, cell_size: f64, cells: [usize; 3]) -> Self {
+        let mut c = [0usize; 3];
+        c[..D::N].copy_from_slice(&cells[..D::N]);
+        let nodes = [c[0] + 1, c[1] + 1, c[2] + 1];
+        Grid { origin, cell_size, inv_h: 1.0 / cell_size, cells: c, nodes }
+    }
+
+    /// Total number of nodes.
+    pub fn node_count(&self) -> usize {
+        self.nodes[0] * self.nodes[1] * self.nodes[2]
+    }
+
+    /// Id of node (i, j, k).
+    #[inline(always)]
+    pub fn node_id(&self, ijk: [usize; 3]) -> usize {
+        ijk[0] + self.nodes[0] * (ijk[1] + self.nodes[1] * ijk[2])
+    }
+
+    /// Integer coordinates of a node id.
+    #[inline]
+    pub fn node_ijk(&self, id: usize) -> [usize; 3] {
+        let i = id % self.nodes[0];
+        let rest = id / self.nodes[0];
+        [i, rest % self.nodes[1], rest / self.nodes[1]]
+    }
+
+    /// Position of node (i, j, k) (m).
+    pub fn node_position(&self, ijk: [usize; 3]) -> D::Vec {
+        let mut x = self.origin;
+        for (a, &i) in ijk.iter().enumerate().take(D::N) {
+            x.set(a, x.get(a) + i as f64 * self.cell_size);
+        }
+        x
+    }
+
+    /// Upper corner of the grid (m).
+    pub fn max_corner(&self) -> D::Vec {
+        self.node_position(self.cells)
+    }
+
+    /// Position in cell units from the origin along `axis`.
+    #[inline(always)]
+    pub fn grid_coordinate(&self, x: D::Vec, axis: usize) -> f64 {
+        (x.get(axis) - self.origin.get(axis)) * self.inv_h
+    }
+
+    /// Index of the cell holding `x` along each axis, or `None` outside the grid.
+    /// A point on the upper face belongs to the last cell.
+    pub fn cell_of(&self, x: D::Vec) -> Option<[usize; 3]> {
+        let mut c = [0usize; 3];
+        for (a, ca) in c.iter_mut().enumerate().take(D::N) {
+            let xi = self.grid_coordinate(x, a);
+            if !(xi >= 0.0 && xi <= self.cells[a] as f64) {
+                return None;
+            }
+            *ca = (xi as usize).min(self.cells[a] - 1);
+        }
+        Some(c)
+    }
+
+    /// Linear cell id of `x` (for sorting points by cell), or `None` outside the grid.
+    pub fn cell_id(&self, x: D::Vec) -> Option<usize> {
+        self.cell_of(x).map(|c| c[0] + self.cells[0] * (c[1] + self.cells[1].max(1) * c[2]))
+    }
+
+    /// True when `x` lies inside the grid's bounding box (faces included).
+    pub fn contains(&self, x: D::Vec) -> bool {
+        self.cell_of(x).is_some()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::dim::{Dim2, Dim3};
+    use glam::{DVec2, DVec3};
+
+    #[test]
+    fn node_ids_round_trip() {
+        let g = Grid::<Dim3>::new(DVec3::ZERO, 0.5, [4, 3, 2]);
+        assert_eq!(g.node_count(), 5 * 4 * 3);
+        for id in 0..g.node_count() {
+            assert_eq!(g.node_id(g.node_ijk(id)), id);
+        }
+    }
+
+    #[test]
+    fn a_2d_grid_has_one_layer_of_nodes() {
+        let g = Grid::<Dim2>::new(DVec2::ZERO, 1.0, [3, 2, 7]);
+        assert_eq!(g.cells, [3, 2, 0]);
+        assert_eq!(g.node_count(), 4 * 3);
+        assert_eq!(g.cell_of(DVec2::new(3.0, 2.0)), Some([2, 1, 0]));
+        assert_eq!(g.cell_of(DVec2::new(3.01, 1.0)), None);
+    }
+}

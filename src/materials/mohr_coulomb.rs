@@ -1,0 +1,365 @@
+//! Mohr-Coulomb linear-elastic perfectly-plastic material with a tension cut-off.
+//!
+//! The return mapping works in principal stress space (tension positive, σ1 ≥ σ2 ≥ σ3),
+//! after Clausen, Damkilde & Andersen (2006), "Efficient return algorithms for associated
+//! plasticity with multiple yield planes", extended to non-associated flow:
+//!
+//! * yield function  f = k σ1 − σ3 − σc,   k = (1 + sin φ)/(1 − sin φ),  σc = 2c √k;
+//! * plastic potential g = m σ1 − σ3,       m = (1 + sin ψ)/(1 − sin ψ);
+//! * return to the plane along D·∂g/∂σ; if that breaks the principal order, to one of the
+//!   two edges (σ1 = σ2 or σ2 = σ3) along the span of the two planes' flow directions; if the
+//!   edge point lies beyond the apex σ1 = σ2 = σ3 = c·cot φ, to the apex.
+//! * tension cut-off σ_i ≤ σt (σt ≤ c·cot φ) as a Rankine return applied afterwards; it
+//!   lowers σ1 more than σ3 (k ≥ 1, λ + 2G > λ), so it never re-violates f ≤ 0.
+//!
+//! In compression-positive terms the plane f = 0 is the classical
+//! σ1' = σ3' (1 + sin φ)/(1 − sin φ) + 2c cos φ/(1 − sin φ).
+
+use super::{Elasticity, Material};
+use crate::tensor::Sym3;
+use glam::DVec3;
+
+/// Mohr-Coulomb perfectly plastic material.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MohrCoulomb {
+    /// Mass density ρ (kg/m³).
+    pub density: f64,
+    /// Elastic constants.
+    pub elasticity: Elasticity,
+    /// Cohesion c (Pa).
+    pub cohesion: f64,
+    /// Friction angle φ (rad).
+    pub friction: f64,
+    /// Dilatancy angle ψ (rad).
+    pub dilatancy: f64,
+    /// Largest principal stress allowed (Pa, tension positive).
+    pub tension_cutoff: f64,
+    // Derived constants.
+    k: f64,
+    sigma_c: f64,
+    apex: Option<f64>,
+    /// D·∂g/∂σ for the plane σ1 ≥ σ2 ≥ σ3 and its two neighbours.
+    flow_main: DVec3,
+    flow_12: DVec3,
+    flow_23: DVec3,
+    grad_f: DVec3,
+}
+
+/// How a trial stress was returned (for tests and diagnostics).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Return {
+    /// Inside the yield surface: unchanged.
+    Elastic,
+    /// Onto the main plane.
+    Plane,
+    /// Onto the edge σ1 = σ2.
+    EdgeOneTwo,
+    /// Onto the edge σ2 = σ3.
+    EdgeTwoThree,
+    /// Onto the apex.
+    Apex,
+}
+
+impl MohrCoulomb {
+    /// From density (kg/m³), E (Pa), ν, c (Pa), φ and ψ (degrees) and an optional tension
+    /// cut-off (Pa); the cut-off is never above the apex c·cot φ.
+    pub fn new(
+        density: f64,
+        youngs_modulus: f64,
+        poisson_ratio: f64,
+        cohesion: f64,
+        friction_deg: f64,
+        dilatancy_deg: f64,
+        tension_cutoff: Option<f64>,
+    ) -> Self {
+        let elasticity = Elasticity::new(youngs_modulus, poisson_ratio);
+        let (phi, psi) = (friction_deg.to_radians(), dilatancy_deg.to_radians());
+        let k = (1.0 + phi.sin()) / (1.0 - phi.sin());
+        let m = (1.0 + psi.sin()) / (1.0 - psi.sin());
+        let sigma_c = 2.0 * cohesion * k.sqrt();
+        let apex = (phi > 0.0).then(|| sigma_c / (k - 1.0));
+        let limit = apex.unwrap_or(f64::INFINITY);
+        let tension_cutoff = tension_cutoff.map_or(limit, |t| t.min(limit));
+        let d = |g: DVec3| {
+            let vol = elasticity.lambda * (g.x + g.y + g.z);
+            DVec3::splat(vol) + g * (2.0 * elasticity.shear)
+        };
+        MohrCoulomb {
+            density,
+            elasticity,
+            cohesion,
+            friction: phi,
+            dilatancy: psi,
+            tension_cutoff,
+            k,
+            sigma_c,
+            apex,
+            flow_main: d(DVec3::new(m, 0.0, -1.0)),
+            flow_12: d(DVec3::new(0.0, m, -1.0)),
+            flow_23: d(DVec3::new(m, -1.0, 0.0)),
+            grad_f: DVec3::new(k, 0.0, -1.0),
+        }
+    }
+
+    /// Yield function f for principal stresses sorted σ1 ≥ σ2 ≥ σ3 (Pa; ≤ 0 is admissible).
+    pub fn yield_function(&self, p: [f64; 3]) -> f64 {
+        self.k * p[0] - p[2] - self.sigma_c
+    }
+
+    /// Returns sorted principal trial stresses to the yield surface.
+    pub fn return_principal(&self, trial: [f64; 3]) -> ([f64; 3], Return) {
+        let t = DVec3::from_array(trial);
+        let f = self.yield_function(trial);
+        let (mut s, mut kind) = (t, Return::Elastic);
+        if f > 0.0 {
+            (s, kind) = self.return_mohr_coulomb(t, f);
+        }
+        if s.x > self.tension_cutoff {
+            s = self.return_tension(s);
+        }
+        (s.to_array(), kind)
+    }
+
+    fn return_mohr_coulomb(&self, t: DVec3, f: f64) -> (DVec3, Return) {
+        let scale = t.abs().max_element().max(self.sigma_c).max(1.0);
+        let tol = 1e-12 * scale;
+        // Plane.
+        let s = t - self.flow_main * (f / self.grad_f.dot(self.flow_main));
+        if s.x + tol >= s.y && s.y + tol >= s.z {
+            return (s, Return::Plane);
+        }
+        // Edges: the line through a point on both planes, along their intersection.
+        let edges = [
+            (DVec3::new(1.0, 1.0, self.k), self.flow_12, Return::EdgeOneTwo),
+            (DVec3::new(1.0, self.k, self.k), self.flow_23, Return::EdgeTwoThree),
+        ];
+        for (dir, flow_b, kind) in edges {
+            let p0 = match self.apex {
+                Some(a) => DVec3::splat(a),
+                // φ = 0 (Tresca): no apex; a point with σ1 − σ3 = σc on this edge.
+                None if kind == Return::EdgeOneTwo => DVec3::new(0.5, 0.5, -0.5) * self.sigma_c,
+                None => DVec3::new(0.5, -0.5, -0.5) * self.sigma_c,
+            };
+            let n = self.flow_main.cross(flow_b);
+            let u = n.dot(t - p0) / n.dot(dir);
+            if self.apex.is_some() && u > 0.0 {
+                continue; // beyond the apex
+            }
+            let s = p0 + dir * u;
+            // Multipliers of the two flow directions: t − s = λa·flow_main + λb·flow_b.
+            let d = t - s;
+            let ca = flow_b.cross(n);
+            let cb = self.flow_main.cross(n);
+            let la = d.dot(ca) / self.flow_main.dot(ca);
+            let lb = d.dot(cb) / flow_b.dot(cb);
+            let ordered = s.x + tol >= s.y && s.y + tol >= s.z;
+            if la >= -1e-12 && lb >= -1e-12 && ordered {
+                return (s, kind);
+            }
+        }
+        let apex = self.apex.expect("a Tresca return always lands on a plane or an edge");
+        (DVec3::splat(apex), Return::Apex)
+    }
+
+    /// Rankine return σ_i ≤ σt for the principal stresses above the cut-off.
+    fn return_tension(&self, s: DVec3) -> DVec3 {
+        let (l, g2) = (self.elasticity.lambda, 2.0 * self.elasticity.shear);
+        let st = self.tension_cutoff;
+        let s = s.to_array();
+        // Active set grows from the largest value; at most three passes.
+        for active in 1..=3 {
+            if s[active - 1] <= st {
+                break;
+            }
+            // Solve (λ 11ᵀ + 2G I) Δλ = s_J − σt on the first `active` components:
+            // Δλ_j = (e_j − λ Σe/(2G + nλ)) / 2G with e_j = s_j − σt.
+            let excess: Vec<f64> = s[..active].iter().map(|v| v - st).collect();
+            let sum: f64 = excess.iter().sum();
+            let common = l * sum / (g2 + active as f64 * l);
+            let dl: Vec<f64> = excess.iter().map(|e| (e - common) / g2).collect();
+            let trace: f64 = dl.iter().sum();
+            let mut out = s;
+            for (i, o) in out.iter_mut().enumerate() {
+                let own = if i < active { dl[i] } else { 0.0 };
+                *o = s[i] - l * trace - g2 * own;
+            }
+            if active == 3 || out[active] <= st {
+                return DVec3::from_array(out);
+            }
+        }
+        DVec3::from_array(s)
+    }
+
+    /// Equivalent plastic strain of the principal stress correction Δσ (Pa):
+    /// sqrt(2/3 · dev(Δεp) : dev(Δεp)) with Δεp = D⁻¹ Δσ.
+    fn plastic_strain_increment(&self, ds: DVec3) -> f64 {
+        // dev(D⁻¹ Δσ) = dev(Δσ) / 2G for isotropic elasticity.
+        let mean = (ds.x + ds.y + ds.z) / 3.0;
+        let dev = (ds - DVec3::splat(mean)) / (2.0 * self.elasticity.shear);
+        (2.0 / 3.0 * dev.length_squared()).sqrt()
+    }
+}
+
+impl Material for MohrCoulomb {
+    fn density(&self) -> f64 {
+        self.density
+    }
+    fn p_wave_modulus(&self) -> f64 {
+        self.elasticity.p_wave()
+    }
+    fn is_plastic(&self) -> bool {
+        true
+    }
+    #[inline]
+    fn update(&self, stress: &mut Sym3, de: &Sym3, plastic: Option<&mut f64>) {
+        let trial = *stress + self.elasticity.stress_increment(de);
+        let (p, r) = trial.eigen();
+        if self.yield_function(p) <= 0.0 && p[0] <= self.tension_cutoff {
+            *stress = trial;
+            return;
+        }
+        let (ret, _) = self.return_principal(p);
+        *stress = Sym3::from_principal(ret, &r);
+        if let Some(eps) = plastic {
+            *eps += self.plastic_strain_increment(DVec3::from_array(p) - DVec3::from_array(ret));
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn soil(c: f64, phi: f64, psi: f64) -> MohrCoulomb {
+        MohrCoulomb::new(2000.0, 20e6, 0.3, c, phi, psi, None)
+    }
+
+    fn sorted(mut v: [f64; 3]) -> [f64; 3] {
+        v.sort_by(|a, b| b.total_cmp(a));
+        v
+    }
+
+    proptest! {
+        #[test]
+        fn returned_stress_lies_on_or_inside_the_yield_surface(
+            a in -1e6f64..3e5, b in -1e6f64..3e5, c_ in -1e6f64..3e5,
+            coh in 0.0f64..5e4, phi in 0.0f64..45.0, psi_frac in 0.0f64..1.0,
+        ) {
+            let mc = soil(coh, phi, psi_frac * phi);
+            let trial = sorted([a, b, c_]);
+            let (s, kind) = mc.return_principal(trial);
+            let scale = trial.iter().fold(0.0f64, |m, v| m.max(v.abs())).max(coh).max(1.0);
+            let f = mc.yield_function(sorted(s));
+            prop_assert!(f <= 1e-9 * scale, "f = {f} for {trial:?} -> {s:?} ({kind:?})");
+            if kind != Return::Elastic {
+                prop_assert!(f.abs() <= 1e-9 * scale, "not on the surface: f = {f} ({kind:?})");
+            }
+            prop_assert!(sorted(s)[0] <= mc.tension_cutoff + 1e-9 * scale);
+        }
+
+        #[test]
+        fn stresses_inside_the_surface_return_unchanged(
+            s3 in -1e6f64..-1e3, f1 in 0.0f64..1.0, f2 in 0.0f64..1.0,
+        ) {
+            let mc = soil(1e4, 30.0, 0.0);
+            // σ1 between σ3 and the limit (σ3 + σc)/k, σ2 in between.
+            let s1 = s3 + f1 * ((s3 + mc.sigma_c) / mc.k - s3) * 0.999;
+            let s2 = s3 + f2 * (s1 - s3);
+            let (s, kind) = mc.return_principal([s1, s2, s3]);
+            prop_assert_eq!(kind, Return::Elastic);
+            prop_assert_eq!(s, [s1, s2, s3]);
+        }
+    }
+
+    #[test]
+    fn apex_return_of_a_cohesionless_soil_gives_zero_stress() {
+        let mc = soil(0.0, 20.0, 0.0);
+        let (s, kind) = mc.return_principal([2e4, 1e4, 5e3]);
+        assert_eq!(kind, Return::Apex);
+        assert_eq!(s, [0.0; 3]);
+    }
+
+    #[test]
+    fn plastic_flow_with_zero_dilatancy_keeps_the_volume_on_the_plane() {
+        // Plane return: Δε_p ∝ ∂g/∂σ = (m, 0, −1) with m = 1 for ψ = 0 has zero trace, so the
+        // correction Δσ = D Δε_p = 2G Δε_p leaves the mean stress unchanged.
+        let mc = soil(1e4, 30.0, 0.0);
+        let trial = [-1e5, -2e5, -6e5];
+        let (s, kind) = mc.return_principal(trial);
+        assert_eq!(kind, Return::Plane);
+        let ds: f64 = (0..3).map(|i| trial[i] - s[i]).sum();
+        assert!(ds.abs() < 1e-9 * 6e5, "mean stress changed by {ds}");
+        // With ψ = φ the same return dilates, which shows up as a change of mean stress.
+        let assoc = soil(1e4, 30.0, 30.0);
+        let (sa, _) = assoc.return_principal(trial);
+        let dsa: f64 = (0..3).map(|i| trial[i] - sa[i]).sum();
+        assert!(dsa > 1e3, "associated flow must change the mean stress: {dsa}");
+    }
+
+    #[test]
+    fn flow_direction_follows_the_dilatancy_angle() {
+        // Plastic strain Δε_p = D⁻¹(σ_trial − σ): its principal ratio ε1/ε3 = −m.
+        for psi in [0.0, 10.0, 20.0] {
+            let mc = soil(5e3, 30.0, psi);
+            let trial = [-1e5, -2e5, -6e5];
+            let (s, kind) = mc.return_principal(trial);
+            assert_eq!(kind, Return::Plane);
+            let e = mc.elasticity;
+            let ym = e.shear * (3.0 * e.lambda + 2.0 * e.shear) / (e.lambda + e.shear);
+            let nu = e.lambda / (2.0 * (e.lambda + e.shear));
+            let ds: Vec<f64> = (0..3).map(|i| trial[i] - s[i]).collect();
+            let eps = |i: usize, j: usize, k: usize| (ds[i] - nu * (ds[j] + ds[k])) / ym;
+            let (e1, e2, e3) = (eps(0, 1, 2), eps(1, 0, 2), eps(2, 0, 1));
+            let m = (1.0 + psi.to_radians().sin()) / (1.0 - psi.to_radians().sin());
+            assert!(e2.abs() < 1e-12, "no flow along σ2: {e2}");
+            assert!((e1 / e3 + m).abs() < 1e-9, "ψ = {psi}: ε1/ε3 = {}", e1 / e3);
+        }
+    }
+
+    /// Drives a stress path by strain increments and returns the final principal stresses.
+    fn drive(mc: &MohrCoulomb, start: Sym3, de: Sym3, steps: usize) -> [f64; 3] {
+        let mut s = start;
+        let mut eps = 0.0;
+        for _ in 0..steps {
+            mc.update(&mut s, &de, Some(&mut eps));
+        }
+        s.principal_values()
+    }
+
+    #[test]
+    fn triaxial_compression_reaches_the_analytic_mohr_coulomb_peak() {
+        // Confined at σ3' = 100 kPa (compression positive), axial strain until failure.
+        // Analytic peak: σ1' = σ3' (1 + sin φ)/(1 − sin φ) + 2c cos φ/(1 − sin φ).
+        let (c, phi) = (10e3, 30.0f64);
+        let mc = MohrCoulomb::new(2000.0, 20e6, 0.0, c, phi, 0.0, None);
+        let conf = -100e3;
+        // ν = 0: an axial strain increment leaves the lateral stresses at the confinement.
+        let de = Sym3 { zz: -1e-5, ..Sym3::ZERO };
+        let p = drive(&mc, Sym3::diagonal(conf, conf, conf), de, 2000);
+        let sp = phi.to_radians().sin();
+        let peak = 100e3 * (1.0 + sp) / (1.0 - sp) + 2.0 * c * phi.to_radians().cos() / (1.0 - sp);
+        assert!((-p[2] - peak).abs() < 1e-6 * peak, "σ1' = {} vs {}", -p[2], peak);
+        assert!((-p[0] - 100e3).abs() < 1e-6 * peak);
+    }
+
+    #[test]
+    fn uniaxial_compression_reaches_the_unconfined_strength() {
+        // Unconfined (σ3' = 0): σ1' = 2c cos φ/(1 − sin φ).
+        let (c, phi) = (25e3, 25.0f64);
+        let mc = MohrCoulomb::new(2000.0, 20e6, 0.0, c, phi, 0.0, None);
+        let de = Sym3 { yy: -1e-5, ..Sym3::ZERO };
+        let p = drive(&mc, Sym3::ZERO, de, 2000);
+        let sp = phi.to_radians().sin();
+        let ucs = 2.0 * c * phi.to_radians().cos() / (1.0 - sp);
+        assert!((-p[2] - ucs).abs() < 1e-6 * ucs, "σ1' = {} vs {}", -p[2], ucs);
+    }
+
+    #[test]
+    fn tension_cut_off_caps_the_largest_principal_stress() {
+        let mc = MohrCoulomb::new(2000.0, 20e6, 0.3, 50e3, 30.0, 0.0, Some(10e3));
+        let (s, _) = mc.return_principal([40e3, -20e3, -50e3]);
+        assert!(s[0] <= 10e3 + 1e-6, "{s:?}");
+        assert!(mc.yield_function(sorted(s)) <= 1e-6);
+    }
+}

@@ -1,0 +1,7 @@
+//! Results on disk: `history.csv` (one row per output step) and `summary.json`.
+
+pub mod history;
+pub mod summary;
+
+pub use history::History;
+pub use summary::Summary;

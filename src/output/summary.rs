@@ -1,0 +1,95 @@
+//! `summary.json`: the outcome of a run.
+
+use crate::dim::Dim;
+use crate::schedule::Timing;
+use crate::simulation::{Simulation, TracedResult};
+use crate::state::{ForceNorm, Peak, StopReason};
+use serde::Serialize;
+
+/// The outcome of a run, as written to `summary.json`.
+#[derive(Clone, Debug, Serialize)]
+pub struct Summary {
+    /// Scene file.
+    pub scene: String,
+    /// 2 or 3.
+    pub dimension: usize,
+    /// True when K_F and K_E both reached the tolerance.
+    pub converged: bool,
+    /// Why the run stopped (absent after an error).
+    pub stop_reason: Option<StopReason>,
+    /// The error that stopped the run, if any.
+    pub error: Option<String>,
+    /// Steps taken.
+    pub steps: u64,
+    /// Simulated time (s).
+    pub time: f64,
+    /// Time step (s).
+    pub time_step: f64,
+    /// K_F in the norm the stopping rule reads.
+    pub force_ratio: f64,
+    /// That norm.
+    pub force_norm: ForceNorm,
+    /// K_F, max-norm (paper eq. 3).
+    pub force_ratio_max: f64,
+    /// K_F, mean norm.
+    pub force_ratio_mean: f64,
+    /// K_E (eq. 4).
+    pub energy_ratio: f64,
+    /// Tolerance for both.
+    pub tolerance: f64,
+    /// Kinetic-damping resets.
+    pub kinetic_resets: u64,
+    /// The first kinetic-energy peak (s, J).
+    pub first_peak: Option<Peak>,
+    /// Kinetic energy (J) at the end.
+    pub kinetic_energy: f64,
+    /// External work (J) at the end.
+    pub external_work: f64,
+    /// Material points (load carriers included).
+    pub particles: usize,
+    /// Total point mass (kg).
+    pub total_mass: f64,
+    /// Wall time of the stepping loop (s).
+    pub wall_seconds: f64,
+    /// Points × steps per wall second of the stepping loop.
+    pub particle_steps_per_second: f64,
+    /// Traced points.
+    pub traced: Vec<TracedResult>,
+    /// Per-system cost.
+    pub systems: Vec<Timing>,
+}
+
+impl Summary {
+    /// Collects the summary of `sim` after a run that took `wall_seconds`.
+    pub fn collect<D: Dim>(scene: &str, sim: &Simulation<D>, wall_seconds: f64, error: Option<String>) -> Self {
+        let s = &sim.ctx.state;
+        let st = &sim.ctx.settings;
+        let particles = sim.point_count();
+        Summary {
+            scene: scene.to_string(),
+            dimension: D::N,
+            converged: s.stop == Some(StopReason::Converged),
+            stop_reason: if error.is_some() { None } else { s.stop },
+            error,
+            steps: s.step,
+            time: s.time,
+            time_step: s.dt,
+            force_ratio: s.force_ratio(st.force_norm),
+            force_norm: st.force_norm,
+            force_ratio_max: s.force_ratio_max,
+            force_ratio_mean: s.force_ratio_mean,
+            energy_ratio: s.energy_ratio,
+            tolerance: st.tolerance,
+            kinetic_resets: s.resets,
+            first_peak: s.peaks.first().copied(),
+            kinetic_energy: s.kinetic_energy,
+            external_work: s.external_work,
+            particles,
+            total_mass: sim.total_mass(),
+            wall_seconds,
+            particle_steps_per_second: if wall_seconds > 0.0 { particles as f64 * s.step as f64 / wall_seconds } else { 0.0 },
+            traced: sim.traced_results(),
+            systems: sim.schedule.timings(),
+        }
+    }
+}

@@ -1,0 +1,272 @@
+//! Building a simulation from a valid scene: grid nodes, material points, loads, tracing
+//! and the schedule. Only what the scene uses is created.
+
+use super::validate::{self, Derived};
+use super::{Condition, LoadedScene, Region, Scene};
+use crate::components::*;
+use crate::dim::{Dim, Dim2, Dim3, Vector};
+use crate::error::SceneError;
+use crate::grid::Grid;
+use crate::materials::{Material, MaterialModel};
+use crate::shape::{for_each_node, Linear, QuadraticBSpline, ShapeKind};
+use crate::simulation::{AnySimulation, Context, Simulation, TracedPoint};
+use crate::state::{Gravity, Settings, SolverState};
+use crate::systems::{default_schedule, Needs};
+use crate::tensor::Sym3;
+use hecs::{Entity, World};
+
+/// Validates the scene and builds its simulation with the default schedule.
+pub fn build(loaded: &LoadedScene) -> Result<(AnySimulation, Derived), SceneError> {
+    let checked = validate::check(loaded)?;
+    Ok(match loaded.scene.dimension {
+        2 => {
+            let (sim, d) = build_dim::<Dim2>(loaded, checked)?;
+            (AnySimulation::Two(sim), d)
+        }
+        _ => {
+            let (sim, d) = build_dim::<Dim3>(loaded, checked)?;
+            (AnySimulation::Three(sim), d)
+        }
+    })
+}
+
+fn pad3(v: &[f64]) -> [f64; 3] {
+    [v[0], v.get(1).copied().unwrap_or(0.0), v.get(2).copied().unwrap_or(0.0)]
+}
+
+/// Calls `f(node, w)` over the support of `x` with the scene's shape functions.
+fn visit_support<D: Dim>(grid: &Grid<D>, shape: ShapeKind, x: D::Vec, mut f: impl FnMut(usize, f64)) {
+    match shape {
+        ShapeKind::Linear => for_each_node::<D, Linear>(grid, x, |i, w, _| f(i, w)),
+        ShapeKind::QuadraticBSpline => for_each_node::<D, QuadraticBSpline>(grid, x, |i, w, _| f(i, w)),
+    }
+}
+
+/// Even-odd rule point-in-polygon test.
+fn in_polygon(vertices: &[[f64; 2]], x: f64, y: f64) -> bool {
+    let mut inside = false;
+    let mut j = vertices.len() - 1;
+    for i in 0..vertices.len() {
+        let (a, b) = (vertices[i], vertices[j]);
+        if (a[1] > y) != (b[1] > y) && x < (b[0] - a[0]) * (y - a[1]) / (b[1] - a[1]) + a[0] {
+            inside = !inside;
+        }
+        j = i;
+    }
+    inside
+}
+
+/// Bounding box and membership test of a region.
+fn region_bounds(region: &Region, n: usize) -> ([f64; 3], [f64; 3]) {
+    match region {
+        Region::Box { min, max } => (pad3(min), pad3(max)),
+        Region::Polygon { vertices, z } => {
+            let mut lo = [f64::INFINITY, f64::INFINITY, 0.0];
+            let mut hi = [f64::NEG_INFINITY, f64::NEG_INFINITY, 0.0];
+            for v in vertices {
+                for a in 0..2 {
+                    lo[a] = lo[a].min(v[a]);
+                    hi[a] = hi[a].max(v[a]);
+                }
+            }
+            if n == 3 {
+                let z = z.expect("validated");
+                (lo[2], hi[2]) = (z[0], z[1]);
+            }
+            (lo, hi)
+        }
+    }
+}
+
+fn region_contains(region: &Region, x: [f64; 3], n: usize) -> bool {
+    match region {
+        Region::Box { min, max } => (0..n).all(|a| x[a] > min[a] && x[a] < max[a]),
+        Region::Polygon { vertices, z } => {
+            in_polygon(vertices, x[0], x[1]) && (n == 2 || z.is_some_and(|z| x[2] > z[0] && x[2] < z[1]))
+        }
+    }
+}
+
+/// Positions of the points filling `region`: centres of equal sub-cells of every grid cell.
+fn fill_points<D: Dim>(grid: &Grid<D>, region: &Region, ppc: &[usize]) -> Vec<[f64; 3]> {
+    let n = D::N;
+    let (lo, hi) = region_bounds(region, n);
+    let mut range = [(0usize, 1usize); 3];
+    for a in 0..n {
+        let o = grid.origin.get(a);
+        let first = ((lo[a] - o) * grid.inv_h).floor().max(0.0) as usize;
+        let last = (((hi[a] - o) * grid.inv_h).ceil().max(0.0) as usize).min(grid.cells[a]);
+        range[a] = (first, last);
+    }
+    let sub = [ppc[0], ppc[1], ppc.get(2).copied().unwrap_or(1)];
+    let o = D::vec_to3(grid.origin);
+    let h = grid.cell_size;
+    let mut out = Vec::new();
+    for k in range[2].0..range[2].1 {
+        for j in range[1].0..range[1].1 {
+            for i in range[0].0..range[0].1 {
+                for sk in 0..if n == 3 { sub[2] } else { 1 } {
+                    for sj in 0..sub[1] {
+                        for si in 0..sub[0] {
+                            let mut x = [
+                                o[0] + h * (i as f64 + (si as f64 + 0.5) / sub[0] as f64),
+                                o[1] + h * (j as f64 + (sj as f64 + 0.5) / sub[1] as f64),
+                                0.0,
+                            ];
+                            if n == 3 {
+                                x[2] = o[2] + h * (k as f64 + (sk as f64 + 0.5) / sub[2] as f64);
+                            }
+                            if region_contains(region, x, n) {
+                                out.push(x);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+    out
+}
+
+type Checked = (Vec<(String, MaterialModel)>, f64, f64, f64);
+
+fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulation<D>, Derived), SceneError> {
+    let (table, c_p, dt_crit, dt) = checked;
+    let s: &Scene = &loaded.scene;
+    let n = D::N;
+    let mut cells = [0usize; 3];
+    cells[..n].copy_from_slice(&s.grid.cells);
+    let grid = Grid::<D>::new(D::vec_from(pad3(&s.grid.origin)), s.grid.cell_size, cells);
+    let mut world = World::new();
+
+    // Grid nodes, one archetype, spawned in id order.
+    let mut fixity = vec![NodeFixity(0); grid.node_count()];
+    for bc in &s.boundaries {
+        let (axis, upper) = bc.face.axis_side();
+        let mask = match bc.condition {
+            Condition::Fixed => (1u8 << n) - 1,
+            Condition::Roller => 1u8 << axis,
+        };
+        let layer = if upper { grid.cells[axis] } else { 0 };
+        for (id, f) in fixity.iter_mut().enumerate() {
+            if grid.node_ijk(id)[axis] == layer {
+                f.0 |= mask;
+            }
+        }
+    }
+    let z = D::Vec::ZERO;
+    world.spawn_batch(fixity.into_iter().map(|f| {
+        (NodeMass(0.0), NodeMomentum(z), NodeForce(z), NodeExternalForce(z), NodeAcceleration(z), NodeVelocity(z), f)
+    }));
+
+    // Material points, body by body (cell order within a body keeps them spatially sorted).
+    let cell_volume = s.grid.cell_size.powi(n as i32);
+    let mut positions: Vec<([f64; 3], Entity)> = Vec::new();
+    let mut min_mass = f64::INFINITY;
+    let (gmin, gmax) = (D::vec_to3(grid.origin), D::vec_to3(grid.max_corner()));
+    for (b, body) in s.bodies.iter().enumerate() {
+        let (lo, hi) = region_bounds(&body.region, n);
+        if (0..n).any(|a| lo[a] < gmin[a] - 1e-9 || hi[a] > gmax[a] + 1e-9) {
+            return Err(loaded.invalid(
+                &format!("bodies[{b}].region"),
+                format!("the body spans {:?}..{:?}, outside the grid {:?}..{:?}", &lo[..n], &hi[..n], &gmin[..n], &gmax[..n]),
+            ));
+        }
+        let xs = fill_points(&grid, &body.region, &body.points_per_cell);
+        if xs.is_empty() {
+            return Err(loaded.invalid(&format!("bodies[{b}].region"), "the body holds no material point (is it smaller than a sub-cell?)"));
+        }
+        let mat = table.iter().position(|(name, _)| *name == body.material).expect("validated");
+        let model = &table[mat].1;
+        let volume = cell_volume / body.points_per_cell.iter().product::<usize>() as f64;
+        let mass = model.density() * volume;
+        min_mass = min_mass.min(mass);
+        let common = |x: &[f64; 3]| {
+            (
+                Position(D::vec_from(*x)),
+                Velocity(z),
+                Displacement(z),
+                Mass(mass),
+                Volume(volume),
+                Stress(Sym3::ZERO),
+                VelocityGradient(D::MAT_ZERO),
+                MaterialId(mat as u16),
+            )
+        };
+        // Plastic state only where the material needs it.
+        let entities: Vec<Entity> = if model.is_plastic() {
+            world.spawn_batch(xs.iter().map(|x| {
+                let (a, b, c, d, e, f, g, h) = common(x);
+                (a, b, c, d, e, f, g, h, PlasticStrain(0.0))
+            })).collect()
+        } else {
+            world.spawn_batch(xs.iter().map(common)).collect()
+        };
+        positions.extend(xs.into_iter().zip(entities));
+    }
+
+    // Which nodes the points touch at the start.
+    let mut touched = vec![false; grid.node_count()];
+    for (x, _) in &positions {
+        visit_support(&grid, s.shape, D::vec_from(*x), |i, w| touched[i] |= w > 0.0);
+    }
+
+    // Point loads: massless carriers that move with the body.
+    for (i, l) in s.point_loads.iter().enumerate() {
+        let x = D::vec_from(pad3(&l.position));
+        if !grid.contains(x) {
+            return Err(loaded.invalid(&format!("point_loads[{i}].position"), "the load lies outside the grid"));
+        }
+        let mut on_body = false;
+        visit_support(&grid, s.shape, x, |node, w| on_body |= w > 0.0 && touched[node]);
+        if !on_body {
+            return Err(loaded.invalid(&format!("point_loads[{i}].position"), format!("load \"{}\" acts on no node that carries mass: put it on a body", l.name)));
+        }
+        let e = world.spawn((Position(x), Velocity(z), Displacement(z), Mass(0.0), PointLoad(D::vec_from(pad3(&l.force)))));
+        positions.push((pad3(&l.position), e));
+    }
+
+    // Traced points: the nearest point within one cell.
+    let mut traced = Vec::new();
+    for (i, t) in s.traced.iter().enumerate() {
+        let want = pad3(&t.position);
+        let dist = |x: &[f64; 3]| (0..3).map(|a| (x[a] - want[a]).powi(2)).sum::<f64>().sqrt();
+        let best = positions.iter().min_by(|a, b| dist(&a.0).total_cmp(&dist(&b.0)));
+        match best {
+            Some((x, e)) if dist(x) <= s.grid.cell_size => {
+                traced.push(TracedPoint { name: t.name.clone(), entity: *e, initial_position: *x })
+            }
+            _ => {
+                return Err(loaded.invalid(&format!("traced[{i}].position"), format!("no material point within one cell ({} m) of {:?}", s.grid.cell_size, &want[..n])))
+            }
+        }
+    }
+
+    let settings = Settings {
+        scheme: s.solver.scheme,
+        damping: s.solver.damping,
+        tolerance: s.solver.tolerance,
+        force_norm: s.solver.force_norm,
+        max_steps: s.solver.max_steps,
+        max_time: s.solver.max_time,
+        gravity: s.gravity.as_ref().map(|g| Gravity { acceleration: pad3(&g.acceleration), ramp_time: g.ramp_time }),
+        // A node reached only by the far tail of a point's support carries no real mass;
+        // giving it degrees of freedom would divide by almost nothing.
+        min_node_mass: 1e-9 * min_mass,
+    };
+    let needs = Needs { point_loads: !s.point_loads.is_empty() };
+    let schedule = default_schedule::<D>(&settings, s.shape, needs);
+    let derived = Derived {
+        p_wave_speed: c_p,
+        critical_time_step: dt_crit,
+        time_step: dt,
+        points: positions.len(),
+        active_nodes: touched.iter().filter(|&&t| t).count(),
+        grid_nodes: grid.node_count(),
+        systems: schedule.names(),
+    };
+    let state = SolverState { dt, ..SolverState::default() };
+    let materials = table.into_iter().map(|(_, m)| m).collect();
+    let ctx = Context { world, grid, materials, settings, state };
+    Ok((Simulation { ctx, schedule, traced }, derived))
+}

@@ -1,0 +1,323 @@
+//! A small scanner over RON text: where a field stands (for `file:line:column` messages)
+//! and replacing a field's value (for `--set path=value` overrides).
+//!
+//! Paths are dotted field names and map keys with optional list indices:
+//! `solver.tolerance`, `materials.soil.friction_angle`, `bodies[0].points_per_cell`.
+//! The scanner understands comments, strings and bracket nesting; it does not validate.
+
+use crate::error::SceneError;
+
+/// 1-based (line, column) of byte offset `at`.
+pub fn line_column(text: &str, at: usize) -> (usize, usize) {
+    let before = &text[..at.min(text.len())];
+    let line = before.matches('\n').count() + 1;
+    let col = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+    (line, col)
+}
+
+/// Position of the field named by `path`: its name if present, else the deepest parent
+/// found. `None` when not even the first segment is in the text.
+pub fn field_position(text: &str, path: &str) -> Option<(usize, usize)> {
+    let mut found = None;
+    let mut open = top_open(text)?;
+    for seg in segments(path) {
+        match seg {
+            Seg::Field(name) => match find_field(text, open, name) {
+                Some((key, value)) => {
+                    found = Some(key);
+                    match descend(text, value) {
+                        Some(o) => open = o,
+                        None => break,
+                    }
+                }
+                None => break,
+            },
+            Seg::Index(i) => match element(text, open, i) {
+                Some(e) => {
+                    found = Some(e);
+                    match descend(text, e) {
+                        Some(o) => open = o,
+                        None => break,
+                    }
+                }
+                None => break,
+            },
+        }
+    }
+    found.map(|at| line_column(text, at))
+}
+
+/// Applies one override `path=value`, replacing the value in the text (or inserting the
+/// field into its parent when the scene relies on the default).
+pub fn apply_override(text: &str, assignment: &str) -> Result<String, SceneError> {
+    let err = |m: &str| SceneError::Override(assignment.to_string(), m.to_string());
+    let (path, value) = assignment.split_once('=').ok_or_else(|| err("expected path=value"))?;
+    let (path, value) = (path.trim(), value.trim());
+    if path.is_empty() || value.is_empty() {
+        return Err(err("expected path=value"));
+    }
+    let segs = segments(path);
+    let mut open = top_open(text).ok_or_else(|| err("the scene has no top-level struct"))?;
+    for (k, seg) in segs.iter().enumerate() {
+        let last = k + 1 == segs.len();
+        match *seg {
+            Seg::Field(name) => match find_field(text, open, name) {
+                Some((_, v)) if last => {
+                    let end = value_end(text, v);
+                    return Ok(format!("{}{}{}", &text[..v], value, &text[end..]));
+                }
+                Some((_, v)) => {
+                    open = descend(text, v).ok_or_else(|| err(&format!("`{name}` holds no fields")))?
+                }
+                None if last => {
+                    let at = open + 1;
+                    return Ok(format!("{} {name}: {value},{}", &text[..at], &text[at..]));
+                }
+                None => return Err(err(&format!("no field `{name}` in the scene"))),
+            },
+            Seg::Index(i) => {
+                let e = element(text, open, i).ok_or_else(|| err(&format!("no element [{i}]")))?;
+                if last {
+                    let end = value_end(text, e);
+                    return Ok(format!("{}{}{}", &text[..e], value, &text[end..]));
+                }
+                open = descend(text, e).ok_or_else(|| err(&format!("element [{i}] holds no fields")))?;
+            }
+        }
+    }
+    Err(err("empty path"))
+}
+
+enum Seg<'a> {
+    Field(&'a str),
+    Index(usize),
+}
+
+fn segments(path: &str) -> Vec<Seg<'_>> {
+    let mut out = Vec::new();
+    for part in path.split('.') {
+        let (name, rest) = part.split_once('[').map_or((part, ""), |(n, r)| (n, r));
+        if !name.is_empty() {
+            out.push(Seg::Field(name));
+        }
+        for idx in rest.split('[') {
+            if let Ok(i) = idx.trim_end_matches(']').parse() {
+                out.push(Seg::Index(i));
+            }
+        }
+    }
+    out
+}
+
+/// Skips white space and comments from `at`.
+fn skip_ws(text: &str, mut at: usize) -> usize {
+    let b = text.as_bytes();
+    loop {
+        while at < b.len() && b[at].is_ascii_whitespace() {
+            at += 1;
+        }
+        if text[at..].starts_with("//") {
+            at = text[at..].find('\n').map_or(b.len(), |n| at + n);
+        } else if text[at..].starts_with("/*") {
+            at = text[at..].find("*/").map_or(b.len(), |n| at + n + 2);
+        } else {
+            return at;
+        }
+    }
+}
+
+/// End of a string literal starting at `at` (which holds the quote).
+fn string_end(text: &str, at: usize) -> usize {
+    let b = text.as_bytes();
+    let mut i = at + 1;
+    while i < b.len() {
+        match b[i] {
+            b'\\' => i += 2,
+            b'"' => return i + 1,
+            _ => i += 1,
+        }
+    }
+    b.len()
+}
+
+/// Offset of the top-level struct's opening parenthesis.
+fn top_open(text: &str) -> Option<usize> {
+    let mut at = skip_ws(text, 0);
+    while text[at..].starts_with("#!") {
+        at = text[at..].find(']').map(|n| skip_ws(text, at + n + 1))?;
+    }
+    text[at..].find('(').map(|n| at + n)
+}
+
+/// Walks the items of the container opened at `open`, calling `f(token_start, depth)` at
+/// each token boundary at depth 0; stops at the closing bracket or when `f` says so.
+fn scan<T>(text: &str, open: usize, mut f: impl FnMut(usize, u8) -> Option<T>) -> Option<T> {
+    let b = text.as_bytes();
+    let mut at = open + 1;
+    let mut depth = 0i32;
+    loop {
+        at = skip_ws(text, at);
+        if at >= b.len() {
+            return None;
+        }
+        let c = b[at];
+        if depth == 0 {
+            if let Some(t) = f(at, c) {
+                return Some(t);
+            }
+        }
+        match c {
+            b'(' | b'[' | b'{' => depth += 1,
+            b')' | b']' | b'}' => {
+                depth -= 1;
+                if depth < 0 {
+                    return None;
+                }
+            }
+            b'"' => {
+                at = string_end(text, at);
+                continue;
+            }
+            _ => {}
+        }
+        at += 1;
+    }
+}
+
+/// Finds `name: value` directly inside the container at `open`; returns the offsets of the
+/// name and of the value.
+fn find_field(text: &str, open: usize, name: &str) -> Option<(usize, usize)> {
+    let b = text.as_bytes();
+    let mut prev_boundary = true;
+    scan(text, open, |at, c| {
+        let boundary = prev_boundary;
+        prev_boundary = matches!(c, b',' | b'(' | b'{' | b'[');
+        if !boundary {
+            return None;
+        }
+        let key_end = if c == b'"' {
+            let end = string_end(text, at);
+            (&text[at + 1..end - 1] == name).then_some(end)
+        } else {
+            let end = at + text[at..].find(|ch: char| !(ch.is_alphanumeric() || ch == '_')).unwrap_or(0);
+            (&text[at..end] == name).then_some(end)
+        }?;
+        let colon = skip_ws(text, key_end);
+        (b.get(colon) == Some(&b':')).then(|| (at, skip_ws(text, colon + 1)))
+    })
+}
+
+/// Offset of element `index` of the list or tuple opened at `open`.
+fn element(text: &str, open: usize, index: usize) -> Option<usize> {
+    let mut count = 0usize;
+    let mut expecting = true;
+    scan(text, open, |at, c| {
+        if c == b',' {
+            count += 1;
+            expecting = true;
+            return None;
+        }
+        if matches!(c, b')' | b']' | b'}') {
+            return None;
+        }
+        if expecting && count == index {
+            return Some(at);
+        }
+        expecting = false;
+        None
+    })
+}
+
+/// The opening bracket of the fields of the value at `value`, looking through an enum
+/// variant name and `Some(...)`.
+fn descend(text: &str, value: usize) -> Option<usize> {
+    let mut at = skip_ws(text, value);
+    let b = text.as_bytes();
+    loop {
+        let ident_end = at + text[at..].find(|ch: char| !(ch.is_alphanumeric() || ch == '_')).unwrap_or(0);
+        let next = skip_ws(text, ident_end);
+        let c = *b.get(next)?;
+        if !matches!(c, b'(' | b'[' | b'{') {
+            return None;
+        }
+        if &text[at..ident_end] == "Some" {
+            at = skip_ws(text, next + 1);
+            continue;
+        }
+        return Some(next);
+    }
+}
+
+/// End of the value starting at `value` (exclusive, trailing space trimmed).
+fn value_end(text: &str, value: usize) -> usize {
+    let b = text.as_bytes();
+    let mut at = value;
+    let mut depth = 0i32;
+    while at < b.len() {
+        match b[at] {
+            b'(' | b'[' | b'{' => depth += 1,
+            b')' | b']' | b'}' if depth == 0 => break,
+            b')' | b']' | b'}' => depth -= 1,
+            b',' if depth == 0 => break,
+            b'"' => {
+                at = string_end(text, at);
+                continue;
+            }
+            b'/' if text[at..].starts_with("//") || text[at..].starts_with("/*") => {
+                if depth == 0 {
+                    break;
+                }
+                at = skip_ws(text, at);
+                continue;
+            }
+            _ => {}
+        }
+        at += 1;
+    }
+    value + text[value..at].trim_end().len()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const TEXT: &str = r#"#![enable(implicit_some)]
+// a comment with solver: in it
+Scene(
+    dimension: 2,
+    materials: {
+        "soil": MohrCoulomb(density: 2000.0, friction_angle: 20.0),
+    },
+    bodies: [
+        (material: "soil", points_per_cell: [2, 2]),
+        (material: "rock", points_per_cell: [3, 3]),
+    ],
+    solver: (time_step: Courant(0.2), damping: Viscous(beta: 0.1)),
+)
+"#;
+
+    #[test]
+    fn finds_nested_fields_keys_and_list_elements() {
+        assert_eq!(field_position(TEXT, "dimension"), Some((4, 5)));
+        assert_eq!(field_position(TEXT, "materials.soil.friction_angle"), Some((6, 46)));
+        assert_eq!(field_position(TEXT, "bodies[1].material"), Some((10, 10)));
+        assert_eq!(field_position(TEXT, "solver.damping"), Some((12, 41)));
+        // A missing leaf points at its parent.
+        assert_eq!(field_position(TEXT, "solver.tolerance"), Some((12, 5)));
+        assert_eq!(field_position(TEXT, "nothing"), None);
+    }
+
+    #[test]
+    fn overrides_replace_values_and_insert_missing_fields() {
+        let t = apply_override(TEXT, "solver.damping=Kinetic").unwrap();
+        assert!(t.contains("damping: Kinetic)"), "{t}");
+        let t = apply_override(TEXT, "solver.tolerance=1e-4").unwrap();
+        assert!(t.contains("solver: ( tolerance: 1e-4,time_step"), "{t}");
+        let t = apply_override(TEXT, "bodies[1].points_per_cell=[1, 1]").unwrap();
+        assert!(t.contains("(material: \"rock\", points_per_cell: [1, 1])"), "{t}");
+        let t = apply_override(TEXT, "materials.soil.friction_angle=35").unwrap();
+        assert!(t.contains("friction_angle: 35)"), "{t}");
+        assert!(apply_override(TEXT, "solver").is_err());
+        assert!(apply_override(TEXT, "nope.field=1").is_err());
+    }
+}

@@ -1,0 +1,294 @@
+//! Scenes: the RON description of a problem, its validation, and building a simulation.
+//!
+//! The format is documented field by field in `docs/scene-format.md`. Units are SI
+//! (m, s, kg, Pa, N); angles are in degrees. Vectors are lists with one entry per axis.
+
+mod build;
+pub mod locate;
+mod validate;
+
+pub use build::build;
+pub use validate::Derived;
+
+use crate::error::SceneError;
+use crate::grid::Face;
+use crate::shape::ShapeKind;
+use crate::state::{Damping, ForceNorm, Scheme};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// A whole problem: grid, materials, bodies, boundary conditions, loads and solver settings.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scene {
+    /// 2 (plane strain, unit thickness) or 3.
+    pub dimension: u8,
+    /// Background grid.
+    pub grid: GridSpec,
+    /// Shape functions.
+    #[serde(default)]
+    pub shape: ShapeKind,
+    /// Materials by name.
+    pub materials: BTreeMap<String, MaterialSpec>,
+    /// Bodies filled with material points.
+    pub bodies: Vec<BodySpec>,
+    /// Conditions on grid faces.
+    #[serde(default)]
+    pub boundaries: Vec<BoundarySpec>,
+    /// Gravity, if any.
+    #[serde(default)]
+    pub gravity: Option<GravitySpec>,
+    /// Concentrated loads, each carried by a massless point that moves with the body.
+    #[serde(default)]
+    pub point_loads: Vec<PointLoadSpec>,
+    /// Points whose displacement is recorded each output step and reported at the end.
+    #[serde(default)]
+    pub traced: Vec<TracedSpec>,
+    /// Solver settings.
+    pub solver: SolverSpec,
+    /// Output settings.
+    #[serde(default)]
+    pub output: OutputSpec,
+}
+
+/// Background grid of square (cubic) cells.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GridSpec {
+    /// Lower corner (m), one entry per axis.
+    pub origin: Vec<f64>,
+    /// Cell edge length h (m), > 0.
+    pub cell_size: f64,
+    /// Number of cells per axis, ≥ 1.
+    pub cells: Vec<usize>,
+}
+
+/// A material, by model.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum MaterialSpec {
+    /// Linear elastic.
+    LinearElastic {
+        /// ρ (kg/m³), > 0.
+        density: f64,
+        /// E (Pa), > 0.
+        youngs_modulus: f64,
+        /// ν, in [0, 0.5).
+        poisson_ratio: f64,
+    },
+    /// Mohr-Coulomb elastic perfectly plastic.
+    MohrCoulomb {
+        /// ρ (kg/m³), > 0.
+        density: f64,
+        /// E (Pa), > 0.
+        youngs_modulus: f64,
+        /// ν, in [0, 0.5).
+        poisson_ratio: f64,
+        /// c (Pa), ≥ 0.
+        cohesion: f64,
+        /// φ (degrees), in [0, 90).
+        friction_angle: f64,
+        /// ψ (degrees), in [0, φ].
+        #[serde(default)]
+        dilatancy_angle: f64,
+        /// Largest tensile principal stress (Pa); default and upper bound c·cot φ.
+        #[serde(default)]
+        tension_cutoff: Option<f64>,
+    },
+}
+
+/// A region filled with material points.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BodySpec {
+    /// Name of a material in `materials`.
+    pub material: String,
+    /// The region.
+    pub region: Region,
+    /// Points per cell along each axis, ≥ 1 (placed at the centres of equal sub-cells).
+    pub points_per_cell: Vec<usize>,
+}
+
+/// The shape of a body.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum Region {
+    /// Axis-aligned box (m).
+    Box {
+        /// Lower corner.
+        min: Vec<f64>,
+        /// Upper corner.
+        max: Vec<f64>,
+    },
+    /// A simple polygon in the x-y plane (m), extruded over `z` in 3D.
+    Polygon {
+        /// Vertices in order (either orientation).
+        vertices: Vec<[f64; 2]>,
+        /// Extent along z in 3D (m); ignored in 2D.
+        #[serde(default)]
+        z: Option<[f64; 2]>,
+    },
+}
+
+/// Condition on a grid face.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Condition {
+    /// All velocity components zero.
+    Fixed,
+    /// Normal velocity component zero (free sliding).
+    Roller,
+}
+
+/// A boundary condition on one face of the grid.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BoundarySpec {
+    /// The face.
+    pub face: Face,
+    /// The condition.
+    pub condition: Condition,
+}
+
+/// Gravity.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GravitySpec {
+    /// Acceleration (m/s²), one entry per axis.
+    pub acceleration: Vec<f64>,
+    /// Time to ramp from zero to full gravity (s); 0 (default) applies it at once.
+    #[serde(default)]
+    pub ramp_time: f64,
+}
+
+/// A concentrated load.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PointLoadSpec {
+    /// Name (for messages and tracing).
+    pub name: String,
+    /// Where it acts (m); it must lie inside a body's cells.
+    pub position: Vec<f64>,
+    /// The force (N; N per metre of thickness in 2D).
+    pub force: Vec<f64>,
+}
+
+/// A traced point: the material point nearest to `position`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TracedSpec {
+    /// Name, used as a column prefix in `history.csv`.
+    pub name: String,
+    /// Where to look (m); the nearest point within one cell is taken.
+    pub position: Vec<f64>,
+}
+
+/// How the time step is chosen.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub enum TimeStep {
+    /// A fixed step (s).
+    Fixed(f64),
+    /// Δt = α·h / c_p with c_p the largest P-wave speed of the scene's materials.
+    Courant(f64),
+}
+
+/// Solver settings.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SolverSpec {
+    /// Damping (default `Kinetic`).
+    #[serde(default)]
+    pub damping: Damping,
+    /// Update scheme (default `Musl`).
+    #[serde(default)]
+    pub scheme: Scheme,
+    /// Time step.
+    pub time_step: TimeStep,
+    /// Tolerance for K_F and K_E (default 0.01).
+    #[serde(default = "default_tolerance")]
+    pub tolerance: f64,
+    /// Norm of K_F used to stop (default `Max`, the paper's eq. 3).
+    #[serde(default)]
+    pub force_norm: ForceNorm,
+    /// Step limit.
+    #[serde(default)]
+    pub max_steps: Option<u64>,
+    /// Simulated-time limit (s).
+    #[serde(default)]
+    pub max_time: Option<f64>,
+}
+
+fn default_tolerance() -> f64 {
+    0.01
+}
+
+/// Output settings.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OutputSpec {
+    /// Write a `history.csv` row every this many steps (and at the last step), ≥ 1.
+    #[serde(default = "default_every")]
+    pub history_every: u64,
+}
+
+fn default_every() -> u64 {
+    1
+}
+
+impl Default for OutputSpec {
+    fn default() -> Self {
+        OutputSpec { history_every: 1 }
+    }
+}
+
+/// A scene together with its source text, for messages that point into the file.
+#[derive(Clone, Debug)]
+pub struct LoadedScene {
+    /// The parsed scene.
+    pub scene: Scene,
+    /// Where it came from.
+    pub path: PathBuf,
+    /// Its text (after overrides).
+    pub text: String,
+}
+
+fn ron_options() -> ron::Options {
+    ron::Options::default().with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME)
+}
+
+impl LoadedScene {
+    /// Reads and parses a scene file, applying `overrides` (`path.to.field=value`) first.
+    pub fn from_file(path: &Path, overrides: &[String]) -> Result<Self, SceneError> {
+        let text = std::fs::read_to_string(path)
+            .map_err(|source| SceneError::Read { path: path.to_path_buf(), source })?;
+        Self::from_text(path, &text, overrides)
+    }
+
+    /// Parses scene text; `path` is used in messages.
+    pub fn from_text(path: &Path, text: &str, overrides: &[String]) -> Result<Self, SceneError> {
+        let mut text = text.to_string();
+        for o in overrides {
+            text = locate::apply_override(&text, o)?;
+        }
+        let scene: Scene = ron_options().from_str(&text).map_err(|e| SceneError::Syntax {
+            path: path.to_path_buf(),
+            line: e.span.start.line,
+            column: e.span.start.col,
+            message: e.code.to_string(),
+        })?;
+        let loaded = LoadedScene { scene, path: path.to_path_buf(), text };
+        Ok(loaded)
+    }
+
+    /// An error for the field at dotted `field` path (e.g. `materials.soil.density`).
+    pub fn invalid(&self, field: &str, rule: impl Into<String>) -> SceneError {
+        let (line, column) = locate::field_position(&self.text, field).unwrap_or((0, 0));
+        SceneError::Invalid {
+            path: self.path.clone(),
+            line,
+            column,
+            field: field.to_string(),
+            rule: rule.into(),
+        }
+    }
+}

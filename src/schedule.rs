@@ -1,0 +1,147 @@
+//! The ordered list of named systems that makes one explicit step, with per-system timings.
+//!
+//! Reading a default schedule (see [`crate::systems::default_schedule`]) gives the whole
+//! algorithm in order; every name leads to one file under `src/systems/`.
+
+use crate::dim::Dim;
+use crate::error::StepError;
+use crate::simulation::Context;
+use std::time::{Duration, Instant};
+
+/// One stage of the explicit step.
+pub trait System<D: Dim>: Send {
+    /// Stable name, used in schedules, profiles and error messages.
+    fn name(&self) -> &str;
+    /// Runs the stage once.
+    fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError>;
+}
+
+/// A system made from a closure, for user code (see `examples/custom_system.rs`).
+pub struct FnSystem<F> {
+    name: String,
+    f: F,
+}
+
+impl<F> FnSystem<F> {
+    /// A system called `name` that runs `f`.
+    pub fn new(name: impl Into<String>, f: F) -> Self {
+        FnSystem { name: name.into(), f }
+    }
+}
+
+impl<D: Dim, F> System<D> for FnSystem<F>
+where
+    F: FnMut(&mut Context<D>) -> Result<(), StepError> + Send,
+{
+    fn name(&self) -> &str {
+        &self.name
+    }
+    fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
+        (self.f)(ctx)
+    }
+}
+
+/// Accumulated cost of one system.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
+pub struct Timing {
+    /// System name.
+    pub name: String,
+    /// Number of calls.
+    pub calls: u64,
+    /// Total wall time (s).
+    pub seconds: f64,
+}
+
+/// An ordered list of systems.
+pub struct Schedule<D: Dim> {
+    systems: Vec<Box<dyn System<D>>>,
+    time: Vec<Duration>,
+    calls: Vec<u64>,
+}
+
+impl<D: Dim> Default for Schedule<D> {
+    fn default() -> Self {
+        Schedule { systems: Vec::new(), time: Vec::new(), calls: Vec::new() }
+    }
+}
+
+impl<D: Dim> Schedule<D> {
+    /// An empty schedule.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Appends a system.
+    pub fn push(&mut self, system: impl System<D> + 'static) -> &mut Self {
+        self.push_boxed(Box::new(system))
+    }
+
+    /// Appends a boxed system.
+    pub fn push_boxed(&mut self, system: Box<dyn System<D>>) -> &mut Self {
+        self.systems.push(system);
+        self.time.push(Duration::ZERO);
+        self.calls.push(0);
+        self
+    }
+
+    /// Inserts a system right after the one called `after`. Returns false if there is none.
+    pub fn insert_after(&mut self, after: &str, system: impl System<D> + 'static) -> bool {
+        match self.position(after) {
+            Some(i) => {
+                self.systems.insert(i + 1, Box::new(system));
+                self.time.insert(i + 1, Duration::ZERO);
+                self.calls.insert(i + 1, 0);
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// Inserts a system right before the one called `before`. Returns false if there is none.
+    pub fn insert_before(&mut self, before: &str, system: impl System<D> + 'static) -> bool {
+        match self.position(before) {
+            Some(i) => {
+                self.systems.insert(i, Box::new(system));
+                self.time.insert(i, Duration::ZERO);
+                self.calls.insert(i, 0);
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// Index of the first system called `name`.
+    pub fn position(&self, name: &str) -> Option<usize> {
+        self.systems.iter().position(|s| s.name() == name)
+    }
+
+    /// Names in order.
+    pub fn names(&self) -> Vec<String> {
+        self.systems.iter().map(|s| s.name().to_string()).collect()
+    }
+
+    /// Runs every system once, in order, timing each.
+    pub fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
+        for (i, system) in self.systems.iter_mut().enumerate() {
+            let start = Instant::now();
+            let result = system.run(ctx);
+            self.time[i] += start.elapsed();
+            self.calls[i] += 1;
+            result?;
+        }
+        Ok(())
+    }
+
+    /// Accumulated cost of every system, in schedule order.
+    pub fn timings(&self) -> Vec<Timing> {
+        self.systems
+            .iter()
+            .zip(self.time.iter().zip(&self.calls))
+            .map(|(s, (t, &calls))| Timing {
+                name: s.name().to_string(),
+                calls,
+                seconds: t.as_secs_f64(),
+            })
+            .collect()
+    }
+}

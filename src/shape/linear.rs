@@ -1,0 +1,21 @@
+//! Linear hat functions (bilinear/trilinear by tensor product).
+
+use super::{Shape, Stencil1};
+
+/// Linear hat function: w = 1 − |x − x_i|/h on the two nodes of the cell holding the point.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Linear;
+
+impl Shape for Linear {
+    const NAME: &'static str = "Linear";
+    const SUPPORT: usize = 2;
+
+    #[inline(always)]
+    fn eval_1d(xi: f64, cells: usize, inv_h: f64) -> Stencil1 {
+        // A point on the upper face belongs to the last cell, so it never reaches a node
+        // beyond the grid.
+        let base = (xi.max(0.0) as usize).min(cells.saturating_sub(1));
+        let f = xi - base as f64;
+        Stencil1 { base, w: [1.0 - f, f, 0.0], dw: [-inv_h, inv_h, 0.0] }
+    }
+}

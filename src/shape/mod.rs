@@ -1,0 +1,176 @@
+//! Shape functions: the weights w_ip and gradients ∇w_ip that connect point p to node i.
+//!
+//! Each shape is a tensor product of a 1D function ([`Shape::eval_1d`]); [`for_each_node`] is
+//! the single place where the product is formed and node ids are computed, so every transfer
+//! (particle-to-grid, grid-to-particle, remap, kinematics) uses the same weights.
+
+mod bspline;
+mod linear;
+
+pub use bspline::QuadraticBSpline;
+pub use linear::Linear;
+
+use crate::dim::Dim;
+use crate::grid::Grid;
+
+/// The 1D weights of one point along one axis: nodes `base .. base + SUPPORT`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Stencil1 {
+    /// Index of the first node of the stencil along this axis.
+    pub base: usize,
+    /// Weights (dimensionless).
+    pub w: [f64; 3],
+    /// Derivatives of the weights along the axis (1/m).
+    pub dw: [f64; 3],
+}
+
+/// A 1D shape function family, extended to 2D/3D by tensor product.
+pub trait Shape: Copy + Send + Sync + Default + std::fmt::Debug + 'static {
+    /// Name used in scenes and reports.
+    const NAME: &'static str;
+    /// Nodes per axis that a point touches.
+    const SUPPORT: usize;
+    /// Weights for a point at grid coordinate `xi` (cell units from the origin) on an axis
+    /// with `cells` cells of inverse size `inv_h`. The caller guarantees `0 ≤ xi ≤ cells`.
+    fn eval_1d(xi: f64, cells: usize, inv_h: f64) -> Stencil1;
+}
+
+/// Calls `f(node_id, w, ∇w)` for every node in the support of a point at `x`.
+///
+/// The point must lie inside the grid (the kinematics system guarantees this).
+#[inline(always)]
+pub fn for_each_node<D: Dim, S: Shape>(
+    grid: &Grid<D>,
+    x: D::Vec,
+    mut f: impl FnMut(usize, f64, D::Vec),
+) {
+    let sx = S::eval_1d(grid.grid_coordinate(x, 0), grid.cells[0], grid.inv_h);
+    let sy = S::eval_1d(grid.grid_coordinate(x, 1), grid.cells[1], grid.inv_h);
+    let nx = grid.nodes[0];
+    if D::N == 2 {
+        for j in 0..S::SUPPORT {
+            let row = (sy.base + j) * nx + sx.base;
+            for i in 0..S::SUPPORT {
+                let grad = D::vec_from([sx.dw[i] * sy.w[j], sx.w[i] * sy.dw[j], 0.0]);
+                f(row + i, sx.w[i] * sy.w[j], grad);
+            }
+        }
+    } else {
+        let sz = S::eval_1d(grid.grid_coordinate(x, 2), grid.cells[2], grid.inv_h);
+        let ny = grid.nodes[1];
+        for k in 0..S::SUPPORT {
+            for j in 0..S::SUPPORT {
+                let row = ((sz.base + k) * ny + sy.base + j) * nx + sx.base;
+                let wyz = sy.w[j] * sz.w[k];
+                let dyz = sy.dw[j] * sz.w[k];
+                let ydz = sy.w[j] * sz.dw[k];
+                for i in 0..S::SUPPORT {
+                    let grad = D::vec_from([sx.dw[i] * wyz, sx.w[i] * dyz, sx.w[i] * ydz]);
+                    f(row + i, sx.w[i] * wyz, grad);
+                }
+            }
+        }
+    }
+}
+
+/// The shape function family chosen by a scene.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum ShapeKind {
+    /// Linear (bilinear in 2D, trilinear in 3D) hat functions: 2 nodes per axis.
+    #[default]
+    Linear,
+    /// Quadratic B-splines, modified at the grid boundary: 3 nodes per axis.
+    QuadraticBSpline,
+}
+
+impl ShapeKind {
+    /// Nodes per axis in a point's support.
+    pub fn support(self) -> usize {
+        match self {
+            ShapeKind::Linear => Linear::SUPPORT,
+            ShapeKind::QuadraticBSpline => QuadraticBSpline::SUPPORT,
+        }
+    }
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+    use crate::dim::{Dim2, Dim3, Vector};
+    use glam::{DVec2, DVec3};
+
+    /// Checks Σw = 1, Σ w x_i = x, Σ ∇w = 0 and Σ x_i ⊗ ∇w = I at `x`.
+    pub fn check_consistency<D: Dim, S: Shape>(grid: &Grid<D>, x: D::Vec) {
+        let mut sum_w = 0.0;
+        let mut moment = D::Vec::ZERO;
+        let mut sum_grad = D::Vec::ZERO;
+        let mut grad_moment = [[0.0; 3]; 3];
+        for_each_node::<D, S>(grid, x, |node, w, grad| {
+            let xi = grid.node_position(grid.node_ijk(node));
+            sum_w += w;
+            moment += xi * w;
+            sum_grad += grad;
+            for a in 0..D::N {
+                for b in 0..D::N {
+                    grad_moment[a][b] += xi.get(a) * grad.get(b);
+                }
+            }
+        });
+        assert!((sum_w - 1.0).abs() < 1e-12, "partition of unity at {x:?}: {sum_w}");
+        for a in 0..D::N {
+            assert!((moment.get(a) - x.get(a)).abs() < 1e-12, "linear reproduction at {x:?}");
+            assert!(sum_grad.get(a).abs() < 1e-12, "gradients sum to zero at {x:?}");
+            for b in 0..D::N {
+                let expect = if a == b { 1.0 } else { 0.0 };
+                assert!((grad_moment[a][b] - expect).abs() < 1e-12, "∇x = I at {x:?}");
+            }
+        }
+    }
+
+    fn sample_points(n: usize, lo: f64, hi: f64) -> Vec<f64> {
+        (0..=n).map(|k| lo + (hi - lo) * k as f64 / n as f64).collect()
+    }
+
+    #[test]
+    fn linear_shape_is_a_partition_of_unity_and_reproduces_linear_fields() {
+        let g2 = Grid::<Dim2>::new(DVec2::new(-1.0, 2.0), 0.5, [6, 4, 0]);
+        let g3 = Grid::<Dim3>::new(DVec3::new(0.0, -1.0, 3.0), 0.25, [4, 4, 4]);
+        for &x in &sample_points(37, -1.0, 2.0) {
+            for &y in &sample_points(13, 2.0, 4.0) {
+                check_consistency::<Dim2, Linear>(&g2, DVec2::new(x, y));
+            }
+        }
+        for &x in &sample_points(9, 0.0, 1.0) {
+            for &z in &sample_points(11, 3.0, 4.0) {
+                check_consistency::<Dim3, Linear>(&g3, DVec3::new(x, -0.3, z));
+            }
+        }
+    }
+
+    #[test]
+    fn bspline_is_a_partition_of_unity_and_reproduces_linear_fields_up_to_the_boundary() {
+        let g2 = Grid::<Dim2>::new(DVec2::ZERO, 1.0, [5, 4, 0]);
+        let g3 = Grid::<Dim3>::new(DVec3::ZERO, 0.5, [3, 4, 3]);
+        // Includes points on the faces, in the boundary cells and in the interior.
+        for &x in &sample_points(50, 0.0, 5.0) {
+            for &y in &sample_points(16, 0.0, 4.0) {
+                check_consistency::<Dim2, QuadraticBSpline>(&g2, DVec2::new(x, y));
+            }
+        }
+        for &x in &sample_points(12, 0.0, 1.5) {
+            for &z in &sample_points(12, 0.0, 1.5) {
+                check_consistency::<Dim3, QuadraticBSpline>(&g3, DVec3::new(x, 0.1, z));
+            }
+        }
+    }
+
+    #[test]
+    fn shape_weights_are_never_negative() {
+        for k in 0..=400 {
+            let xi = 5.0 * k as f64 / 400.0;
+            for s in [Linear::eval_1d(xi, 5, 1.0), QuadraticBSpline::eval_1d(xi, 5, 1.0)] {
+                assert!(s.w.iter().all(|&w| w >= -1e-15), "{xi}: {s:?}");
+            }
+        }
+    }
+}

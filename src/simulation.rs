@@ -1,0 +1,133 @@
+//! A simulation: the ECS world, grid, materials and solver state, stepped by a schedule.
+
+use crate::columns::{col, points_with};
+use crate::components::*;
+use crate::dim::{Dim, Dim2, Dim3};
+use crate::error::StepError;
+use crate::grid::Grid;
+use crate::materials::MaterialModel;
+use crate::schedule::Schedule;
+use crate::state::{Settings, SolverState};
+use crate::tensor::Sym3;
+use hecs::{Entity, World};
+
+/// Everything the systems read and write: the world (points and nodes), the grid, the
+/// material table and the solver-wide state.
+pub struct Context<D: Dim> {
+    /// Points and nodes.
+    pub world: World,
+    /// Background grid geometry.
+    pub grid: Grid<D>,
+    /// Materials, indexed by [`MaterialId`].
+    pub materials: Vec<MaterialModel>,
+    /// Fixed settings.
+    pub settings: Settings,
+    /// Quantities updated every step.
+    pub state: SolverState,
+}
+
+/// A point whose history is recorded.
+#[derive(Clone, Debug)]
+pub struct TracedPoint {
+    /// Name given in the scene.
+    pub name: String,
+    /// Its entity.
+    pub entity: Entity,
+    /// Position at the start (m).
+    pub initial_position: [f64; 3],
+}
+
+/// What a traced point reports at the end of a run.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct TracedResult {
+    /// Name given in the scene.
+    pub name: String,
+    /// Position at the start (m).
+    pub initial_position: [f64; 3],
+    /// Displacement (m).
+    pub displacement: [f64; 3],
+    /// Cauchy stress (Pa, tension positive); zero for a load carrier.
+    pub stress: Sym3,
+}
+
+/// A ready-to-run simulation of dimension `D`.
+pub struct Simulation<D: Dim> {
+    /// World, grid, materials and state.
+    pub ctx: Context<D>,
+    /// The systems of one step, in order.
+    pub schedule: Schedule<D>,
+    /// Points whose history is recorded.
+    pub traced: Vec<TracedPoint>,
+}
+
+impl<D: Dim> Simulation<D> {
+    /// Runs one explicit step.
+    pub fn step(&mut self) -> Result<(), StepError> {
+        let s = &mut self.ctx.state;
+        s.step += 1;
+        // time = n·Δt rather than a running sum, so long runs do not drift.
+        s.time = s.step as f64 * s.dt;
+        s.reset_this_step = false;
+        self.schedule.run(&mut self.ctx)
+    }
+
+    /// Steps until a stop reason is set (convergence or a limit) or an error occurs.
+    /// `observe` is called after every step.
+    pub fn run(&mut self, mut observe: impl FnMut(&SolverState)) -> Result<(), StepError> {
+        self.ctx.state.stop = None;
+        while self.ctx.state.stop.is_none() {
+            self.step()?;
+            observe(&self.ctx.state);
+        }
+        Ok(())
+    }
+
+    /// Number of material points (load carriers included).
+    pub fn point_count(&self) -> usize {
+        points_with::<Position<D::Vec>>(&self.ctx.world).map(|a| a.len() as usize).sum()
+    }
+
+    /// Total mass of the points (kg).
+    pub fn total_mass(&self) -> f64 {
+        points_with::<Mass>(&self.ctx.world)
+            .map(|a| col::<Mass>(a).iter().map(|m| m.0).sum::<f64>())
+            .sum()
+    }
+
+    /// Current displacement and stress of every traced point.
+    pub fn traced_results(&self) -> Vec<TracedResult> {
+        self.traced
+            .iter()
+            .map(|t| {
+                let e = self.ctx.world.entity(t.entity).expect("traced point exists");
+                let u = e.get::<&Displacement<D::Vec>>().map(|u| D::vec_to3(u.0)).unwrap_or_default();
+                let stress = e.get::<&Stress>().map(|s| s.0).unwrap_or_default();
+                TracedResult {
+                    name: t.name.clone(),
+                    initial_position: t.initial_position,
+                    displacement: u,
+                    stress,
+                }
+            })
+            .collect()
+    }
+}
+
+/// A simulation of either dimension, as built from a scene.
+pub enum AnySimulation {
+    /// Plane strain.
+    Two(Simulation<Dim2>),
+    /// Three dimensions.
+    Three(Simulation<Dim3>),
+}
+
+/// Evaluates `$body` with `$sim` bound to the inner [`Simulation`] of an [`AnySimulation`].
+#[macro_export]
+macro_rules! with_simulation {
+    ($any:expr, $sim:ident => $body:expr) => {
+        match $any {
+            $crate::simulation::AnySimulation::Two($sim) => $body,
+            $crate::simulation::AnySimulation::Three($sim) => $body,
+        }
+    };
+}

@@ -1,0 +1,144 @@
+//! Solver-wide state and settings: plain structs outside the ECS world.
+
+use serde::{Deserialize, Serialize};
+
+/// Where the stress update sits in the step.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Scheme {
+    /// Update stress first, with the velocities mapped at the start of the step.
+    Usf,
+    /// Update stress last, with the updated grid velocities.
+    Usl,
+    /// Modified USL: remap the updated point velocities to the grid and use those
+    /// (Sulsky et al. 1995). The default: it is the most robust with small nodal masses.
+    #[default]
+    Musl,
+}
+
+/// Artificial damping that turns the dynamic problem into a static solver.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub enum Damping {
+    /// No damping: the plain dynamic problem.
+    None,
+    /// Kinetic damping: zero every velocity at each peak of the kinetic energy (paper §2.2).
+    #[default]
+    Kinetic,
+    /// Viscous damping F_damp = 2β M v (β in 1/s).
+    Viscous {
+        /// Damping factor β (1/s).
+        beta: f64,
+    },
+}
+
+/// Which norm of the out-of-balance force the stopping rule reads (both are always reported).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum ForceNorm {
+    /// The paper's eq. (3): max |F_ext + F_int| / max |F_ext| over free degrees of freedom.
+    #[default]
+    Max,
+    /// Σ |F_ext + F_int| / Σ |F_ext| over the same degrees of freedom (FLAC's ratio-average).
+    Mean,
+}
+
+/// Why a run stopped.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum StopReason {
+    /// K_F and K_E both at or below the tolerance.
+    Converged,
+    /// The step limit was reached first.
+    MaxSteps,
+    /// The time limit was reached first.
+    MaxTime,
+}
+
+/// Gravity acting on all points (m/s²), applied at once or ramped linearly.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Gravity {
+    /// Full gravitational acceleration (m/s², x y z).
+    pub acceleration: [f64; 3],
+    /// Time over which it rises linearly from zero (s); 0 applies it at once.
+    pub ramp_time: f64,
+}
+
+impl Gravity {
+    /// The fraction of full gravity at time `t` (s).
+    pub fn factor(&self, t: f64) -> f64 {
+        if self.ramp_time > 0.0 {
+            (t / self.ramp_time).min(1.0)
+        } else {
+            1.0
+        }
+    }
+}
+
+/// Settings fixed for the whole run.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Settings {
+    /// Update scheme.
+    pub scheme: Scheme,
+    /// Damping.
+    pub damping: Damping,
+    /// Tolerance for K_F and K_E.
+    pub tolerance: f64,
+    /// Norm of K_F that the stopping rule reads.
+    pub force_norm: ForceNorm,
+    /// Step limit.
+    pub max_steps: Option<u64>,
+    /// Simulated-time limit (s).
+    pub max_time: Option<f64>,
+    /// Gravity, if any.
+    pub gravity: Option<Gravity>,
+    /// Nodes lighter than this carry no degrees of freedom (kg).
+    pub min_node_mass: f64,
+}
+
+/// A kinetic-energy peak at which velocities were reset.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Peak {
+    /// Time of the peak (s).
+    pub time: f64,
+    /// Kinetic energy at the peak (J).
+    pub energy: f64,
+}
+
+/// Solver-wide quantities updated by the systems every step.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SolverState {
+    /// Number of the current step (1-based while the schedule runs; steps done afterwards).
+    pub step: u64,
+    /// Simulated time at the end of the current step (s).
+    pub time: f64,
+    /// Time step (s).
+    pub dt: f64,
+    /// Kinetic energy of the points after this step's velocity update, eq. (5) (J).
+    pub kinetic_energy: f64,
+    /// Kinetic energy the peak watch compares against (J); 0 after a reset.
+    pub previous_kinetic_energy: f64,
+    /// Cumulative external work, eq. (6) (J).
+    pub external_work: f64,
+    /// K_F in the max-norm, eq. (3).
+    pub force_ratio_max: f64,
+    /// K_F in the mean norm.
+    pub force_ratio_mean: f64,
+    /// K_E, eq. (4).
+    pub energy_ratio: f64,
+    /// Number of kinetic-damping resets so far.
+    pub resets: u64,
+    /// True when this step's peak watch zeroed the velocities (points do not move).
+    pub reset_this_step: bool,
+    /// Every peak at which velocities were reset.
+    pub peaks: Vec<Peak>,
+    /// Set when the run should stop after this step.
+    pub stop: Option<StopReason>,
+}
+
+impl SolverState {
+    /// K_F in the norm the stopping rule reads.
+    pub fn force_ratio(&self, norm: ForceNorm) -> f64 {
+        match norm {
+            ForceNorm::Max => self.force_ratio_max,
+            ForceNorm::Mean => self.force_ratio_mean,
+        }
+    }
+}

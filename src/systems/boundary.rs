@@ -1,0 +1,49 @@
+//! Essential boundary conditions on the grid (paper step 2).
+
+use crate::columns::{col, col_mut, nodes};
+use crate::components::*;
+use crate::dim::{Dim, Vector};
+use crate::error::StepError;
+use crate::schedule::System;
+use crate::simulation::Context;
+
+/// Zeroes the fixed components of nodal momentum and force, so that fixed nodes neither
+/// move nor accelerate.
+#[derive(Debug, Default)]
+pub struct Boundary;
+
+impl<D: Dim> System<D> for Boundary {
+    fn name(&self) -> &str {
+        "boundary"
+    }
+    fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
+        let n = nodes(&ctx.world);
+        let fix = col::<NodeFixity>(n);
+        let mut np = col_mut::<NodeMomentum<D::Vec>>(n);
+        let mut nf = col_mut::<NodeForce<D::Vec>>(n);
+        for (i, f) in fix.iter().enumerate() {
+            if f.0 == 0 {
+                continue;
+            }
+            for a in 0..D::N {
+                if f.is_fixed(a) {
+                    np[i].0.set(a, 0.0);
+                    nf[i].0.set(a, 0.0);
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Zeroes the fixed components of a nodal velocity.
+#[inline(always)]
+pub fn constrain<V: Vector>(v: &mut V, fixity: NodeFixity, dims: usize) {
+    if fixity.0 != 0 {
+        for a in 0..dims {
+            if fixity.is_fixed(a) {
+                v.set(a, 0.0);
+            }
+        }
+    }
+}

@@ -1,0 +1,47 @@
+//! Nodal integration of the equations of motion, eq. (2) (paper step 3).
+
+use crate::columns::{col, col_mut, nodes};
+use crate::components::*;
+use crate::dim::{Dim, Vector};
+use crate::error::StepError;
+use crate::schedule::System;
+use crate::simulation::Context;
+use crate::state::Damping;
+
+/// a_i = (f_i − 2β p_i)/m_i and v_i ← p_i/m_i + a_i Δt (explicit Euler on the grid).
+/// Viscous damping F_damp = 2β M v enters here; massless nodes get no motion.
+#[derive(Debug, Default)]
+pub struct Integrate;
+
+impl<D: Dim> System<D> for Integrate {
+    fn name(&self) -> &str {
+        "integrate"
+    }
+    fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
+        let dt = ctx.state.dt;
+        let beta2 = match ctx.settings.damping {
+            Damping::Viscous { beta } => 2.0 * beta,
+            _ => 0.0,
+        };
+        let min_mass = ctx.settings.min_node_mass;
+        let n = nodes(&ctx.world);
+        let nm = col::<NodeMass>(n);
+        let np = col::<NodeMomentum<D::Vec>>(n);
+        let nf = col::<NodeForce<D::Vec>>(n);
+        let mut na = col_mut::<NodeAcceleration<D::Vec>>(n);
+        let mut nv = col_mut::<NodeVelocity<D::Vec>>(n);
+        for i in 0..nm.len() {
+            let m = nm[i].0;
+            if m > min_mass {
+                let inv = 1.0 / m;
+                let a = (nf[i].0 - np[i].0 * beta2) * inv;
+                na[i].0 = a;
+                nv[i].0 = np[i].0 * inv + a * dt;
+            } else {
+                na[i].0 = D::Vec::ZERO;
+                nv[i].0 = D::Vec::ZERO;
+            }
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,39 @@
+//! Nodal velocity from mapped momentum, v_i = p_i/m_i, with the boundary conditions.
+
+use super::boundary::constrain;
+use crate::columns::{col, col_mut, nodes};
+use crate::components::*;
+use crate::dim::{Dim, Vector};
+use crate::error::StepError;
+use crate::schedule::System;
+use crate::simulation::Context;
+
+/// Sets `NodeVelocity` from `NodeMomentum` and `NodeMass` (zero on massless nodes and on
+/// fixed components). Used by the MUSL remap and by USF before its stress update.
+pub fn velocity_from_momentum<D: Dim>(ctx: &Context<D>) {
+    let min_mass = ctx.settings.min_node_mass;
+    let n = nodes(&ctx.world);
+    let nm = col::<NodeMass>(n);
+    let np = col::<NodeMomentum<D::Vec>>(n);
+    let fix = col::<NodeFixity>(n);
+    let mut nv = col_mut::<NodeVelocity<D::Vec>>(n);
+    for i in 0..nm.len() {
+        let mut v = if nm[i].0 > min_mass { np[i].0 * (1.0 / nm[i].0) } else { D::Vec::ZERO };
+        constrain(&mut v, fix[i], D::N);
+        nv[i].0 = v;
+    }
+}
+
+/// USF's nodal velocity at the start of the step.
+#[derive(Debug, Default)]
+pub struct NodalVelocity;
+
+impl<D: Dim> System<D> for NodalVelocity {
+    fn name(&self) -> &str {
+        "nodal_velocity"
+    }
+    fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
+        velocity_from_momentum(ctx);
+        Ok(())
+    }
+}

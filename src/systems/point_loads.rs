@@ -1,0 +1,66 @@
+//! Point loads: concentrated forces carried by points. Scheduled only when a scene has them.
+
+use crate::columns::{col, col_mut, nodes, points_with};
+use crate::components::*;
+use crate::dim::Dim;
+use crate::error::StepError;
+use crate::schedule::System;
+use crate::shape::{for_each_node, Shape};
+use crate::simulation::Context;
+use std::marker::PhantomData;
+
+/// Spreads each point load F over the nodes of its support that carry mass, with the shape
+/// weights renormalised over those nodes.
+///
+/// A load point at the free end of a bar sits on the last node; once the bar stretches its
+/// support reaches the empty node beyond, where a share of F would be lost (massless nodes
+/// have no degrees of freedom). Renormalising keeps the whole load on the body.
+#[derive(Debug)]
+pub struct PointLoads<D, S>(PhantomData<fn() -> (D, S)>);
+
+impl<D, S> Default for PointLoads<D, S> {
+    fn default() -> Self {
+        PointLoads(PhantomData)
+    }
+}
+
+impl<D: Dim, S: Shape> System<D> for PointLoads<D, S> {
+    fn name(&self) -> &str {
+        "point_loads"
+    }
+    fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
+        let grid = &ctx.grid;
+        let min_mass = ctx.settings.min_node_mass;
+        let n = nodes(&ctx.world);
+        let nm = col::<NodeMass>(n);
+        let mut nf = col_mut::<NodeForce<D::Vec>>(n);
+        let mut ne = col_mut::<NodeExternalForce<D::Vec>>(n);
+        for arch in points_with::<PointLoad<D::Vec>>(&ctx.world) {
+            let x = col::<Position<D::Vec>>(arch);
+            let load = col::<PointLoad<D::Vec>>(arch);
+            for p in 0..x.len() {
+                let mut carried = 0.0;
+                for_each_node::<D, S>(grid, x[p].0, |i, w, _| {
+                    if nm[i].0 > min_mass {
+                        carried += w;
+                    }
+                });
+                if carried <= 0.0 {
+                    return Err(StepError::LoadLost {
+                        step: ctx.state.step,
+                        point: p,
+                        position: D::vec_to3(x[p].0),
+                    });
+                }
+                let f = load[p].0 * (1.0 / carried);
+                for_each_node::<D, S>(grid, x[p].0, |i, w, _| {
+                    if nm[i].0 > min_mass {
+                        nf[i].0 += f * w;
+                        ne[i].0 += f * w;
+                    }
+                });
+            }
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,51 @@
+//! MUSL remap: the updated point velocities mapped back to the grid (paper step 6).
+
+use super::nodal_velocity::velocity_from_momentum;
+use crate::columns::{col, col_mut, nodes, points_with};
+use crate::components::*;
+use crate::dim::{Dim, Vector};
+use crate::error::StepError;
+use crate::schedule::System;
+use crate::shape::{for_each_node, Shape};
+use crate::simulation::Context;
+use std::marker::PhantomData;
+
+/// p_i = Σ_p w_ip m_p v_p with the new v_p, then v_i = p_i/m_i with boundary conditions.
+/// After a kinetic-damping reset all v_p are zero, and so is the remapped field.
+#[derive(Debug)]
+pub struct Remap<D, S>(PhantomData<fn() -> (D, S)>);
+
+impl<D, S> Default for Remap<D, S> {
+    fn default() -> Self {
+        Remap(PhantomData)
+    }
+}
+
+impl<D: Dim, S: Shape> System<D> for Remap<D, S> {
+    fn name(&self) -> &str {
+        "remap"
+    }
+    fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
+        let n = nodes(&ctx.world);
+        if ctx.state.reset_this_step {
+            col_mut::<NodeVelocity<D::Vec>>(n).fill(NodeVelocity(D::Vec::ZERO));
+            return Ok(());
+        }
+        {
+            let grid = &ctx.grid;
+            let mut np = col_mut::<NodeMomentum<D::Vec>>(n);
+            np.fill(NodeMomentum(D::Vec::ZERO));
+            for arch in points_with::<Velocity<D::Vec>>(&ctx.world) {
+                let x = col::<Position<D::Vec>>(arch);
+                let m = col::<Mass>(arch);
+                let v = col::<Velocity<D::Vec>>(arch);
+                for p in 0..x.len() {
+                    let mv = v[p].0 * m[p].0;
+                    for_each_node::<D, S>(grid, x[p].0, |i, w, _| np[i].0 += mv * w);
+                }
+            }
+        }
+        velocity_from_momentum(ctx);
+        Ok(())
+    }
+}

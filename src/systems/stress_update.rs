@@ -1,0 +1,42 @@
+//! Constitutive update with the Jaumann stress rate, eqs. (7)–(10) (paper step 6).
+
+use crate::columns::{col, col_mut, points_with};
+use crate::components::*;
+use crate::dim::Dim;
+use crate::error::StepError;
+use crate::materials::Material;
+use crate::schedule::System;
+use crate::simulation::Context;
+use crate::tensor::jaumann_rotate;
+
+/// For each point: Δε = sym(L)Δt and ΔW = skew(L)Δt; the stress is first rotated by ΔW
+/// (objective Jaumann term) and then integrated by the point's material over Δε.
+#[derive(Debug, Default)]
+pub struct StressUpdate;
+
+impl<D: Dim> System<D> for StressUpdate {
+    fn name(&self) -> &str {
+        "stress_update"
+    }
+    fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
+        if ctx.state.reset_this_step {
+            return Ok(());
+        }
+        let dt = ctx.state.dt;
+        let materials = &ctx.materials;
+        for arch in points_with::<Stress>(&ctx.world) {
+            let l = col::<VelocityGradient<D::Mat>>(arch);
+            let mat = col::<MaterialId>(arch);
+            let mut stress = col_mut::<Stress>(arch);
+            let mut plastic = arch.get::<&mut PlasticStrain>();
+            for p in 0..stress.len() {
+                let (de, w) = D::strain_spin(&l[p].0, dt);
+                let mut s = jaumann_rotate(&stress[p].0, w);
+                let eps = plastic.as_mut().map(|e| &mut e[p].0);
+                materials[mat[p].0 as usize].update(&mut s, &de, eps);
+                stress[p].0 = s;
+            }
+        }
+        Ok(())
+    }
+}

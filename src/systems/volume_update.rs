@@ -1,0 +1,32 @@
+//! Volume (and so density ρ = m/V) update (paper step 6).
+
+use crate::columns::{col, col_mut, points_with};
+use crate::components::*;
+use crate::dim::Dim;
+use crate::error::StepError;
+use crate::schedule::System;
+use crate::simulation::Context;
+
+/// V_p ← V_p · det(I + L_p Δt). Density is not stored: it is m_p / V_p.
+#[derive(Debug, Default)]
+pub struct VolumeUpdate;
+
+impl<D: Dim> System<D> for VolumeUpdate {
+    fn name(&self) -> &str {
+        "volume_update"
+    }
+    fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
+        if ctx.state.reset_this_step {
+            return Ok(());
+        }
+        let dt = ctx.state.dt;
+        for arch in points_with::<Volume>(&ctx.world) {
+            let l = col::<VelocityGradient<D::Mat>>(arch);
+            let mut vol = col_mut::<Volume>(arch);
+            for (v, l) in vol.iter_mut().zip(l.iter()) {
+                v.0 *= D::volume_ratio(&l.0, dt);
+            }
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,302 @@
+//! Symmetric second-order tensors (stress in Pa, strain increments, dimensionless), their
+//! principal values, and the objective (Jaumann) rotation of stress.
+//!
+//! Sign convention: tension positive, as in continuum mechanics.
+
+use glam::{DMat3, DVec3};
+use std::ops::{Add, AddAssign, Mul, Sub, SubAssign};
+
+/// A symmetric 3×3 tensor stored by its six independent components.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Sym3 {
+    /// Component xx.
+    pub xx: f64,
+    /// Component yy.
+    pub yy: f64,
+    /// Component zz.
+    pub zz: f64,
+    /// Component xy (= yx).
+    pub xy: f64,
+    /// Component yz (= zy).
+    pub yz: f64,
+    /// Component zx (= xz).
+    pub zx: f64,
+}
+
+impl Sym3 {
+    /// The zero tensor.
+    pub const ZERO: Sym3 = Sym3 { xx: 0.0, yy: 0.0, zz: 0.0, xy: 0.0, yz: 0.0, zx: 0.0 };
+    /// The identity tensor.
+    pub const IDENTITY: Sym3 = Sym3 { xx: 1.0, yy: 1.0, zz: 1.0, xy: 0.0, yz: 0.0, zx: 0.0 };
+
+    /// A diagonal tensor.
+    pub const fn diagonal(a: f64, b: f64, c: f64) -> Sym3 {
+        Sym3 { xx: a, yy: b, zz: c, xy: 0.0, yz: 0.0, zx: 0.0 }
+    }
+
+    /// Trace (sum of the diagonal).
+    #[inline(always)]
+    pub fn trace(&self) -> f64 {
+        self.xx + self.yy + self.zz
+    }
+
+    /// Double contraction a:b.
+    #[inline(always)]
+    pub fn ddot(&self, b: &Sym3) -> f64 {
+        self.xx * b.xx
+            + self.yy * b.yy
+            + self.zz * b.zz
+            + 2.0 * (self.xy * b.xy + self.yz * b.yz + self.zx * b.zx)
+    }
+
+    /// Frobenius norm sqrt(a:a).
+    #[inline(always)]
+    pub fn norm(&self) -> f64 {
+        self.ddot(self).sqrt()
+    }
+
+    /// True when every component is finite.
+    #[inline(always)]
+    pub fn is_finite(&self) -> bool {
+        self.to_array().iter().all(|c| c.is_finite())
+    }
+
+    /// Components in the order xx, yy, zz, xy, yz, zx.
+    #[inline(always)]
+    pub fn to_array(&self) -> [f64; 6] {
+        [self.xx, self.yy, self.zz, self.xy, self.yz, self.zx]
+    }
+
+    /// The full matrix.
+    #[inline(always)]
+    pub fn to_mat3(&self) -> DMat3 {
+        DMat3::from_cols(
+            DVec3::new(self.xx, self.xy, self.zx),
+            DVec3::new(self.xy, self.yy, self.yz),
+            DVec3::new(self.zx, self.yz, self.zz),
+        )
+    }
+
+    /// The symmetric part of a matrix.
+    #[inline(always)]
+    pub fn from_mat3(m: &DMat3) -> Sym3 {
+        let c = |i: usize, j: usize| m.col(j)[i];
+        Sym3 {
+            xx: c(0, 0),
+            yy: c(1, 1),
+            zz: c(2, 2),
+            xy: 0.5 * (c(0, 1) + c(1, 0)),
+            yz: 0.5 * (c(1, 2) + c(2, 1)),
+            zx: 0.5 * (c(2, 0) + c(0, 2)),
+        }
+    }
+
+    /// R·a·Rᵀ built from principal values `p` and the principal directions (columns of `r`).
+    #[inline]
+    pub fn from_principal(p: [f64; 3], r: &DMat3) -> Sym3 {
+        let d = DMat3::from_diagonal(DVec3::from_array(p));
+        Sym3::from_mat3(&(*r * d * r.transpose()))
+    }
+
+    /// Principal values in descending order (σ1 ≥ σ2 ≥ σ3) and the matching unit
+    /// eigenvectors as the columns of a rotation matrix.
+    pub fn eigen(&self) -> ([f64; 3], DMat3) {
+        let (vals, vecs) = jacobi_eigen(self);
+        let mut order = [0usize, 1, 2];
+        order.sort_by(|&i, &j| vals[j].total_cmp(&vals[i]));
+        let p = [vals[order[0]], vals[order[1]], vals[order[2]]];
+        let r = DMat3::from_cols(vecs.col(order[0]), vecs.col(order[1]), vecs.col(order[2]));
+        (p, r)
+    }
+
+    /// Principal values in descending order.
+    pub fn principal_values(&self) -> [f64; 3] {
+        self.eigen().0
+    }
+}
+
+/// Cyclic Jacobi eigen-decomposition of a symmetric 3×3 tensor. Robust for repeated
+/// eigenvalues (common here: a uniaxial or zero stress), which closed forms handle badly.
+fn jacobi_eigen(s: &Sym3) -> ([f64; 3], DMat3) {
+    let mut a = [[s.xx, s.xy, s.zx], [s.xy, s.yy, s.yz], [s.zx, s.yz, s.zz]];
+    let mut v = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    let scale = s.norm();
+    for _sweep in 0..32 {
+        let off = a[0][1].abs() + a[1][2].abs() + a[0][2].abs();
+        if off <= f64::EPSILON * 1e-3 * scale || off == 0.0 {
+            break;
+        }
+        for (p, q) in [(0usize, 1usize), (0, 2), (1, 2)] {
+            let apq = a[p][q];
+            if apq == 0.0 {
+                continue;
+            }
+            let theta = (a[q][q] - a[p][p]) / (2.0 * apq);
+            let t = theta.signum() / (theta.abs() + (theta * theta + 1.0).sqrt());
+            let t = if theta == 0.0 { 1.0 } else { t };
+            let c = 1.0 / (t * t + 1.0).sqrt();
+            let sn = t * c;
+            for k in 0..3 {
+                let akp = a[k][p];
+                let akq = a[k][q];
+                a[k][p] = c * akp - sn * akq;
+                a[k][q] = sn * akp + c * akq;
+            }
+            for k in 0..3 {
+                let apk = a[p][k];
+                let aqk = a[q][k];
+                a[p][k] = c * apk - sn * aqk;
+                a[q][k] = sn * apk + c * aqk;
+            }
+            for row in v.iter_mut() {
+                let vp = row[p];
+                let vq = row[q];
+                row[p] = c * vp - sn * vq;
+                row[q] = sn * vp + c * vq;
+            }
+        }
+    }
+    let vecs = DMat3::from_cols(
+        DVec3::new(v[0][0], v[1][0], v[2][0]),
+        DVec3::new(v[0][1], v[1][1], v[2][1]),
+        DVec3::new(v[0][2], v[1][2], v[2][2]),
+    );
+    ([a[0][0], a[1][1], a[2][2]], vecs)
+}
+
+/// Rotates `stress` by the spin increment `w = (W_yz, W_zx, W_xy)·dt` (the skew part of the
+/// velocity gradient times the step): the Jaumann-rate term σ̇ = … + Wσ − σW of eq. (8).
+///
+/// The rotation is the Cayley transform R = (I − W/2)⁻¹(I + W/2) (Hughes–Winget), which is
+/// exactly orthogonal: a rigid rotation leaves the principal stresses unchanged to round-off,
+/// where the forward-Euler form σ + Wσ − σW would inflate them by (1 + |w|²) every step.
+#[inline]
+pub fn jaumann_rotate(stress: &Sym3, w: [f64; 3]) -> Sym3 {
+    if w == [0.0; 3] {
+        return *stress;
+    }
+    // Half-spin matrix Â = W/2 with W_xy = w[2], W_yz = w[0], W_zx = w[1] (W skew).
+    let (a, b, c) = (0.5 * w[0], 0.5 * w[1], 0.5 * w[2]);
+    let half = DMat3::from_cols(
+        DVec3::new(0.0, -c, b),
+        DVec3::new(c, 0.0, -a),
+        DVec3::new(-b, a, 0.0),
+    );
+    // Cayley: R = I + 2/(1 + |a|²) (Â + Â²).
+    let k = 2.0 / (1.0 + a * a + b * b + c * c);
+    let r = DMat3::IDENTITY + (half + half * half) * k;
+    Sym3::from_mat3(&(r * stress.to_mat3() * r.transpose()))
+}
+
+impl Add for Sym3 {
+    type Output = Sym3;
+    #[inline(always)]
+    fn add(self, b: Sym3) -> Sym3 {
+        Sym3 {
+            xx: self.xx + b.xx,
+            yy: self.yy + b.yy,
+            zz: self.zz + b.zz,
+            xy: self.xy + b.xy,
+            yz: self.yz + b.yz,
+            zx: self.zx + b.zx,
+        }
+    }
+}
+
+impl Sub for Sym3 {
+    type Output = Sym3;
+    #[inline(always)]
+    fn sub(self, b: Sym3) -> Sym3 {
+        self + b * -1.0
+    }
+}
+
+impl Mul<f64> for Sym3 {
+    type Output = Sym3;
+    #[inline(always)]
+    fn mul(self, k: f64) -> Sym3 {
+        Sym3 {
+            xx: self.xx * k,
+            yy: self.yy * k,
+            zz: self.zz * k,
+            xy: self.xy * k,
+            yz: self.yz * k,
+            zx: self.zx * k,
+        }
+    }
+}
+
+impl AddAssign for Sym3 {
+    #[inline(always)]
+    fn add_assign(&mut self, b: Sym3) {
+        *self = *self + b;
+    }
+}
+
+impl SubAssign for Sym3 {
+    #[inline(always)]
+    fn sub_assign(&mut self, b: Sym3) {
+        *self = *self - b;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample() -> Sym3 {
+        Sym3 { xx: -3.0e5, yy: -1.2e5, zz: -0.7e5, xy: 4.0e4, yz: -1.0e4, zx: 2.5e4 }
+    }
+
+    #[test]
+    fn eigen_reconstructs_the_tensor() {
+        let s = sample();
+        let (p, r) = s.eigen();
+        assert!(p[0] >= p[1] && p[1] >= p[2]);
+        let back = Sym3::from_principal(p, &r);
+        assert!((back - s).norm() < 1e-9 * s.norm());
+        assert!((p.iter().sum::<f64>() - s.trace()).abs() < 1e-9 * s.norm());
+    }
+
+    #[test]
+    fn eigen_handles_repeated_values() {
+        let (p, _) = Sym3::diagonal(-1.0, -1.0, -1.0).eigen();
+        assert_eq!(p, [-1.0, -1.0, -1.0]);
+        let (p, _) = Sym3::ZERO.eigen();
+        assert_eq!(p, [0.0; 3]);
+    }
+
+    #[test]
+    fn rigid_rotation_through_jaumann_update_keeps_principal_stresses() {
+        // A full turn about a skew axis in 1000 increments: the Cayley rotation is orthogonal,
+        // so the principal values must survive to round-off.
+        let s0 = sample();
+        let p0 = s0.principal_values();
+        let axis = DVec3::new(0.3, -0.5, 0.8).normalize();
+        let dtheta = 2.0 * std::f64::consts::PI / 1000.0;
+        let mut s = s0;
+        for _ in 0..1000 {
+            s = jaumann_rotate(&s, (axis * dtheta).to_array());
+        }
+        let p = s.principal_values();
+        for k in 0..3 {
+            assert!((p[k] - p0[k]).abs() < 1e-9 * s0.norm(), "{p:?} vs {p0:?}");
+        }
+    }
+
+    #[test]
+    fn small_spin_matches_the_jaumann_rate() {
+        // For a small increment the rotation must equal σ + Wσ − σW to second order.
+        let s = sample();
+        let w = [1e-6, -2e-6, 3e-6];
+        let rotated = jaumann_rotate(&s, w);
+        let wm = DMat3::from_cols(
+            DVec3::new(0.0, -w[2], w[1]),
+            DVec3::new(w[2], 0.0, -w[0]),
+            DVec3::new(-w[1], w[0], 0.0),
+        );
+        let sm = s.to_mat3();
+        let euler = Sym3::from_mat3(&(sm + wm * sm - sm * wm));
+        assert!((rotated - euler).norm() < 1e-9 * s.norm());
+    }
+}
