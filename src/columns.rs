@@ -32,5 +32,7 @@ pub fn nodes(world: &World) -> &Archetype {
 /// Non-empty archetypes that hold component `T` and are not grid nodes: the material-point
 /// archetypes a system visits.
 pub fn points_with<T: Component>(world: &World) -> impl Iterator<Item = &Archetype> {
-    world.archetypes().filter(|a| a.has::<T>() && !a.is_empty() && !a.has::<NodeMass>())
+    world
+        .archetypes()
+        .filter(|a| a.has::<T>() && !a.is_empty() && !a.has::<NodeMass>())
 }

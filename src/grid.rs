@@ -58,7 +58,13 @@ impl<D: Dim> Grid<D> {
         let mut c = [0usize; 3];
         c[..D::N].copy_from_slice(&cells[..D::N]);
         let nodes = [c[0] + 1, c[1] + 1, c[2] + 1];
-        Grid { origin, cell_size, inv_h: 1.0 / cell_size, cells: c, nodes }
+        Grid {
+            origin,
+            cell_size,
+            inv_h: 1.0 / cell_size,
+            cells: c,
+            nodes,
+        }
     }
 
     /// Total number of nodes.
@@ -116,7 +122,8 @@ impl<D: Dim> Grid<D> {
 
     /// Linear cell id of `x` (for sorting points by cell), or `None` outside the grid.
     pub fn cell_id(&self, x: D::Vec) -> Option<usize> {
-        self.cell_of(x).map(|c| c[0] + self.cells[0] * (c[1] + self.cells[1].max(1) * c[2]))
+        self.cell_of(x)
+            .map(|c| c[0] + self.cells[0] * (c[1] + self.cells[1].max(1) * c[2]))
     }
 
     /// True when `x` lies inside the grid's bounding box (faces included).

@@ -9,7 +9,11 @@ use std::process::ExitCode;
 use std::time::Instant;
 
 #[derive(Parser)]
-#[command(name = "kdmpm", version, about = "Static large-deformation MPM with kinetic damping")]
+#[command(
+    name = "kdmpm",
+    version,
+    about = "Static large-deformation MPM with kinetic damping"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -52,7 +56,13 @@ const RUN_FAILED: u8 = 1;
 fn main() -> ExitCode {
     match Cli::parse().command {
         Command::Check { scene, overrides } => check(&scene, &overrides),
-        Command::Run { scene, out, overrides, profile, quiet } => run(&scene, out, &overrides, profile, quiet),
+        Command::Run {
+            scene,
+            out,
+            overrides,
+            profile,
+            quiet,
+        } => run(&scene, out, &overrides, profile, quiet),
     }
 }
 
@@ -65,7 +75,11 @@ fn check(path: &Path, overrides: &[String]) -> ExitCode {
             println!("  active nodes          {} of {}", d.active_nodes, d.grid_nodes);
             println!("  P-wave speed          {:.6} m/s", d.p_wave_speed);
             println!("  critical time step    {:.6e} s", d.critical_time_step);
-            println!("  time step             {:.6e} s (Courant {:.3})", d.time_step, d.time_step / d.critical_time_step);
+            println!(
+                "  time step             {:.6e} s (Courant {:.3})",
+                d.time_step,
+                d.time_step / d.critical_time_step
+            );
             println!("  systems               {}", d.systems.join(" → "));
             ExitCode::SUCCESS
         }
@@ -77,14 +91,17 @@ fn check(path: &Path, overrides: &[String]) -> ExitCode {
 }
 
 fn run(path: &Path, out: Option<PathBuf>, overrides: &[String], profile: bool, quiet: bool) -> ExitCode {
-    let (loaded, mut sim) = match LoadedScene::from_file(path, overrides).and_then(|l| build(&l).map(|(s, _)| (l, s))) {
-        Ok(v) => v,
-        Err(e) => {
-            eprintln!("error: {e}");
-            return ExitCode::from(BAD_INPUT);
-        }
-    };
-    let stem = path.file_stem().map_or("scene".into(), |s| s.to_string_lossy().into_owned());
+    let (loaded, mut sim) =
+        match LoadedScene::from_file(path, overrides).and_then(|l| build(&l).map(|(s, _)| (l, s))) {
+            Ok(v) => v,
+            Err(e) => {
+                eprintln!("error: {e}");
+                return ExitCode::from(BAD_INPUT);
+            }
+        };
+    let stem = path
+        .file_stem()
+        .map_or("scene".into(), |s| s.to_string_lossy().into_owned());
     let out = out.unwrap_or_else(|| Path::new("out").join(&stem));
     if let Err(e) = std::fs::create_dir_all(&out) {
         eprintln!("error: cannot create output directory {}: {e}", out.display());
@@ -94,7 +111,14 @@ fn run(path: &Path, out: Option<PathBuf>, overrides: &[String], profile: bool, q
     with_simulation!(&mut sim, s => run_dim(s, path, &out, every, profile, quiet))
 }
 
-fn run_dim<D: Dim>(sim: &mut Simulation<D>, scene: &Path, out: &Path, every: u64, profile: bool, quiet: bool) -> ExitCode {
+fn run_dim<D: Dim>(
+    sim: &mut Simulation<D>,
+    scene: &Path,
+    out: &Path,
+    every: u64,
+    profile: bool,
+    quiet: bool,
+) -> ExitCode {
     let history = match History::<D>::create(&out.join("history.csv"), every, &sim.traced) {
         Ok(h) => h,
         Err(e) => {
@@ -104,7 +128,13 @@ fn run_dim<D: Dim>(sim: &mut Simulation<D>, scene: &Path, out: &Path, every: u64
     };
     sim.schedule.push(history);
     if !quiet {
-        eprintln!("{}: {} points, {}D, Δt = {:.4e} s", scene.display(), sim.point_count(), D::N, sim.ctx.state.dt);
+        eprintln!(
+            "{}: {} points, {}D, Δt = {:.4e} s",
+            scene.display(),
+            sim.point_count(),
+            D::N,
+            sim.ctx.state.dt
+        );
     }
     let start = Instant::now();
     let mut last_report = Instant::now();
@@ -151,10 +181,24 @@ fn run_dim<D: Dim>(sim: &mut Simulation<D>, scene: &Path, out: &Path, every: u64
 
 fn print_profile(summary: &Summary) {
     let total: f64 = summary.systems.iter().map(|t| t.seconds).sum();
-    println!("{:<18} {:>10} {:>12} {:>12} {:>7}", "system", "calls", "total (s)", "mean (µs)", "share");
+    println!(
+        "{:<18} {:>10} {:>12} {:>12} {:>7}",
+        "system", "calls", "total (s)", "mean (µs)", "share"
+    );
     for t in &summary.systems {
-        let mean = if t.calls > 0 { 1e6 * t.seconds / t.calls as f64 } else { 0.0 };
-        let share = if total > 0.0 { 100.0 * t.seconds / total } else { 0.0 };
-        println!("{:<18} {:>10} {:>12.4} {:>12.2} {:>6.1}%", t.name, t.calls, t.seconds, mean, share);
+        let mean = if t.calls > 0 {
+            1e6 * t.seconds / t.calls as f64
+        } else {
+            0.0
+        };
+        let share = if total > 0.0 {
+            100.0 * t.seconds / total
+        } else {
+            0.0
+        };
+        println!(
+            "{:<18} {:>10} {:>12.4} {:>12.2} {:>6.1}%",
+            t.name, t.calls, t.seconds, mean, share
+        );
     }
 }

@@ -61,7 +61,11 @@ pub struct Schedule<D: Dim> {
 
 impl<D: Dim> Default for Schedule<D> {
     fn default() -> Self {
-        Schedule { systems: Vec::new(), time: Vec::new(), calls: Vec::new() }
+        Schedule {
+            systems: Vec::new(),
+            time: Vec::new(),
+            calls: Vec::new(),
+        }
     }
 }
 

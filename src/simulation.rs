@@ -84,7 +84,9 @@ impl<D: Dim> Simulation<D> {
 
     /// Number of material points (load carriers included).
     pub fn point_count(&self) -> usize {
-        points_with::<Position<D::Vec>>(&self.ctx.world).map(|a| a.len() as usize).sum()
+        points_with::<Position<D::Vec>>(&self.ctx.world)
+            .map(|a| a.len() as usize)
+            .sum()
     }
 
     /// Total mass of the points (kg).
@@ -100,7 +102,10 @@ impl<D: Dim> Simulation<D> {
             .iter()
             .map(|t| {
                 let e = self.ctx.world.entity(t.entity).expect("traced point exists");
-                let u = e.get::<&Displacement<D::Vec>>().map(|u| D::vec_to3(u.0)).unwrap_or_default();
+                let u = e
+                    .get::<&Displacement<D::Vec>>()
+                    .map(|u| D::vec_to3(u.0))
+                    .unwrap_or_default();
                 let stress = e.get::<&Stress>().map(|s| s.0).unwrap_or_default();
                 TracedResult {
                     name: t.name.clone(),

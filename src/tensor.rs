@@ -25,13 +25,34 @@ pub struct Sym3 {
 
 impl Sym3 {
     /// The zero tensor.
-    pub const ZERO: Sym3 = Sym3 { xx: 0.0, yy: 0.0, zz: 0.0, xy: 0.0, yz: 0.0, zx: 0.0 };
+    pub const ZERO: Sym3 = Sym3 {
+        xx: 0.0,
+        yy: 0.0,
+        zz: 0.0,
+        xy: 0.0,
+        yz: 0.0,
+        zx: 0.0,
+    };
     /// The identity tensor.
-    pub const IDENTITY: Sym3 = Sym3 { xx: 1.0, yy: 1.0, zz: 1.0, xy: 0.0, yz: 0.0, zx: 0.0 };
+    pub const IDENTITY: Sym3 = Sym3 {
+        xx: 1.0,
+        yy: 1.0,
+        zz: 1.0,
+        xy: 0.0,
+        yz: 0.0,
+        zx: 0.0,
+    };
 
     /// A diagonal tensor.
     pub const fn diagonal(a: f64, b: f64, c: f64) -> Sym3 {
-        Sym3 { xx: a, yy: b, zz: c, xy: 0.0, yz: 0.0, zx: 0.0 }
+        Sym3 {
+            xx: a,
+            yy: b,
+            zz: c,
+            xy: 0.0,
+            yz: 0.0,
+            zx: 0.0,
+        }
     }
 
     /// Trace (sum of the diagonal).
@@ -245,7 +266,14 @@ mod tests {
     use super::*;
 
     fn sample() -> Sym3 {
-        Sym3 { xx: -3.0e5, yy: -1.2e5, zz: -0.7e5, xy: 4.0e4, yz: -1.0e4, zx: 2.5e4 }
+        Sym3 {
+            xx: -3.0e5,
+            yy: -1.2e5,
+            zz: -0.7e5,
+            xy: 4.0e4,
+            yz: -1.0e4,
+            zx: 2.5e4,
+        }
     }
 
     #[test]

@@ -15,7 +15,10 @@ pub struct LinearElastic {
 impl LinearElastic {
     /// From density (kg/m³), Young's modulus (Pa) and Poisson's ratio.
     pub fn new(density: f64, youngs_modulus: f64, poisson_ratio: f64) -> Self {
-        LinearElastic { density, elasticity: Elasticity::new(youngs_modulus, poisson_ratio) }
+        LinearElastic {
+            density,
+            elasticity: Elasticity::new(youngs_modulus, poisson_ratio),
+        }
     }
 }
 

@@ -39,7 +39,10 @@ impl Elasticity {
     /// From Young's modulus E (Pa) and Poisson's ratio ν.
     pub fn new(youngs_modulus: f64, poisson_ratio: f64) -> Self {
         let (e, nu) = (youngs_modulus, poisson_ratio);
-        Elasticity { shear: e / (2.0 * (1.0 + nu)), lambda: e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)) }
+        Elasticity {
+            shear: e / (2.0 * (1.0 + nu)),
+            lambda: e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)),
+        }
     }
 
     /// Bulk modulus K (Pa).

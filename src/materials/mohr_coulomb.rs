@@ -131,7 +131,11 @@ impl MohrCoulomb {
         // Edges: the line through a point on both planes, along their intersection.
         let edges = [
             (DVec3::new(1.0, 1.0, self.k), self.flow_12, Return::EdgeOneTwo),
-            (DVec3::new(1.0, self.k, self.k), self.flow_23, Return::EdgeTwoThree),
+            (
+                DVec3::new(1.0, self.k, self.k),
+                self.flow_23,
+                Return::EdgeTwoThree,
+            ),
         ];
         for (dir, flow_b, kind) in edges {
             let p0 = match self.apex {
@@ -157,7 +161,9 @@ impl MohrCoulomb {
                 return (s, kind);
             }
         }
-        let apex = self.apex.expect("a Tresca return always lands on a plane or an edge");
+        let apex = self
+            .apex
+            .expect("a Tresca return always lands on a plane or an edge");
         (DVec3::splat(apex), Return::Apex)
     }
 
@@ -317,12 +323,29 @@ mod tests {
         }
     }
 
-    /// Drives a stress path by strain increments and returns the final principal stresses.
-    fn drive(mc: &MohrCoulomb, start: Sym3, de: Sym3, steps: usize) -> [f64; 3] {
-        let mut s = start;
+    /// A stress-controlled triaxial test: axial strain increments `de_axial` along z while
+    /// the lateral stresses σxx = σyy are held at `confinement` (Pa, tension positive) by
+    /// solving for the lateral strain increment (bisection). Returns the principal stresses.
+    fn triaxial(mc: &MohrCoulomb, confinement: f64, de_axial: f64, steps: usize) -> [f64; 3] {
+        let mut s = Sym3::diagonal(confinement, confinement, confinement);
         let mut eps = 0.0;
         for _ in 0..steps {
-            mc.update(&mut s, &de, Some(&mut eps));
+            let attempt = |e: f64| {
+                let mut t = s;
+                let mut p = eps;
+                mc.update(&mut t, &Sym3::diagonal(e, e, de_axial), Some(&mut p));
+                (t, p)
+            };
+            let (mut lo, mut hi) = (-1e-3, 1e-3);
+            for _ in 0..200 {
+                let mid = 0.5 * (lo + hi);
+                if attempt(mid).0.xx > confinement {
+                    hi = mid;
+                } else {
+                    lo = mid;
+                }
+            }
+            (s, eps) = attempt(0.5 * (lo + hi));
         }
         s.principal_values()
     }
@@ -332,27 +355,22 @@ mod tests {
         // Confined at σ3' = 100 kPa (compression positive), axial strain until failure.
         // Analytic peak: σ1' = σ3' (1 + sin φ)/(1 − sin φ) + 2c cos φ/(1 − sin φ).
         let (c, phi) = (10e3, 30.0f64);
-        let mc = MohrCoulomb::new(2000.0, 20e6, 0.0, c, phi, 0.0, None);
-        let conf = -100e3;
-        // ν = 0: an axial strain increment leaves the lateral stresses at the confinement.
-        let de = Sym3 { zz: -1e-5, ..Sym3::ZERO };
-        let p = drive(&mc, Sym3::diagonal(conf, conf, conf), de, 2000);
+        let mc = MohrCoulomb::new(2000.0, 20e6, 0.3, c, phi, 0.0, None);
+        let p = triaxial(&mc, -100e3, -1e-4, 300);
         let sp = phi.to_radians().sin();
         let peak = 100e3 * (1.0 + sp) / (1.0 - sp) + 2.0 * c * phi.to_radians().cos() / (1.0 - sp);
-        assert!((-p[2] - peak).abs() < 1e-6 * peak, "σ1' = {} vs {}", -p[2], peak);
-        assert!((-p[0] - 100e3).abs() < 1e-6 * peak);
+        assert!((-p[2] / peak - 1.0).abs() < 1e-6, "σ1' = {} vs {}", -p[2], peak);
+        assert!((-p[0] / 100e3 - 1.0).abs() < 1e-6, "σ3' = {}", -p[0]);
     }
 
     #[test]
     fn uniaxial_compression_reaches_the_unconfined_strength() {
         // Unconfined (σ3' = 0): σ1' = 2c cos φ/(1 − sin φ).
         let (c, phi) = (25e3, 25.0f64);
-        let mc = MohrCoulomb::new(2000.0, 20e6, 0.0, c, phi, 0.0, None);
-        let de = Sym3 { yy: -1e-5, ..Sym3::ZERO };
-        let p = drive(&mc, Sym3::ZERO, de, 2000);
-        let sp = phi.to_radians().sin();
-        let ucs = 2.0 * c * phi.to_radians().cos() / (1.0 - sp);
-        assert!((-p[2] - ucs).abs() < 1e-6 * ucs, "σ1' = {} vs {}", -p[2], ucs);
+        let mc = MohrCoulomb::new(2000.0, 20e6, 0.25, c, phi, 5.0, None);
+        let p = triaxial(&mc, 0.0, -1e-4, 300);
+        let ucs = 2.0 * c * phi.to_radians().cos() / (1.0 - phi.to_radians().sin());
+        assert!((-p[2] / ucs - 1.0).abs() < 1e-6, "σ1' = {} vs {}", -p[2], ucs);
     }
 
     #[test]

@@ -45,7 +45,12 @@ impl<D: Dim> History<D> {
             }
         }
         writer.write_record(&header).map_err(std::io::Error::other)?;
-        Ok(History { writer, every, traced: traced.iter().map(|t| t.entity).collect(), _marker: PhantomData })
+        Ok(History {
+            writer,
+            every,
+            traced: traced.iter().map(|t| t.entity).collect(),
+            _marker: PhantomData,
+        })
     }
 }
 
@@ -71,7 +76,11 @@ impl<D: Dim> System<D> for History<D> {
         ];
         for &e in &self.traced {
             // A handful of traced points: an entity lookup is fine here.
-            let u = ctx.world.get::<&Displacement<D::Vec>>(e).map(|u| D::vec_to3(u.0)).unwrap_or_default();
+            let u = ctx
+                .world
+                .get::<&Displacement<D::Vec>>(e)
+                .map(|u| D::vec_to3(u.0))
+                .unwrap_or_default();
             row.extend(u.iter().take(D::N).map(|c| format!("{c:.9e}")));
         }
         self.writer.write_record(&row).map_err(std::io::Error::other)?;

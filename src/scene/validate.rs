@@ -26,9 +26,22 @@ pub struct Derived {
     pub systems: Vec<String>,
 }
 
-/// Checks every rule that does not need the points; returns the material table in name
-/// order and the time step.
-pub fn check(loaded: &LoadedScene) -> Result<(Vec<(String, MaterialModel)>, f64, f64, f64), SceneError> {
+/// What [`check`] establishes: the material table in name order, the largest P-wave speed
+/// (m/s), the critical time step (s) and the time step to use (s).
+pub type Checked = (Vec<(String, MaterialModel)>, f64, f64, f64);
+
+/// True for a finite number > 0 (NaN fails).
+fn positive(x: f64) -> bool {
+    x > 0.0 && x.is_finite()
+}
+
+/// True for a finite number ≥ 0 (NaN fails).
+fn non_negative(x: f64) -> bool {
+    x >= 0.0 && x.is_finite()
+}
+
+/// Checks every rule that does not need the points.
+pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
     let s = &loaded.scene;
     let bad = |field: &str, rule: String| Err(loaded.invalid(field, rule));
     if s.dimension != 2 && s.dimension != 3 {
@@ -43,14 +56,24 @@ pub fn check(loaded: &LoadedScene) -> Result<(Vec<(String, MaterialModel)>, f64,
     };
     len("grid.origin", s.grid.origin.len())?;
     len("grid.cells", s.grid.cells.len())?;
-    if !(s.grid.cell_size > 0.0 && s.grid.cell_size.is_finite()) {
-        return bad("grid.cell_size", format!("must be > 0 m, found {}", s.grid.cell_size));
+    if !positive(s.grid.cell_size) {
+        return bad(
+            "grid.cell_size",
+            format!("must be > 0 m, found {}", s.grid.cell_size),
+        );
     }
-    let min_cells = if s.shape == ShapeKind::QuadraticBSpline { 2 } else { 1 };
+    let min_cells = if s.shape == ShapeKind::QuadraticBSpline {
+        2
+    } else {
+        1
+    };
     if let Some(c) = s.grid.cells.iter().find(|&&c| c < min_cells) {
         return bad(
             "grid.cells",
-            format!("every axis needs at least {min_cells} cell(s) with {:?} shape functions, found {c}", s.shape),
+            format!(
+                "every axis needs at least {min_cells} cell(s) with {:?} shape functions, found {c}",
+                s.shape
+            ),
         );
     }
     if s.materials.is_empty() {
@@ -60,35 +83,59 @@ pub fn check(loaded: &LoadedScene) -> Result<(Vec<(String, MaterialModel)>, f64,
     for (name, m) in &s.materials {
         let at = |f: &str| format!("materials.{name}.{f}");
         let (rho, e, nu) = match m {
-            MaterialSpec::LinearElastic { density, youngs_modulus, poisson_ratio }
-            | MaterialSpec::MohrCoulomb { density, youngs_modulus, poisson_ratio, .. } => {
-                (*density, *youngs_modulus, *poisson_ratio)
+            MaterialSpec::LinearElastic {
+                density,
+                youngs_modulus,
+                poisson_ratio,
             }
+            | MaterialSpec::MohrCoulomb {
+                density,
+                youngs_modulus,
+                poisson_ratio,
+                ..
+            } => (*density, *youngs_modulus, *poisson_ratio),
         };
-        if !(rho > 0.0 && rho.is_finite()) {
+        if !positive(rho) {
             return bad(&at("density"), format!("must be > 0 kg/m³, found {rho}"));
         }
-        if !(e > 0.0 && e.is_finite()) {
+        if !positive(e) {
             return bad(&at("youngs_modulus"), format!("must be > 0 Pa, found {e}"));
         }
         if !(0.0..0.5).contains(&nu) {
             return bad(&at("poisson_ratio"), format!("must be in [0, 0.5), found {nu}"));
         }
         let model = match m {
-            MaterialSpec::LinearElastic { .. } => MaterialModel::LinearElastic(LinearElastic::new(rho, e, nu)),
-            MaterialSpec::MohrCoulomb { cohesion, friction_angle, dilatancy_angle, tension_cutoff, .. } => {
+            MaterialSpec::LinearElastic { .. } => {
+                MaterialModel::LinearElastic(LinearElastic::new(rho, e, nu))
+            }
+            MaterialSpec::MohrCoulomb {
+                cohesion,
+                friction_angle,
+                dilatancy_angle,
+                tension_cutoff,
+                ..
+            } => {
                 let (c, phi, psi) = (*cohesion, *friction_angle, *dilatancy_angle);
-                if !(c >= 0.0 && c.is_finite()) {
+                if !non_negative(c) {
                     return bad(&at("cohesion"), format!("must be ≥ 0 Pa, found {c}"));
                 }
                 if !(0.0..90.0).contains(&phi) {
-                    return bad(&at("friction_angle"), format!("must be in [0°, 90°), found {phi}°"));
+                    return bad(
+                        &at("friction_angle"),
+                        format!("must be in [0°, 90°), found {phi}°"),
+                    );
                 }
-                if !(psi >= 0.0 && psi <= phi) {
-                    return bad(&at("dilatancy_angle"), format!("must be in [0°, φ = {phi}°], found {psi}°"));
+                if !(non_negative(psi) && psi <= phi) {
+                    return bad(
+                        &at("dilatancy_angle"),
+                        format!("must be in [0°, φ = {phi}°], found {psi}°"),
+                    );
                 }
                 if phi == 0.0 && c == 0.0 {
-                    return bad(&at("cohesion"), "with φ = 0 the cohesion must be > 0 (no strength at all)".into());
+                    return bad(
+                        &at("cohesion"),
+                        "with φ = 0 the cohesion must be > 0 (no strength at all)".into(),
+                    );
                 }
                 MaterialModel::MohrCoulomb(MohrCoulomb::new(rho, e, nu, c, phi, psi, *tension_cutoff))
             }
@@ -102,8 +149,11 @@ pub fn check(loaded: &LoadedScene) -> Result<(Vec<(String, MaterialModel)>, f64,
     let dt_crit = s.grid.cell_size / c_p;
     let dt = match s.solver.time_step {
         TimeStep::Fixed(dt) => {
-            if !(dt > 0.0 && dt.is_finite()) {
-                return bad("solver.time_step", format!("Fixed(Δt) needs Δt > 0 s, found {dt}"));
+            if !positive(dt) {
+                return bad(
+                    "solver.time_step",
+                    format!("Fixed(Δt) needs Δt > 0 s, found {dt}"),
+                );
             }
             if dt > dt_crit {
                 return bad(
@@ -118,28 +168,40 @@ pub fn check(loaded: &LoadedScene) -> Result<(Vec<(String, MaterialModel)>, f64,
             dt
         }
         TimeStep::Courant(a) => {
-            if !(a > 0.0 && a <= 1.0) {
-                return bad("solver.time_step", format!("Courant(α) needs 0 < α ≤ 1, found {a}"));
+            if !(positive(a) && a <= 1.0) {
+                return bad(
+                    "solver.time_step",
+                    format!("Courant(α) needs 0 < α ≤ 1, found {a}"),
+                );
             }
             a * dt_crit
         }
     };
-    if !(s.solver.tolerance > 0.0 && s.solver.tolerance.is_finite()) {
-        return bad("solver.tolerance", format!("must be > 0, found {}", s.solver.tolerance));
+    if !positive(s.solver.tolerance) {
+        return bad(
+            "solver.tolerance",
+            format!("must be > 0, found {}", s.solver.tolerance),
+        );
     }
     if let crate::state::Damping::Viscous { beta } = s.solver.damping {
-        if !(beta >= 0.0 && beta.is_finite()) {
-            return bad("solver.damping", format!("viscous β must be ≥ 0 (1/s), found {beta}"));
+        if !non_negative(beta) {
+            return bad(
+                "solver.damping",
+                format!("viscous β must be ≥ 0 (1/s), found {beta}"),
+            );
         }
     }
     if s.solver.max_steps.is_none() && s.solver.max_time.is_none() {
-        return bad("solver", "set max_steps or max_time, so that a run that never converges still ends".into());
+        return bad(
+            "solver",
+            "set max_steps or max_time, so that a run that never converges still ends".into(),
+        );
     }
     if s.solver.max_steps == Some(0) {
         return bad("solver.max_steps", "must be ≥ 1".into());
     }
     if let Some(t) = s.solver.max_time {
-        if !(t > 0.0) {
+        if !positive(t) {
             return bad("solver.max_time", format!("must be > 0 s, found {t}"));
         }
     }
@@ -147,47 +209,75 @@ pub fn check(loaded: &LoadedScene) -> Result<(Vec<(String, MaterialModel)>, f64,
         return bad("output.history_every", "must be ≥ 1".into());
     }
     if s.bodies.is_empty() {
-        return bad("bodies", "the scene has no body: there is nothing to simulate".into());
+        return bad(
+            "bodies",
+            "the scene has no body: there is nothing to simulate".into(),
+        );
     }
     for (b, body) in s.bodies.iter().enumerate() {
         if !s.materials.contains_key(&body.material) {
             let known: Vec<_> = s.materials.keys().map(String::as_str).collect();
             return bad(
                 &format!("bodies[{b}].material"),
-                format!("unknown material \"{}\" (defined: {})", body.material, known.join(", ")),
+                format!(
+                    "unknown material \"{}\" (defined: {})",
+                    body.material,
+                    known.join(", ")
+                ),
             );
         }
-        len(&format!("bodies[{b}].points_per_cell"), body.points_per_cell.len())?;
+        len(
+            &format!("bodies[{b}].points_per_cell"),
+            body.points_per_cell.len(),
+        )?;
         if body.points_per_cell.contains(&0) {
-            return bad(&format!("bodies[{b}].points_per_cell"), "every entry must be ≥ 1".into());
+            return bad(
+                &format!("bodies[{b}].points_per_cell"),
+                "every entry must be ≥ 1".into(),
+            );
         }
         match &body.region {
             Region::Box { min, max } => {
                 len(&format!("bodies[{b}].region.min"), min.len())?;
                 len(&format!("bodies[{b}].region.max"), max.len())?;
-                if min.iter().zip(max).any(|(a, b)| !(a < b)) {
-                    return bad(&format!("bodies[{b}].region"), "box needs min < max on every axis".into());
+                if min.iter().zip(max).any(|(a, b)| !positive(b - a)) {
+                    return bad(
+                        &format!("bodies[{b}].region"),
+                        "box needs min < max on every axis".into(),
+                    );
                 }
             }
             Region::Polygon { vertices, z } => {
                 if vertices.len() < 3 {
-                    return bad(&format!("bodies[{b}].region.vertices"), "a polygon needs at least 3 vertices".into());
+                    return bad(
+                        &format!("bodies[{b}].region.vertices"),
+                        "a polygon needs at least 3 vertices".into(),
+                    );
                 }
-                if n == 3 && z.is_none_or(|z| !(z[0] < z[1])) {
-                    return bad(&format!("bodies[{b}].region"), "in 3D a polygon needs z: [z_min, z_max] with z_min < z_max".into());
+                if n == 3 && !z.is_some_and(|z| positive(z[1] - z[0])) {
+                    return bad(
+                        &format!("bodies[{b}].region"),
+                        "in 3D a polygon needs z: [z_min, z_max] with z_min < z_max".into(),
+                    );
                 }
             }
         }
     }
     for (i, bc) in s.boundaries.iter().enumerate() {
         if bc.face.axis_side().0 >= n {
-            return bad(&format!("boundaries[{i}].face"), format!("{:?} does not exist in {n}D", bc.face));
+            return bad(
+                &format!("boundaries[{i}].face"),
+                format!("{:?} does not exist in {n}D", bc.face),
+            );
         }
     }
     if let Some(g) = &s.gravity {
         len("gravity.acceleration", g.acceleration.len())?;
-        if !(g.ramp_time >= 0.0) {
-            return bad("gravity.ramp_time", format!("must be ≥ 0 s, found {}", g.ramp_time));
+        if !non_negative(g.ramp_time) {
+            return bad(
+                "gravity.ramp_time",
+                format!("must be ≥ 0 s, found {}", g.ramp_time),
+            );
         }
     }
     for (i, l) in s.point_loads.iter().enumerate() {

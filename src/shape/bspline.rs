@@ -30,13 +30,25 @@ impl Shape for QuadraticBSpline {
         let g2 = (0.5 + d) * inv_h;
         if b < 0.0 {
             // Ghost node at −1: nodes 0, 1, 2.
-            Stencil1 { base: 0, w: [w1 + 2.0 * w0, w2 - w0, 0.0], dw: [g1 + 2.0 * g0, g2 - g0, 0.0] }
+            Stencil1 {
+                base: 0,
+                w: [w1 + 2.0 * w0, w2 - w0, 0.0],
+                dw: [g1 + 2.0 * g0, g2 - g0, 0.0],
+            }
         } else if b as usize + 2 > cells {
             // Ghost node at cells + 1: nodes cells − 2, cells − 1, cells.
             let base = cells - 2;
-            Stencil1 { base, w: [0.0, w0 - w2, w1 + 2.0 * w2], dw: [0.0, g0 - g2, g1 + 2.0 * g2] }
+            Stencil1 {
+                base,
+                w: [0.0, w0 - w2, w1 + 2.0 * w2],
+                dw: [0.0, g0 - g2, g1 + 2.0 * g2],
+            }
         } else {
-            Stencil1 { base: b as usize, w: [w0, w1, w2], dw: [g0, g1, g2] }
+            Stencil1 {
+                base: b as usize,
+                w: [w0, w1, w2],
+                dw: [g0, g1, g2],
+            }
         }
     }
 }

@@ -16,6 +16,10 @@ impl Shape for Linear {
         // beyond the grid.
         let base = (xi.max(0.0) as usize).min(cells.saturating_sub(1));
         let f = xi - base as f64;
-        Stencil1 { base, w: [1.0 - f, f, 0.0], dw: [-inv_h, inv_h, 0.0] }
+        Stencil1 {
+            base,
+            w: [1.0 - f, f, 0.0],
+            dw: [-inv_h, inv_h, 0.0],
+        }
     }
 }

@@ -39,11 +39,7 @@ pub trait Shape: Copy + Send + Sync + Default + std::fmt::Debug + 'static {
 ///
 /// The point must lie inside the grid (the kinematics system guarantees this).
 #[inline(always)]
-pub fn for_each_node<D: Dim, S: Shape>(
-    grid: &Grid<D>,
-    x: D::Vec,
-    mut f: impl FnMut(usize, f64, D::Vec),
-) {
+pub fn for_each_node<D: Dim, S: Shape>(grid: &Grid<D>, x: D::Vec, mut f: impl FnMut(usize, f64, D::Vec)) {
     let sx = S::eval_1d(grid.grid_coordinate(x, 0), grid.cells[0], grid.inv_h);
     let sy = S::eval_1d(grid.grid_coordinate(x, 1), grid.cells[1], grid.inv_h);
     let nx = grid.nodes[0];
@@ -116,9 +112,15 @@ pub(crate) mod tests {
                 }
             }
         });
-        assert!((sum_w - 1.0).abs() < 1e-12, "partition of unity at {x:?}: {sum_w}");
+        assert!(
+            (sum_w - 1.0).abs() < 1e-12,
+            "partition of unity at {x:?}: {sum_w}"
+        );
         for a in 0..D::N {
-            assert!((moment.get(a) - x.get(a)).abs() < 1e-12, "linear reproduction at {x:?}");
+            assert!(
+                (moment.get(a) - x.get(a)).abs() < 1e-12,
+                "linear reproduction at {x:?}"
+            );
             assert!(sum_grad.get(a).abs() < 1e-12, "gradients sum to zero at {x:?}");
             for b in 0..D::N {
                 let expect = if a == b { 1.0 } else { 0.0 };

@@ -46,8 +46,19 @@ pub fn force_ratios<D: Dim>(ctx: &Context<D>) -> ForceRatios {
             sum_e += e;
         }
     }
-    let ratio = |u: f64, e: f64| if e > 0.0 { u / e } else if u > 0.0 { f64::INFINITY } else { 0.0 };
-    ForceRatios { max_norm: ratio(max_u, max_e), mean_norm: ratio(sum_u, sum_e) }
+    let ratio = |u: f64, e: f64| {
+        if e > 0.0 {
+            u / e
+        } else if u > 0.0 {
+            f64::INFINITY
+        } else {
+            0.0
+        }
+    };
+    ForceRatios {
+        max_norm: ratio(max_u, max_e),
+        mean_norm: ratio(sum_u, sum_e),
+    }
 }
 
 /// Updates K_F, W_ext and K_E and sets `state.stop` when the run should end.

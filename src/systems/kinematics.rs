@@ -26,15 +26,27 @@ pub struct Kinematics<D, S> {
 impl<D: Dim, S: Shape> Kinematics<D, S> {
     /// Velocity gradient and motion in one pass (USL, MUSL).
     pub fn both() -> Self {
-        Kinematics { gradient: true, motion: true, _marker: PhantomData }
+        Kinematics {
+            gradient: true,
+            motion: true,
+            _marker: PhantomData,
+        }
     }
     /// Velocity gradient only (USF, start of step).
     pub fn gradient_only() -> Self {
-        Kinematics { gradient: true, motion: false, _marker: PhantomData }
+        Kinematics {
+            gradient: true,
+            motion: false,
+            _marker: PhantomData,
+        }
     }
     /// Motion only (USF, end of step).
     pub fn motion_only() -> Self {
-        Kinematics { gradient: false, motion: true, _marker: PhantomData }
+        Kinematics {
+            gradient: false,
+            motion: true,
+            _marker: PhantomData,
+        }
     }
 }
 
@@ -54,8 +66,16 @@ impl<D: Dim, S: Shape> System<D> for Kinematics<D, S> {
         let mut offset = 0;
         for arch in points_with::<Position<D::Vec>>(&ctx.world) {
             let mut x = col_mut::<Position<D::Vec>>(arch);
-            let mut lgrad = if self.gradient { arch.get::<&mut VelocityGradient<D::Mat>>() } else { None };
-            let mut disp = if self.motion { arch.get::<&mut Displacement<D::Vec>>() } else { None };
+            let mut lgrad = if self.gradient {
+                arch.get::<&mut VelocityGradient<D::Mat>>()
+            } else {
+                None
+            };
+            let mut disp = if self.motion {
+                arch.get::<&mut Displacement<D::Vec>>()
+            } else {
+                None
+            };
             for p in 0..x.len() {
                 let mut l = D::MAT_ZERO;
                 let mut vel = D::Vec::ZERO;
@@ -75,7 +95,12 @@ impl<D: Dim, S: Shape> System<D> for Kinematics<D, S> {
                     if !grid.contains(xp) {
                         let position = D::vec_to3(xp);
                         return Err(if position.iter().all(|c| c.is_finite()) {
-                            StepError::PointLeftGrid { step, system: name, point: offset + p, position }
+                            StepError::PointLeftGrid {
+                                step,
+                                system: name,
+                                point: offset + p,
+                                position,
+                            }
                         } else {
                             StepError::NonFinite {
                                 step,

@@ -30,7 +30,10 @@ pub struct P2g<D, S> {
 impl<D: Dim, S: Shape> P2g<D, S> {
     /// A pass that maps `part`.
     pub fn new(part: P2gPart) -> Self {
-        P2g { part, _marker: PhantomData }
+        P2g {
+            part,
+            _marker: PhantomData,
+        }
     }
 }
 
@@ -82,5 +85,95 @@ impl<D: Dim, S: Shape> System<D> for P2g<D, S> {
             }
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::columns::col_mut;
+    use crate::dim::Vector;
+    use crate::scene::{build, LoadedScene};
+    use crate::shape::{Linear, QuadraticBSpline};
+    use crate::simulation::{AnySimulation, Simulation};
+    use crate::systems::GridReset;
+
+    const SCENE: &str = r#"Scene(
+        dimension: DIM,
+        grid: (origin: ORIGIN, cell_size: 0.5, cells: CELLS),
+        materials: { "m": LinearElastic(density: 1800.0, youngs_modulus: 1e7, poisson_ratio: 0.3) },
+        bodies: [(material: "m", region: Box(min: MIN, max: MAX), points_per_cell: PPC)],
+        solver: (time_step: Courant(0.5), max_steps: 1),
+    )"#;
+
+    fn scene(dim3: bool) -> LoadedScene {
+        let t = if dim3 {
+            SCENE
+                .replace("DIM", "3")
+                .replace("ORIGIN", "[0.0, 0.0, 0.0]")
+                .replace("CELLS", "[6, 5, 4]")
+                .replace("MIN", "[0.2, 0.0, 0.3]")
+                .replace("MAX", "[2.9, 1.7, 2.0]")
+                .replace("PPC", "[2, 3, 2]")
+        } else {
+            SCENE
+                .replace("DIM", "2")
+                .replace("ORIGIN", "[-1.0, 0.0]")
+                .replace("CELLS", "[8, 6]")
+                .replace("MIN", "[-1.0, 0.0]")
+                .replace("MAX", "[2.7, 2.3]")
+                .replace("PPC", "[3, 2]")
+        };
+        LoadedScene::from_text(std::path::Path::new("test.ron"), &t, &[]).unwrap()
+    }
+
+    /// Gives every point a different velocity, maps, and compares grid and point totals.
+    fn check<D: Dim, S: Shape>(sim: &mut Simulation<D>) {
+        let mut k = 0.0f64;
+        for arch in points_with::<Velocity<D::Vec>>(&sim.ctx.world) {
+            for v in col_mut::<Velocity<D::Vec>>(arch).iter_mut() {
+                k += 1.0;
+                v.0 = D::vec_from([(k * 0.37).sin(), (k * 0.11).cos(), (k * 0.53).sin() - 0.2]);
+            }
+        }
+        let (mut mass, mut mom) = (0.0, D::Vec::ZERO);
+        for arch in points_with::<Velocity<D::Vec>>(&sim.ctx.world) {
+            let (m, v) = (col::<Mass>(arch), col::<Velocity<D::Vec>>(arch));
+            for p in 0..m.len() {
+                mass += m[p].0;
+                mom += v[p].0 * m[p].0;
+            }
+        }
+        GridReset.run(&mut sim.ctx).unwrap();
+        P2g::<D, S>::new(P2gPart::All).run(&mut sim.ctx).unwrap();
+        let n = nodes(&sim.ctx.world);
+        let grid_mass: f64 = col::<NodeMass>(n).iter().map(|m| m.0).sum();
+        let grid_mom = col::<NodeMomentum<D::Vec>>(n)
+            .iter()
+            .fold(D::Vec::ZERO, |a, p| a + p.0);
+        let grid_force = col::<NodeForce<D::Vec>>(n)
+            .iter()
+            .fold(D::Vec::ZERO, |a, p| a + p.0);
+        assert!((grid_mass / mass - 1.0).abs() < 1e-14, "{grid_mass} vs {mass}");
+        let scale = mom.dot(mom).sqrt();
+        let d = grid_mom - mom;
+        assert!(d.dot(d).sqrt() < 1e-13 * scale, "{grid_mom:?} vs {mom:?}");
+        // Zero stress: no internal force anywhere.
+        assert_eq!(grid_force, D::Vec::ZERO);
+    }
+
+    #[test]
+    fn p2g_conserves_mass_and_momentum() {
+        for dim3 in [false, true] {
+            for bspline in [false, true] {
+                let (sim, _) = build(&scene(dim3)).unwrap();
+                match sim {
+                    AnySimulation::Two(mut s) if bspline => check::<_, QuadraticBSpline>(&mut s),
+                    AnySimulation::Two(mut s) => check::<_, Linear>(&mut s),
+                    AnySimulation::Three(mut s) if bspline => check::<_, QuadraticBSpline>(&mut s),
+                    AnySimulation::Three(mut s) => check::<_, Linear>(&mut s),
+                }
+            }
+        }
     }
 }

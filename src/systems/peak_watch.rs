@@ -23,7 +23,10 @@ impl<D: Dim> System<D> for PeakWatch {
         let s = &mut ctx.state;
         if s.kinetic_energy < s.previous_kinetic_energy {
             // The peak was the energy of the previous step, which ended at t − Δt.
-            s.peaks.push(Peak { time: s.time - s.dt, energy: s.previous_kinetic_energy });
+            s.peaks.push(Peak {
+                time: s.time - s.dt,
+                energy: s.previous_kinetic_energy,
+            });
             s.resets += 1;
             s.reset_this_step = true;
             s.kinetic_energy = 0.0;
