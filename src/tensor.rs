@@ -115,16 +115,40 @@ impl Sym3 {
     /// R·a·Rᵀ built from principal values `p` and the principal directions (columns of `r`).
     #[inline]
     pub fn from_principal(p: [f64; 3], r: &DMat3) -> Sym3 {
-        let d = DMat3::from_diagonal(DVec3::from_array(p));
-        Sym3::from_mat3(&(*r * d * r.transpose()))
+        // a_ij = Σ_k p_k r_ik r_jk, component by component (cheaper than two products).
+        let (c0, c1, c2) = (r.x_axis, r.y_axis, r.z_axis);
+        let e = |i: usize, j: usize| p[0] * c0[i] * c0[j] + p[1] * c1[i] * c1[j] + p[2] * c2[i] * c2[j];
+        Sym3 {
+            xx: e(0, 0),
+            yy: e(1, 1),
+            zz: e(2, 2),
+            xy: e(0, 1),
+            yz: e(1, 2),
+            zx: e(2, 0),
+        }
     }
 
     /// Principal values in descending order (σ1 ≥ σ2 ≥ σ3) and the matching unit
     /// eigenvectors as the columns of a rotation matrix.
     pub fn eigen(&self) -> ([f64; 3], DMat3) {
-        let (vals, vecs) = jacobi_eigen(self);
+        // Plane strain (and any state with z as a principal axis): closed form in the x-y
+        // plane, several times cheaper than Jacobi sweeps.
+        let (vals, vecs) = if self.yz == 0.0 && self.zx == 0.0 {
+            planar_eigen(self)
+        } else {
+            jacobi_eigen(self)
+        };
+        // Three-element sorting network, descending.
         let mut order = [0usize, 1, 2];
-        order.sort_by(|&i, &j| vals[j].total_cmp(&vals[i]));
+        if vals[order[0]] < vals[order[1]] {
+            order.swap(0, 1);
+        }
+        if vals[order[1]] < vals[order[2]] {
+            order.swap(1, 2);
+        }
+        if vals[order[0]] < vals[order[1]] {
+            order.swap(0, 1);
+        }
         let p = [vals[order[0]], vals[order[1]], vals[order[2]]];
         let r = DMat3::from_cols(vecs.col(order[0]), vecs.col(order[1]), vecs.col(order[2]));
         (p, r)
@@ -134,6 +158,27 @@ impl Sym3 {
     pub fn principal_values(&self) -> [f64; 3] {
         self.eigen().0
     }
+}
+
+/// Eigen-decomposition of a tensor whose z axis is principal: the x-y block in closed form
+/// (no trigonometry: the eigenvector of the larger value is (d + r, xy) normalised, taking
+/// the better-conditioned of the two equivalent forms).
+fn planar_eigen(s: &Sym3) -> ([f64; 3], DMat3) {
+    let c = 0.5 * (s.xx + s.yy);
+    let d = 0.5 * (s.xx - s.yy);
+    // Plain sqrt, not hypot: stresses are far from overflow and hypot is slow in glibc.
+    let r = (d * d + s.xy * s.xy).sqrt();
+    let (ex, ey) = if r == 0.0 {
+        (1.0, 0.0)
+    } else if d >= 0.0 {
+        let n = ((d + r) * (d + r) + s.xy * s.xy).sqrt();
+        ((d + r) / n, s.xy / n)
+    } else {
+        let n = (s.xy * s.xy + (r - d) * (r - d)).sqrt();
+        (s.xy / n, (r - d) / n)
+    };
+    let vecs = DMat3::from_cols(DVec3::new(ex, ey, 0.0), DVec3::new(-ey, ex, 0.0), DVec3::Z);
+    ([c + r, c - r, s.zz], vecs)
 }
 
 /// Cyclic Jacobi eigen-decomposition of a symmetric 3×3 tensor. Robust for repeated
@@ -196,6 +241,9 @@ pub fn jaumann_rotate(stress: &Sym3, w: [f64; 3]) -> Sym3 {
     if w == [0.0; 3] {
         return *stress;
     }
+    if w[0] == 0.0 && w[1] == 0.0 {
+        return rotate_about_z(stress, w[2]);
+    }
     // Half-spin matrix Â = W/2 with W_xy = w[2], W_yz = w[0], W_zx = w[1] (W skew).
     let (a, b, c) = (0.5 * w[0], 0.5 * w[1], 0.5 * w[2]);
     let half = DMat3::from_cols(
@@ -207,6 +255,28 @@ pub fn jaumann_rotate(stress: &Sym3, w: [f64; 3]) -> Sym3 {
     let k = 2.0 / (1.0 + a * a + b * b + c * c);
     let r = DMat3::IDENTITY + (half + half * half) * k;
     Sym3::from_mat3(&(r * stress.to_mat3() * r.transpose()))
+}
+
+/// The Cayley rotation of [`jaumann_rotate`] for a spin about z only (all of plane strain):
+/// cos θ = (1 − a²)/(1 + a²), sin θ = 2a/(1 + a²) with a = W_xy/2.
+#[inline]
+fn rotate_about_z(s: &Sym3, wxy: f64) -> Sym3 {
+    let a = 0.5 * wxy;
+    let k = 1.0 / (1.0 + a * a);
+    let (c, sn) = ((1.0 - a * a) * k, 2.0 * a * k);
+    // σ' = R σ Rᵀ with R = [[c, sn], [−sn, c]] in the x-y block.
+    let (xx, yy, xy) = (s.xx, s.yy, s.xy);
+    let cc = c * c;
+    let ss = sn * sn;
+    let cs = c * sn;
+    Sym3 {
+        xx: cc * xx + 2.0 * cs * xy + ss * yy,
+        yy: ss * xx - 2.0 * cs * xy + cc * yy,
+        xy: (cc - ss) * xy + cs * (yy - xx),
+        zz: s.zz,
+        yz: c * s.yz - sn * s.zx,
+        zx: c * s.zx + sn * s.yz,
+    }
 }
 
 impl Add for Sym3 {
@@ -287,6 +357,42 @@ mod tests {
     }
 
     #[test]
+    fn planar_eigen_agrees_with_jacobi() {
+        for s in [
+            Sym3 {
+                xx: -3.0e5,
+                yy: -1.2e5,
+                zz: -2.0e5,
+                xy: 4.0e4,
+                ..Sym3::ZERO
+            },
+            Sym3 {
+                xx: 1.0,
+                yy: 1.0,
+                zz: 5.0,
+                xy: 0.0,
+                ..Sym3::ZERO
+            },
+            Sym3 {
+                xx: -1.0,
+                yy: 2.0,
+                zz: 0.5,
+                xy: -3.0,
+                ..Sym3::ZERO
+            },
+        ] {
+            let (p, r) = s.eigen();
+            let (pj, _) = jacobi_eigen(&s);
+            let mut pj = pj.to_vec();
+            pj.sort_by(|a, b| b.total_cmp(a));
+            for k in 0..3 {
+                assert!((p[k] - pj[k]).abs() < 1e-12 * s.norm());
+            }
+            assert!((Sym3::from_principal(p, &r) - s).norm() < 1e-12 * s.norm());
+        }
+    }
+
+    #[test]
     fn eigen_handles_repeated_values() {
         let (p, _) = Sym3::diagonal(-1.0, -1.0, -1.0).eigen();
         assert_eq!(p, [-1.0, -1.0, -1.0]);
@@ -309,6 +415,23 @@ mod tests {
         let p = s.principal_values();
         for k in 0..3 {
             assert!((p[k] - p0[k]).abs() < 1e-9 * s0.norm(), "{p:?} vs {p0:?}");
+        }
+    }
+
+    #[test]
+    fn rotation_about_z_matches_the_general_rotation() {
+        let s = sample();
+        for w in [1e-3, -0.4, 2.5] {
+            let fast = jaumann_rotate(&s, [0.0, 0.0, w]);
+            // The general path, forced by a spin component that is zero in effect.
+            let a = 0.5 * w;
+            let half = DMat3::from_cols(DVec3::new(0.0, -a, 0.0), DVec3::new(a, 0.0, 0.0), DVec3::ZERO);
+            let r = DMat3::IDENTITY + (half + half * half) * (2.0 / (1.0 + a * a));
+            let general = Sym3::from_mat3(&(r * s.to_mat3() * r.transpose()));
+            assert!(
+                (fast - general).norm() < 1e-12 * s.norm(),
+                "{fast:?} vs {general:?}"
+            );
         }
     }
 

@@ -47,11 +47,11 @@ fn visit_support<D: Dim>(grid: &Grid<D>, shape: ShapeKind, x: D::Vec, mut f: imp
 }
 
 /// Even-odd rule point-in-polygon test.
-fn in_polygon(vertices: &[[f64; 2]], x: f64, y: f64) -> bool {
+fn in_polygon(vertices: &[Vec<f64>], x: f64, y: f64) -> bool {
     let mut inside = false;
     let mut j = vertices.len() - 1;
     for i in 0..vertices.len() {
-        let (a, b) = (vertices[i], vertices[j]);
+        let (a, b) = (&vertices[i], &vertices[j]);
         if (a[1] > y) != (b[1] > y) && x < (b[0] - a[0]) * (y - a[1]) / (b[1] - a[1]) + a[0] {
             inside = !inside;
         }
@@ -74,7 +74,7 @@ fn region_bounds(region: &Region, n: usize) -> ([f64; 3], [f64; 3]) {
                 }
             }
             if n == 3 {
-                let z = z.expect("validated");
+                let z = z.as_ref().expect("validated");
                 (lo[2], hi[2]) = (z[0], z[1]);
             }
             (lo, hi)
@@ -86,7 +86,8 @@ fn region_contains(region: &Region, x: [f64; 3], n: usize) -> bool {
     match region {
         Region::Box { min, max } => (0..n).all(|a| x[a] > min[a] && x[a] < max[a]),
         Region::Polygon { vertices, z } => {
-            in_polygon(vertices, x[0], x[1]) && (n == 2 || z.is_some_and(|z| x[2] > z[0] && x[2] < z[1]))
+            in_polygon(vertices, x[0], x[1])
+                && (n == 2 || z.as_ref().is_some_and(|z| x[2] > z[0] && x[2] < z[1]))
         }
     }
 }
@@ -131,7 +132,6 @@ fn fill_points<D: Dim>(grid: &Grid<D>, region: &Region, ppc: &[usize]) -> Vec<[f
     }
     out
 }
-
 
 fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulation<D>, Derived), SceneError> {
     let (table, c_p, dt_crit, dt) = checked;

@@ -123,11 +123,11 @@ pub enum Region {
     },
     /// A simple polygon in the x-y plane (m), extruded over `z` in 3D.
     Polygon {
-        /// Vertices in order (either orientation).
-        vertices: Vec<[f64; 2]>,
-        /// Extent along z in 3D (m); ignored in 2D.
+        /// Vertices `[x, y]` in order (either orientation).
+        vertices: Vec<Vec<f64>>,
+        /// Extent `[z_min, z_max]` along z in 3D (m); ignored in 2D.
         #[serde(default)]
-        z: Option<[f64; 2]>,
+        z: Option<Vec<f64>>,
     },
 }
 

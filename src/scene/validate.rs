@@ -254,7 +254,13 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
                         "a polygon needs at least 3 vertices".into(),
                     );
                 }
-                if n == 3 && !z.is_some_and(|z| positive(z[1] - z[0])) {
+                if let Some(k) = vertices.iter().position(|v| v.len() != 2) {
+                    return bad(
+                        &format!("bodies[{b}].region.vertices"),
+                        format!("vertex {k} needs 2 entries [x, y], found {}", vertices[k].len()),
+                    );
+                }
+                if n == 3 && !z.as_ref().is_some_and(|z| z.len() == 2 && positive(z[1] - z[0])) {
                     return bad(
                         &format!("bodies[{b}].region"),
                         "in 3D a polygon needs z: [z_min, z_max] with z_min < z_max".into(),
