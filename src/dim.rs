@@ -103,6 +103,8 @@ pub trait Dim: Copy + Send + Sync + Debug + Default + 'static {
     fn strain_spin(l: &Self::Mat, dt: f64) -> (Sym3, [f64; 3]);
     /// det(I + L·dt): the volume ratio of one step.
     fn volume_ratio(l: &Self::Mat, dt: f64) -> f64;
+    /// `m += k·I`.
+    fn add_identity(m: &mut Self::Mat, k: f64);
 }
 
 /// Plane strain, unit thickness (m).
@@ -151,6 +153,11 @@ impl Dim for Dim2 {
     #[inline(always)]
     fn volume_ratio(l: &DMat2, dt: f64) -> f64 {
         (DMat2::IDENTITY + *l * dt).determinant()
+    }
+    #[inline(always)]
+    fn add_identity(m: &mut DMat2, k: f64) {
+        m.x_axis.x += k;
+        m.y_axis.y += k;
     }
 }
 
@@ -203,5 +210,11 @@ impl Dim for Dim3 {
     #[inline(always)]
     fn volume_ratio(l: &DMat3, dt: f64) -> f64 {
         (DMat3::IDENTITY + *l * dt).determinant()
+    }
+    #[inline(always)]
+    fn add_identity(m: &mut DMat3, k: f64) {
+        m.x_axis.x += k;
+        m.y_axis.y += k;
+        m.z_axis.z += k;
     }
 }

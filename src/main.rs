@@ -37,6 +37,9 @@ enum Command {
         /// Print nothing but errors.
         #[arg(long, short)]
         quiet: bool,
+        /// Worker threads (default: all cores). Results are identical for any count.
+        #[arg(long)]
+        threads: Option<usize>,
     },
     /// Parse and validate a scene without running it; print the derived figures.
     Check {
@@ -62,7 +65,19 @@ fn main() -> ExitCode {
             overrides,
             profile,
             quiet,
-        } => run(&scene, out, &overrides, profile, quiet),
+            threads,
+        } => {
+            if let Some(n) = threads {
+                if let Err(e) = rayon::ThreadPoolBuilder::new()
+                    .num_threads(n.max(1))
+                    .build_global()
+                {
+                    eprintln!("error: cannot start {n} threads: {e}");
+                    return ExitCode::from(BAD_INPUT);
+                }
+            }
+            run(&scene, out, &overrides, profile, quiet)
+        }
     }
 }
 
@@ -150,6 +165,10 @@ fn run_dim<D: Dim>(
     let wall = start.elapsed().as_secs_f64();
     let error = result.as_ref().err().map(|e| e.to_string());
     let summary = Summary::collect(&scene.display().to_string(), sim, wall, error);
+    if let Err(e) = kdmpm::output::vtk::write_points(sim, &out.join("points.vtu")) {
+        eprintln!("error: cannot write points.vtu: {e}");
+        return ExitCode::from(BAD_INPUT);
+    }
     let json = serde_json::to_string_pretty(&summary).expect("summary serialises");
     if let Err(e) = std::fs::write(out.join("summary.json"), json) {
         eprintln!("error: cannot write summary.json: {e}");

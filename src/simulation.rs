@@ -58,6 +58,8 @@ pub struct Simulation<D: Dim> {
     pub schedule: Schedule<D>,
     /// Points whose history is recorded.
     pub traced: Vec<TracedPoint>,
+    /// Report the free-surface angle in the summary.
+    pub measure_surface_angle: bool,
 }
 
 impl<D: Dim> Simulation<D> {

@@ -89,6 +89,8 @@ pub struct Settings {
     pub max_time: Option<f64>,
     /// Gravity, if any.
     pub gravity: Option<Gravity>,
+    /// Smooth the volumetric strain rate through the grid before each stress update.
+    pub volumetric_smoothing: bool,
     /// Nodes lighter than this carry no degrees of freedom (kg).
     pub min_node_mass: f64,
 }

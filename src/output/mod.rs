@@ -2,6 +2,7 @@
 
 pub mod history;
 pub mod summary;
+pub mod vtk;
 
 pub use history::History;
 pub use summary::Summary;

@@ -1,6 +1,7 @@
 //! `summary.json`: the outcome of a run.
 
 use crate::dim::Dim;
+use crate::measure::{max_displacements, surface_angle, SurfaceAngle};
 use crate::schedule::Timing;
 use crate::simulation::{Simulation, TracedResult};
 use crate::state::{ForceNorm, Peak, StopReason};
@@ -53,6 +54,12 @@ pub struct Summary {
     pub wall_seconds: f64,
     /// Points × steps per wall second of the stepping loop.
     pub particle_steps_per_second: f64,
+    /// Largest displacement magnitude of any point (m).
+    pub max_displacement: f64,
+    /// Largest |horizontal displacement| of any point (m).
+    pub max_horizontal_displacement: f64,
+    /// Free-surface angle, when the scene asks for it (`output.surface_angle`).
+    pub surface_angle: Option<SurfaceAngle>,
     /// Traced points.
     pub traced: Vec<TracedResult>,
     /// Per-system cost.
@@ -70,6 +77,7 @@ impl Summary {
         let s = &sim.ctx.state;
         let st = &sim.ctx.settings;
         let particles = sim.point_count();
+        let (max_u, max_ux) = max_displacements(sim);
         Summary {
             scene: scene.to_string(),
             dimension: D::N,
@@ -96,6 +104,13 @@ impl Summary {
                 particles as f64 * s.step as f64 / wall_seconds
             } else {
                 0.0
+            },
+            max_displacement: max_u,
+            max_horizontal_displacement: max_ux,
+            surface_angle: if sim.measure_surface_angle {
+                surface_angle(sim)
+            } else {
+                None
             },
             traced: sim.traced_results(),
             systems: sim.schedule.timings(),

@@ -261,6 +261,7 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
             Velocity(z),
             Displacement(z),
             Mass(0.0),
+            VelocityGradient(D::MAT_ZERO),
             PointLoad(D::vec_from(pad3(&l.force))),
         ));
         positions.push((pad3(&l.position), e));
@@ -298,6 +299,7 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         force_norm: s.solver.force_norm,
         max_steps: s.solver.max_steps,
         max_time: s.solver.max_time,
+        volumetric_smoothing: s.solver.volumetric_smoothing,
         gravity: s.gravity.as_ref().map(|g| Gravity {
             acceleration: pad3(&g.acceleration),
             ramp_time: g.ramp_time,
@@ -336,6 +338,7 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
             ctx,
             schedule,
             traced,
+            measure_surface_angle: s.output.surface_angle,
         },
         derived,
     ))

@@ -210,6 +210,9 @@ pub struct SolverSpec {
     /// Norm of K_F used to stop (default `Max`, the paper's eq. 3).
     #[serde(default)]
     pub force_norm: ForceNorm,
+    /// Smooth the volumetric strain rate through the grid (against volumetric locking).
+    #[serde(default)]
+    pub volumetric_smoothing: bool,
     /// Step limit.
     #[serde(default)]
     pub max_steps: Option<u64>,
@@ -229,6 +232,9 @@ pub struct OutputSpec {
     /// Write a `history.csv` row every this many steps (and at the last step), ≥ 1.
     #[serde(default = "default_every")]
     pub history_every: u64,
+    /// Measure the free-surface angle at the end (see `measure::surface_angle`).
+    #[serde(default)]
+    pub surface_angle: bool,
 }
 
 fn default_every() -> u64 {
@@ -237,7 +243,10 @@ fn default_every() -> u64 {
 
 impl Default for OutputSpec {
     fn default() -> Self {
-        OutputSpec { history_every: 1 }
+        OutputSpec {
+            history_every: 1,
+            surface_angle: false,
+        }
     }
 }
 

@@ -4,9 +4,11 @@ use crate::columns::{col, col_mut, nodes, points_with};
 use crate::components::*;
 use crate::dim::{Dim, Vector};
 use crate::error::StepError;
+use crate::parallel::CHUNK;
 use crate::schedule::System;
 use crate::shape::{for_each_node, Shape};
 use crate::simulation::Context;
+use rayon::prelude::*;
 use std::marker::PhantomData;
 
 /// v_p ← v_p + Δt Σ_i w_ip a_i (FLIP update), then E_k = ½ Σ m_p v_p·v_p.
@@ -26,19 +28,30 @@ impl<D: Dim, S: Shape> System<D> for G2p<D, S> {
     fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
         let (grid, dt) = (&ctx.grid, ctx.state.dt);
         let n = nodes(&ctx.world);
-        let na = col::<NodeAcceleration<D::Vec>>(n);
+        let nag = col::<NodeAcceleration<D::Vec>>(n);
+        let na: &[NodeAcceleration<D::Vec>] = &nag;
         let mut twice_ek = 0.0;
         for arch in points_with::<Velocity<D::Vec>>(&ctx.world) {
-            let x = col::<Position<D::Vec>>(arch);
-            let m = col::<Mass>(arch);
-            let mut v = col_mut::<Velocity<D::Vec>>(arch);
-            for p in 0..x.len() {
-                let mut a = D::Vec::ZERO;
-                for_each_node::<D, S>(grid, x[p].0, |i, w, _| a += na[i].0 * w);
-                let vp = v[p].0 + a * dt;
-                v[p].0 = vp;
-                twice_ek += m[p].0 * vp.dot(vp);
-            }
+            let (xg, mg) = (col::<Position<D::Vec>>(arch), col::<Mass>(arch));
+            let (x, m): (&[Position<D::Vec>], &[Mass]) = (&xg, &mg);
+            let mut vg = col_mut::<Velocity<D::Vec>>(arch);
+            let parts: Vec<f64> = vg
+                .par_chunks_mut(CHUNK)
+                .enumerate()
+                .map(|(c, v)| {
+                    let mut e = 0.0;
+                    for (k, vp) in v.iter_mut().enumerate() {
+                        let p = c * CHUNK + k;
+                        let mut a = D::Vec::ZERO;
+                        for_each_node::<D, S>(grid, x[p].0, |i, w, _| a += na[i].0 * w);
+                        vp.0 += a * dt;
+                        e += m[p].0 * vp.0.dot(vp.0);
+                    }
+                    e
+                })
+                .collect();
+            // Partial sums added in chunk order: the same bits for any thread count.
+            twice_ek += parts.iter().sum::<f64>();
         }
         ctx.state.kinetic_energy = 0.5 * twice_ek;
         Ok(())

@@ -5,9 +5,11 @@ use crate::columns::{col, col_mut, nodes, points_with};
 use crate::components::*;
 use crate::dim::{Dim, Vector};
 use crate::error::StepError;
+use crate::parallel::CHUNK;
 use crate::schedule::System;
 use crate::shape::{for_each_node, Shape};
 use crate::simulation::Context;
+use rayon::prelude::*;
 use std::marker::PhantomData;
 
 /// L_p = Σ_i v_i ⊗ ∇w_ip and x_p ← x_p + Δt Σ_i w_ip v_i, with v_i the `NodeVelocity` field.
@@ -61,62 +63,70 @@ impl<D: Dim, S: Shape> System<D> for Kinematics<D, S> {
         }
         let (grid, dt, step) = (&ctx.grid, ctx.state.dt, ctx.state.step);
         let name = self.name_static();
+        let (gradient, motion) = (self.gradient, self.motion);
         let n = nodes(&ctx.world);
-        let nv = col::<NodeVelocity<D::Vec>>(n);
+        let nvg = col::<NodeVelocity<D::Vec>>(n);
+        let nv: &[NodeVelocity<D::Vec>] = &nvg;
         let mut offset = 0;
         for arch in points_with::<Position<D::Vec>>(&ctx.world) {
-            let mut x = col_mut::<Position<D::Vec>>(arch);
-            let mut lgrad = if self.gradient {
-                arch.get::<&mut VelocityGradient<D::Mat>>()
-            } else {
-                None
-            };
-            let mut disp = if self.motion {
-                arch.get::<&mut Displacement<D::Vec>>()
-            } else {
-                None
-            };
-            for p in 0..x.len() {
-                let mut l = D::MAT_ZERO;
-                let mut vel = D::Vec::ZERO;
-                for_each_node::<D, S>(grid, x[p].0, |i, w, grad| {
-                    let vi = nv[i].0;
-                    if self.gradient {
-                        D::add_outer(&mut l, vi, grad);
-                    }
-                    vel += vi * w;
-                });
-                if let Some(lg) = lgrad.as_mut() {
-                    lg[p].0 = l;
-                }
-                if self.motion {
-                    let du = vel * dt;
-                    let xp = x[p].0 + du;
-                    if !grid.contains(xp) {
-                        let position = D::vec_to3(xp);
-                        return Err(if position.iter().all(|c| c.is_finite()) {
-                            StepError::PointLeftGrid {
-                                step,
-                                system: name,
-                                point: offset + p,
-                                position,
+            let mut xg = col_mut::<Position<D::Vec>>(arch);
+            let mut lg = col_mut::<VelocityGradient<D::Mat>>(arch);
+            let mut ug = col_mut::<Displacement<D::Vec>>(arch);
+            // Each chunk reports the first point that left the grid; the first in chunk order
+            // wins, so the error is the same for any thread count.
+            let escaped = xg
+                .par_chunks_mut(CHUNK)
+                .zip(lg.par_chunks_mut(CHUNK))
+                .zip(ug.par_chunks_mut(CHUNK))
+                .enumerate()
+                .map(|(c, ((x, l), u))| {
+                    for k in 0..x.len() {
+                        let mut lp = D::MAT_ZERO;
+                        let mut vel = D::Vec::ZERO;
+                        for_each_node::<D, S>(grid, x[k].0, |i, w, grad| {
+                            let vi = nv[i].0;
+                            if gradient {
+                                D::add_outer(&mut lp, vi, grad);
                             }
-                        } else {
-                            StepError::NonFinite {
-                                step,
-                                system: name,
-                                what: "position",
-                                location: format!("point {}", offset + p),
-                            }
+                            vel += vi * w;
                         });
+                        if gradient {
+                            l[k].0 = lp;
+                        }
+                        if motion {
+                            let du = vel * dt;
+                            let xp = x[k].0 + du;
+                            if !grid.contains(xp) {
+                                return Some((c * CHUNK + k, D::vec_to3(xp)));
+                            }
+                            x[k].0 = xp;
+                            u[k].0 += du;
+                        }
                     }
-                    x[p].0 = xp;
-                    if let Some(u) = disp.as_mut() {
-                        u[p].0 += du;
+                    None
+                })
+                .collect::<Vec<_>>()
+                .into_iter()
+                .flatten()
+                .next();
+            if let Some((p, position)) = escaped {
+                return Err(if position.iter().all(|c| c.is_finite()) {
+                    StepError::PointLeftGrid {
+                        step,
+                        system: name,
+                        point: offset + p,
+                        position,
                     }
-                }
+                } else {
+                    StepError::NonFinite {
+                        step,
+                        system: name,
+                        what: "position",
+                        location: format!("point {}", offset + p),
+                    }
+                });
             }
-            offset += x.len();
+            offset += xg.len();
         }
         Ok(())
     }

@@ -37,6 +37,7 @@ pub mod point_loads;
 pub mod remap;
 pub mod stress_update;
 pub mod volume_update;
+pub mod volumetric_smoothing;
 
 pub use boundary::Boundary;
 pub use convergence::Convergence;
@@ -52,6 +53,7 @@ pub use point_loads::PointLoads;
 pub use remap::Remap;
 pub use stress_update::StressUpdate;
 pub use volume_update::VolumeUpdate;
+pub use volumetric_smoothing::VolumetricSmoothing;
 
 use crate::dim::Dim;
 use crate::schedule::Schedule;
@@ -99,6 +101,9 @@ fn build<D: Dim, S: Shape>(settings: &Settings, needs: Needs) -> Schedule<D> {
                 s.push(Remap::<D, S>::default());
             }
             s.push(Kinematics::<D, S>::both());
+            if settings.volumetric_smoothing {
+                s.push(VolumetricSmoothing::<D, S>::default());
+            }
             s.push(StressUpdate);
             s.push(VolumeUpdate);
         }
@@ -106,6 +111,9 @@ fn build<D: Dim, S: Shape>(settings: &Settings, needs: Needs) -> Schedule<D> {
             s.push(P2g::<D, S>::new(P2gPart::MassMomentum));
             s.push(NodalVelocity);
             s.push(Kinematics::<D, S>::gradient_only());
+            if settings.volumetric_smoothing {
+                s.push(VolumetricSmoothing::<D, S>::default());
+            }
             s.push(StressUpdate);
             s.push(VolumeUpdate);
             s.push(P2g::<D, S>::new(P2gPart::InternalForce));

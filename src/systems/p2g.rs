@@ -2,8 +2,9 @@
 
 use crate::columns::{col, col_mut, nodes, points_with};
 use crate::components::*;
-use crate::dim::Dim;
+use crate::dim::{Dim, Vector};
 use crate::error::StepError;
+use crate::parallel::{slab_rows, ScatterBuffers, Slabs};
 use crate::schedule::System;
 use crate::shape::{for_each_node, Shape};
 use crate::simulation::Context;
@@ -20,11 +21,24 @@ pub enum P2gPart {
     InternalForce,
 }
 
+/// What one point adds to one node.
+#[derive(Clone, Copy, Debug)]
+struct NodeShare<V> {
+    mass: f64,
+    momentum: V,
+    force: V,
+}
+
 /// Maps point mass m_p, momentum m_p v_p and internal force −V_p σ_p·∇w_ip to the grid.
+///
+/// Points are grouped in slabs of grid rows; slabs scatter in parallel into their own node
+/// buffers, which are then added to the grid in slab order (see [`crate::parallel`]).
 #[derive(Debug)]
-pub struct P2g<D, S> {
+pub struct P2g<D: Dim, S> {
     part: P2gPart,
-    _marker: PhantomData<fn() -> (D, S)>,
+    slabs: Slabs,
+    buffers: ScatterBuffers<NodeShare<D::Vec>>,
+    _marker: PhantomData<fn() -> S>,
 }
 
 impl<D: Dim, S: Shape> P2g<D, S> {
@@ -32,6 +46,8 @@ impl<D: Dim, S: Shape> P2g<D, S> {
     pub fn new(part: P2gPart) -> Self {
         P2g {
             part,
+            slabs: Slabs::default(),
+            buffers: ScatterBuffers::default(),
             _marker: PhantomData,
         }
     }
@@ -57,37 +73,62 @@ impl<D: Dim, S: Shape> System<D> for P2g<D, S> {
             P2gPart::MassMomentum => (true, false),
             P2gPart::InternalForce => (false, true),
         };
+        let rows = slab_rows(grid, S::SUPPORT);
         for arch in points_with::<Position<D::Vec>>(&ctx.world) {
-            let x = col::<Position<D::Vec>>(arch);
-            let m = col::<Mass>(arch);
-            let v = col::<Velocity<D::Vec>>(arch);
+            let xg = col::<Position<D::Vec>>(arch);
+            let mg = col::<Mass>(arch);
+            let vg = col::<Velocity<D::Vec>>(arch);
             // Load carriers have no volume or stress and add no internal force.
-            let stressed = arch.get::<&Stress>().zip(arch.get::<&Volume>());
+            let sg = arch.get::<&Stress>();
+            let volg = arch.get::<&Volume>();
+            let stressed: Option<(&[Stress], &[Volume])> = sg.as_deref().zip(volg.as_deref());
             let force = force && stressed.is_some();
             if !mass_momentum && !force {
                 continue;
             }
-            for p in 0..x.len() {
-                let (mp, mv) = (m[p].0, v[p].0 * m[p].0);
-                let f = match (&stressed, force) {
-                    (Some((s, vol)), true) => Some((&s[p].0, -vol[p].0)),
-                    _ => None,
-                };
-                for_each_node::<D, S>(grid, x[p].0, |i, w, grad| {
-                    if mass_momentum {
-                        nm[i].0 += w * mp;
-                        np[i].0 += mv * w;
+            let (x, m): (&[Position<D::Vec>], &[Mass]) = (&xg, &mg);
+            let v: &[Velocity<D::Vec>] = &vg;
+            self.slabs.build(grid, x.iter().map(|p| p.0), rows);
+            let zero = NodeShare {
+                mass: 0.0,
+                momentum: D::Vec::ZERO,
+                force: D::Vec::ZERO,
+            };
+            self.buffers.scatter(
+                grid,
+                &self.slabs,
+                S::SUPPORT,
+                zero,
+                |points, buf, lo| {
+                    for &p in points {
+                        let p = p as usize;
+                        let (mp, mv) = (m[p].0, v[p].0 * m[p].0);
+                        let f = match (stressed, force) {
+                            (Some((s, vol)), true) => Some((&s[p].0, -vol[p].0)),
+                            _ => None,
+                        };
+                        for_each_node::<D, S>(grid, x[p].0, |i, w, grad| {
+                            let b = &mut buf[i - lo];
+                            if mass_momentum {
+                                b.mass += w * mp;
+                                b.momentum += mv * w;
+                            }
+                            if let Some((s, neg_vol)) = f {
+                                b.force += D::stress_dot(s, grad) * neg_vol;
+                            }
+                        });
                     }
-                    if let Some((s, neg_vol)) = f {
-                        nf[i].0 += D::stress_dot(s, grad) * neg_vol;
-                    }
-                });
-            }
+                },
+                |i, share| {
+                    nm[i].0 += share.mass;
+                    np[i].0 += share.momentum;
+                    nf[i].0 += share.force;
+                },
+            );
         }
         Ok(())
     }
 }
-
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -5,6 +5,7 @@ use crate::columns::{col, col_mut, nodes, points_with};
 use crate::components::*;
 use crate::dim::{Dim, Vector};
 use crate::error::StepError;
+use crate::parallel::{slab_rows, ScatterBuffers, Slabs};
 use crate::schedule::System;
 use crate::shape::{for_each_node, Shape};
 use crate::simulation::Context;
@@ -13,11 +14,19 @@ use std::marker::PhantomData;
 /// p_i = Σ_p w_ip m_p v_p with the new v_p, then v_i = p_i/m_i with boundary conditions.
 /// After a kinetic-damping reset all v_p are zero, and so is the remapped field.
 #[derive(Debug)]
-pub struct Remap<D, S>(PhantomData<fn() -> (D, S)>);
+pub struct Remap<D: Dim, S> {
+    slabs: Slabs,
+    buffers: ScatterBuffers<D::Vec>,
+    _marker: PhantomData<fn() -> S>,
+}
 
-impl<D, S> Default for Remap<D, S> {
+impl<D: Dim, S> Default for Remap<D, S> {
     fn default() -> Self {
-        Remap(PhantomData)
+        Remap {
+            slabs: Slabs::default(),
+            buffers: ScatterBuffers::default(),
+            _marker: PhantomData,
+        }
     }
 }
 
@@ -35,14 +44,30 @@ impl<D: Dim, S: Shape> System<D> for Remap<D, S> {
             let grid = &ctx.grid;
             let mut np = col_mut::<NodeMomentum<D::Vec>>(n);
             np.fill(NodeMomentum(D::Vec::ZERO));
+            let rows = slab_rows(grid, S::SUPPORT);
             for arch in points_with::<Velocity<D::Vec>>(&ctx.world) {
-                let x = col::<Position<D::Vec>>(arch);
-                let m = col::<Mass>(arch);
-                let v = col::<Velocity<D::Vec>>(arch);
-                for p in 0..x.len() {
-                    let mv = v[p].0 * m[p].0;
-                    for_each_node::<D, S>(grid, x[p].0, |i, w, _| np[i].0 += mv * w);
-                }
+                let (xg, mg, vg) = (
+                    col::<Position<D::Vec>>(arch),
+                    col::<Mass>(arch),
+                    col::<Velocity<D::Vec>>(arch),
+                );
+                let (x, m): (&[Position<D::Vec>], &[Mass]) = (&xg, &mg);
+                let v: &[Velocity<D::Vec>] = &vg;
+                self.slabs.build(grid, x.iter().map(|p| p.0), rows);
+                self.buffers.scatter(
+                    grid,
+                    &self.slabs,
+                    S::SUPPORT,
+                    D::Vec::ZERO,
+                    |points, buf, lo| {
+                        for &p in points {
+                            let p = p as usize;
+                            let mv = v[p].0 * m[p].0;
+                            for_each_node::<D, S>(grid, x[p].0, |i, w, _| buf[i - lo] += mv * w);
+                        }
+                    },
+                    |i, share| np[i].0 += share,
+                );
             }
         }
         velocity_from_momentum(ctx);

@@ -5,9 +5,11 @@ use crate::components::*;
 use crate::dim::Dim;
 use crate::error::StepError;
 use crate::materials::Material;
+use crate::parallel::CHUNK;
 use crate::schedule::System;
 use crate::simulation::Context;
 use crate::tensor::jaumann_rotate;
+use rayon::prelude::*;
 
 /// For each point: Δε = sym(L)Δt and ΔW = skew(L)Δt; the stress is first rotated by ΔW
 /// (objective Jaumann term) and then integrated by the point's material over Δε.
@@ -24,17 +26,31 @@ impl<D: Dim> System<D> for StressUpdate {
         }
         let dt = ctx.state.dt;
         let materials = &ctx.materials;
-        for arch in points_with::<Stress>(&ctx.world) {
-            let l = col::<VelocityGradient<D::Mat>>(arch);
-            let mat = col::<MaterialId>(arch);
-            let mut stress = col_mut::<Stress>(arch);
-            let mut plastic = arch.get::<&mut PlasticStrain>();
+        let kernel = |stress: &mut [Stress],
+                      l: &[VelocityGradient<D::Mat>],
+                      mat: &[MaterialId],
+                      mut plastic: Option<&mut [PlasticStrain]>| {
             for p in 0..stress.len() {
                 let (de, w) = D::strain_spin(&l[p].0, dt);
                 let mut s = jaumann_rotate(&stress[p].0, w);
                 let eps = plastic.as_mut().map(|e| &mut e[p].0);
                 materials[mat[p].0 as usize].update(&mut s, &de, eps);
                 stress[p].0 = s;
+            }
+        };
+        for arch in points_with::<Stress>(&ctx.world) {
+            let (lg, mg) = (col::<VelocityGradient<D::Mat>>(arch), col::<MaterialId>(arch));
+            let mut sg = col_mut::<Stress>(arch);
+            let chunks = sg
+                .par_chunks_mut(CHUNK)
+                .zip(lg.par_chunks(CHUNK))
+                .zip(mg.par_chunks(CHUNK));
+            // Plastic state exists only on plastic points.
+            match arch.get::<&mut PlasticStrain>() {
+                Some(mut pg) => chunks
+                    .zip(pg.par_chunks_mut(CHUNK))
+                    .for_each(|(((s, l), m), e)| kernel(s, l, m, Some(e))),
+                None => chunks.for_each(|((s, l), m)| kernel(s, l, m, None)),
             }
         }
         Ok(())

@@ -4,8 +4,10 @@ use crate::columns::{col, col_mut, points_with};
 use crate::components::*;
 use crate::dim::Dim;
 use crate::error::StepError;
+use crate::parallel::CHUNK;
 use crate::schedule::System;
 use crate::simulation::Context;
+use rayon::prelude::*;
 
 /// V_p ← V_p · det(I + L_p Δt). Density is not stored: it is m_p / V_p.
 #[derive(Debug, Default)]
@@ -21,11 +23,15 @@ impl<D: Dim> System<D> for VolumeUpdate {
         }
         let dt = ctx.state.dt;
         for arch in points_with::<Volume>(&ctx.world) {
-            let l = col::<VelocityGradient<D::Mat>>(arch);
+            let lg = col::<VelocityGradient<D::Mat>>(arch);
             let mut vol = col_mut::<Volume>(arch);
-            for (v, l) in vol.iter_mut().zip(l.iter()) {
-                v.0 *= D::volume_ratio(&l.0, dt);
-            }
+            vol.par_chunks_mut(CHUNK)
+                .zip(lg.par_chunks(CHUNK))
+                .for_each(|(vol, l)| {
+                    for (v, l) in vol.iter_mut().zip(l) {
+                        v.0 *= D::volume_ratio(&l.0, dt);
+                    }
+                });
         }
         Ok(())
     }

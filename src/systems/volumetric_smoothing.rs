@@ -1,0 +1,111 @@
+//! Volumetric smoothing of the strain increment through the grid (against volumetric
+//! locking and the pressure checkerboard it causes).
+
+use crate::columns::{col, col_mut, points_with};
+use crate::components::*;
+use crate::dim::Dim;
+use crate::error::StepError;
+use crate::parallel::{slab_rows, ScatterBuffers, Slabs, CHUNK};
+use crate::schedule::System;
+use crate::shape::{for_each_node, Shape};
+use crate::simulation::Context;
+use rayon::prelude::*;
+use std::marker::PhantomData;
+
+/// Replaces each point's volumetric strain rate tr(L_p) by its volume-weighted nodal
+/// average, leaving the deviatoric part untouched:
+///
+/// θ_i = Σ_p w_ip V_p tr(L_p) / Σ_p w_ip V_p,   L_p ← L_p + (Σ_i w_ip θ_i − tr(L_p)) I / N.
+///
+/// Near-incompressible plastic flow (ψ = 0) over-constrains a low-order grid (volumetric
+/// locking); the point-to-point pressure noise it leaves ratchets a slope at its limit angle
+/// downhill. Smoothing only the volumetric part keeps full stiffness against every
+/// deviatoric mode. Runs between `kinematics` and `stress_update`, so the stress and the
+/// volume see the same smoothed rate.
+#[derive(Debug)]
+pub struct VolumetricSmoothing<D: Dim, S> {
+    slabs: Slabs,
+    buffers: ScatterBuffers<[f64; 2]>,
+    nodal: Vec<f64>,
+    _marker: PhantomData<fn() -> (D, S)>,
+}
+
+impl<D: Dim, S> Default for VolumetricSmoothing<D, S> {
+    fn default() -> Self {
+        VolumetricSmoothing {
+            slabs: Slabs::default(),
+            buffers: ScatterBuffers::default(),
+            nodal: Vec::new(),
+            _marker: PhantomData,
+        }
+    }
+}
+
+/// Trace of a velocity gradient through the volume ratio's first-order term.
+#[inline(always)]
+fn trace<D: Dim>(l: &D::Mat) -> f64 {
+    D::strain_spin(l, 1.0).0.trace()
+}
+
+impl<D: Dim, S: Shape> System<D> for VolumetricSmoothing<D, S> {
+    fn name(&self) -> &str {
+        "volumetric_smoothing"
+    }
+    fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
+        if ctx.state.reset_this_step {
+            return Ok(());
+        }
+        let grid = &ctx.grid;
+        let rows = slab_rows(grid, S::SUPPORT);
+        let mut sums = vec![[0.0f64; 2]; grid.node_count()];
+        for arch in points_with::<Volume>(&ctx.world) {
+            let (xg, vg, lg) = (
+                col::<Position<D::Vec>>(arch),
+                col::<Volume>(arch),
+                col::<VelocityGradient<D::Mat>>(arch),
+            );
+            let (x, vol): (&[Position<D::Vec>], &[Volume]) = (&xg, &vg);
+            let l: &[VelocityGradient<D::Mat>] = &lg;
+            self.slabs.build(grid, x.iter().map(|p| p.0), rows);
+            self.buffers.scatter(
+                grid,
+                &self.slabs,
+                S::SUPPORT,
+                [0.0; 2],
+                |points, buf, lo| {
+                    for &p in points {
+                        let p = p as usize;
+                        let (v, t) = (vol[p].0, trace::<D>(&l[p].0));
+                        for_each_node::<D, S>(grid, x[p].0, |i, w, _| {
+                            buf[i - lo][0] += w * v * t;
+                            buf[i - lo][1] += w * v;
+                        });
+                    }
+                },
+                |i, s| {
+                    sums[i][0] += s[0];
+                    sums[i][1] += s[1];
+                },
+            );
+        }
+        self.nodal.clear();
+        self.nodal
+            .extend(sums.iter().map(|s| if s[1] > 0.0 { s[0] / s[1] } else { 0.0 }));
+        let nodal: &[f64] = &self.nodal;
+        let n = D::N as f64;
+        for arch in points_with::<Volume>(&ctx.world) {
+            let xg = col::<Position<D::Vec>>(arch);
+            let x: &[Position<D::Vec>] = &xg;
+            let mut lg = col_mut::<VelocityGradient<D::Mat>>(arch);
+            lg.par_chunks_mut(CHUNK).enumerate().for_each(|(c, l)| {
+                for (k, lp) in l.iter_mut().enumerate() {
+                    let mut theta = 0.0;
+                    for_each_node::<D, S>(grid, x[c * CHUNK + k].0, |i, w, _| theta += w * nodal[i]);
+                    let shift = (theta - trace::<D>(&lp.0)) / n;
+                    D::add_identity(&mut lp.0, shift);
+                }
+            });
+        }
+        Ok(())
+    }
+}
