@@ -15,7 +15,7 @@ pub enum SceneError {
         source: std::io::Error,
     },
     /// The text is not valid RON or does not match the scene schema.
-    #[error("{path}:{line}:{column}: {message}")]
+    #[error("{path}:{line}:{column}: {field}{message}")]
     Syntax {
         /// The scene file.
         path: PathBuf,
@@ -23,6 +23,8 @@ pub enum SceneError {
         line: usize,
         /// Column of the fault (1-based).
         column: usize,
+        /// "field `name`: " for the field whose value holds the fault, when there is one.
+        field: String,
         /// What is wrong.
         message: String,
     },

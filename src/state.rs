@@ -72,6 +72,19 @@ impl Gravity {
     }
 }
 
+/// A confirmation that a state meeting K_F and K_E is really static: the run goes on for
+/// `window` seconds and stops only if no point moved more than `max_displacement` in that
+/// time (and both ratios are still met). A creeping slope meets K_F and K_E between
+/// kinetic-damping resets; it does not meet this.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StaticCheck {
+    /// Confirmation window (s).
+    pub window: f64,
+    /// Largest point movement allowed over the window (m).
+    pub max_displacement: f64,
+}
+
 /// Settings fixed for the whole run.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Settings {
@@ -87,8 +100,12 @@ pub struct Settings {
     pub max_steps: Option<u64>,
     /// Simulated-time limit (s).
     pub max_time: Option<f64>,
+    /// Confirmation that a converged state is static, if asked for.
+    pub static_check: Option<StaticCheck>,
     /// Gravity, if any.
     pub gravity: Option<Gravity>,
+    /// FLIP fraction α of the point velocity update (1 = FLIP, 0 = PIC).
+    pub flip: f64,
     /// Smooth the volumetric strain rate through the grid before each stress update.
     pub volumetric_smoothing: bool,
     /// Nodes lighter than this carry no degrees of freedom (kg).
@@ -133,6 +150,10 @@ pub struct SolverState {
     pub peaks: Vec<Peak>,
     /// Set when the run should stop after this step.
     pub stop: Option<StopReason>,
+    /// Time at which the current static-check window opened (s).
+    pub static_window_start: Option<f64>,
+    /// Largest point movement over the last completed static-check window (m).
+    pub static_window_movement: Option<f64>,
 }
 
 impl SolverState {

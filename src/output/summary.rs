@@ -38,6 +38,8 @@ pub struct Summary {
     pub energy_ratio: f64,
     /// Tolerance for both.
     pub tolerance: f64,
+    /// Largest point movement over the last completed static-check window (m).
+    pub static_window_movement: Option<f64>,
     /// Kinetic-damping resets.
     pub kinetic_resets: u64,
     /// The first kinetic-energy peak (s, J).
@@ -93,6 +95,7 @@ impl Summary {
             force_ratio_mean: s.force_ratio_mean,
             energy_ratio: s.energy_ratio,
             tolerance: st.tolerance,
+            static_window_movement: s.static_window_movement,
             kinetic_resets: s.resets,
             first_peak: s.peaks.first().copied(),
             kinetic_energy: s.kinetic_energy,

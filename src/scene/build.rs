@@ -11,11 +11,12 @@ use crate::materials::Material;
 use crate::shape::{for_each_node, Linear, QuadraticBSpline, ShapeKind};
 use crate::simulation::{AnySimulation, Context, Simulation, TracedPoint};
 use crate::state::{Gravity, Settings, SolverState};
-use crate::systems::{default_schedule, Needs};
+use crate::systems::{check_names, default_names, schedule_from_names, Needs};
 use crate::tensor::Sym3;
 use hecs::{Entity, World};
 
-/// Validates the scene and builds its simulation with the default schedule.
+/// Validates the scene and builds its simulation with its schedule (the default one for its
+/// settings unless `solver.schedule` names the systems).
 pub fn build(loaded: &LoadedScene) -> Result<(AnySimulation, Derived), SceneError> {
     let checked = validate::check(loaded)?;
     Ok(match loaded.scene.dimension {
@@ -299,7 +300,9 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         force_norm: s.solver.force_norm,
         max_steps: s.solver.max_steps,
         max_time: s.solver.max_time,
+        static_check: s.solver.static_check,
         volumetric_smoothing: s.solver.volumetric_smoothing,
+        flip: s.solver.flip,
         gravity: s.gravity.as_ref().map(|g| Gravity {
             acceleration: pad3(&g.acceleration),
             ramp_time: g.ramp_time,
@@ -311,7 +314,17 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
     let needs = Needs {
         point_loads: !s.point_loads.is_empty(),
     };
-    let schedule = default_schedule::<D>(&settings, s.shape, needs);
+    let names: Vec<String> = match &s.solver.schedule {
+        Some(names) => {
+            check_names(names, &settings, needs).map_err(|rule| loaded.invalid("solver.schedule", rule))?;
+            names.clone()
+        }
+        None => default_names(&settings, needs)
+            .into_iter()
+            .map(String::from)
+            .collect(),
+    };
+    let schedule = schedule_from_names::<D>(&names, &settings, s.shape);
     let derived = Derived {
         p_wave_speed: c_p,
         critical_time_step: dt_crit,

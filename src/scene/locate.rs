@@ -15,6 +15,32 @@ pub fn line_column(text: &str, at: usize) -> (usize, usize) {
     (line, col)
 }
 
+/// The name of the field whose value holds 1-based (line, column): the nearest `name:`
+/// before it.
+pub fn field_before(text: &str, line: usize, column: usize) -> Option<String> {
+    let start_of_line: usize = text
+        .split_inclusive('\n')
+        .take(line.saturating_sub(1))
+        .map(str::len)
+        .sum();
+    let at = text[start_of_line..]
+        .char_indices()
+        .nth(column.saturating_sub(1))
+        .map_or(text.len(), |(i, _)| start_of_line + i);
+    let before = &text[..at.min(text.len())];
+    let colon = before.rfind(':')?;
+    let head = before[..colon].trim_end();
+    let name: String = head
+        .chars()
+        .rev()
+        .take_while(|c| c.is_alphanumeric() || *c == '_')
+        .collect::<String>()
+        .chars()
+        .rev()
+        .collect();
+    (!name.is_empty()).then_some(name)
+}
+
 /// Position of the field named by `path`: its name if present, else the deepest parent
 /// found. `None` when not even the first segment is in the text.
 pub fn field_position(text: &str, path: &str) -> Option<(usize, usize)> {

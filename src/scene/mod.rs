@@ -13,7 +13,7 @@ pub use validate::Derived;
 use crate::error::SceneError;
 use crate::grid::Face;
 use crate::shape::ShapeKind;
-use crate::state::{Damping, ForceNorm, Scheme};
+use crate::state::{Damping, ForceNorm, Scheme, StaticCheck};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -210,15 +210,30 @@ pub struct SolverSpec {
     /// Norm of K_F used to stop (default `Max`, the paper's eq. 3).
     #[serde(default)]
     pub force_norm: ForceNorm,
+    /// The systems of one step, in order, replacing the default schedule of `scheme`
+    /// (see `kdmpm check` for the default list, `systems::SYSTEM_NAMES` for every name).
+    #[serde(default)]
+    pub schedule: Option<Vec<String>>,
+    /// FLIP fraction α of the point velocity update: 1 (default) is FLIP, 0 is PIC, which
+    /// damps the velocity noise of the points.
+    #[serde(default = "default_flip")]
+    pub flip: f64,
     /// Smooth the volumetric strain rate through the grid (against volumetric locking).
     #[serde(default)]
     pub volumetric_smoothing: bool,
+    /// Confirm a converged state is static before stopping: `(window: s, max_displacement: m)`.
+    #[serde(default)]
+    pub static_check: Option<StaticCheck>,
     /// Step limit.
     #[serde(default)]
     pub max_steps: Option<u64>,
     /// Simulated-time limit (s).
     #[serde(default)]
     pub max_time: Option<f64>,
+}
+
+fn default_flip() -> f64 {
+    1.0
 }
 
 fn default_tolerance() -> f64 {
@@ -281,11 +296,19 @@ impl LoadedScene {
         for o in overrides {
             text = locate::apply_override(&text, o)?;
         }
-        let scene: Scene = ron_options().from_str(&text).map_err(|e| SceneError::Syntax {
-            path: path.to_path_buf(),
-            line: e.span.start.line,
-            column: e.span.start.col,
-            message: e.code.to_string(),
+        let scene: Scene = ron_options().from_str(&text).map_err(|e| {
+            let message = e.code.to_string();
+            let (line, column) = (e.span.start.line, e.span.start.col);
+            let field = locate::field_before(&text, line, column)
+                .filter(|f| !message.contains(&format!("`{f}`")))
+                .map_or(String::new(), |f| format!("field `{f}`: "));
+            SceneError::Syntax {
+                path: path.to_path_buf(),
+                line,
+                column,
+                field,
+                message,
+            }
         })?;
         let loaded = LoadedScene {
             scene,

@@ -191,6 +191,26 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
             );
         }
     }
+    if let Some(c) = s.solver.static_check {
+        if !positive(c.window) {
+            return bad(
+                "solver.static_check.window",
+                format!("must be > 0 s, found {}", c.window),
+            );
+        }
+        if !positive(c.max_displacement) {
+            return bad(
+                "solver.static_check.max_displacement",
+                format!("must be > 0 m, found {}", c.max_displacement),
+            );
+        }
+    }
+    if !(0.0..=1.0).contains(&s.solver.flip) {
+        return bad(
+            "solver.flip",
+            format!("must be in [0, 1] (1 = FLIP, 0 = PIC), found {}", s.solver.flip),
+        );
+    }
     if s.solver.max_steps.is_none() && s.solver.max_time.is_none() {
         return bad(
             "solver",

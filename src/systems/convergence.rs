@@ -1,13 +1,13 @@
 //! Convergence monitor: force ratio K_F (eq. 3), external work (eq. 6), energy ratio K_E
 //! (eq. 4), and the stopping rule (paper step 7).
 
-use crate::columns::{col, nodes};
+use crate::columns::{col, nodes, points_with};
 use crate::components::*;
 use crate::dim::{Dim, Vector};
 use crate::error::StepError;
 use crate::schedule::System;
 use crate::simulation::Context;
-use crate::state::StopReason;
+use crate::state::{StaticCheck, StopReason};
 
 /// Force-ratio sums over the free degrees of freedom of nodes that carry mass.
 ///
@@ -67,8 +67,61 @@ pub fn force_ratios<D: Dim>(ctx: &Context<D>) -> ForceRatios {
 /// loads reach the grid through the shape weights, and every point moves by
 /// Δt Σ_i w_ip v_i, so the sum equals Δt Σ_i F_i^ext·v_i over the nodes, which costs a
 /// grid pass instead of a point pass. A reset step moves nothing and does no work.
+///
+/// With a [`StaticCheck`] the first step that meets both ratios opens a window; the run
+/// stops at the end of the window only if the ratios are met again and no point moved
+/// more than the allowed distance, otherwise a new window opens at the next step that
+/// meets them.
 #[derive(Debug, Default)]
-pub struct Convergence;
+pub struct Convergence {
+    /// Point positions (m, x y z) when the static-check window opened.
+    snapshot: Vec<[f64; 3]>,
+}
+
+impl Convergence {
+    fn positions<D: Dim>(ctx: &Context<D>, out: &mut Vec<[f64; 3]>) {
+        out.clear();
+        for arch in points_with::<Position<D::Vec>>(&ctx.world) {
+            out.extend(col::<Position<D::Vec>>(arch).iter().map(|x| D::vec_to3(x.0)));
+        }
+    }
+
+    fn confirm_static<D: Dim>(&mut self, ctx: &mut Context<D>, met: bool, check: StaticCheck) -> bool {
+        let now = ctx.state.time;
+        match ctx.state.static_window_start {
+            Some(start) if now >= start + check.window * (1.0 - 1e-12) => {
+                let mut current = Vec::with_capacity(self.snapshot.len());
+                Self::positions(ctx, &mut current);
+                let moved = current
+                    .iter()
+                    .zip(&self.snapshot)
+                    .map(|(a, b)| {
+                        ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+                    })
+                    .fold(0.0, f64::max);
+                ctx.state.static_window_movement = Some(moved);
+                ctx.state.static_window_start = None;
+                if met && moved <= check.max_displacement {
+                    return true;
+                }
+                if met {
+                    // Still balanced but moving: a creeping state. Watch a new window.
+                    ctx.state.static_window_start = Some(now);
+                    self.snapshot = current;
+                }
+                false
+            }
+            Some(_) => false,
+            None => {
+                if met {
+                    ctx.state.static_window_start = Some(now);
+                    Self::positions(ctx, &mut self.snapshot);
+                }
+                false
+            }
+        }
+    }
+}
 
 impl<D: Dim> System<D> for Convergence {
     fn name(&self) -> &str {
@@ -97,7 +150,13 @@ impl<D: Dim> System<D> for Convergence {
         };
         let tol = ctx.settings.tolerance;
         let (step, time) = (s.step, s.time);
-        if s.force_ratio(ctx.settings.force_norm) <= tol && s.energy_ratio <= tol {
+        let met = s.force_ratio(ctx.settings.force_norm) <= tol && s.energy_ratio <= tol;
+        let converged = match ctx.settings.static_check {
+            None => met,
+            Some(check) => self.confirm_static(ctx, met, check),
+        };
+        let s = &mut ctx.state;
+        if converged {
             s.stop = Some(StopReason::Converged);
         } else if ctx.settings.max_steps.is_some_and(|m| step >= m) {
             s.stop = Some(StopReason::MaxSteps);

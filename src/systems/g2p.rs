@@ -11,7 +11,8 @@ use crate::simulation::Context;
 use rayon::prelude::*;
 use std::marker::PhantomData;
 
-/// v_p ← v_p + Δt Σ_i w_ip a_i (FLIP update), then E_k = ½ Σ m_p v_p·v_p.
+/// v_p ← α (v_p + Δt Σ_i w_ip a_i) + (1 − α) Σ_i w_ip v_i (FLIP for α = 1, PIC for α = 0),
+/// then E_k = ½ Σ m_p v_p·v_p.
 #[derive(Debug)]
 pub struct G2p<D, S>(PhantomData<fn() -> (D, S)>);
 
@@ -30,6 +31,9 @@ impl<D: Dim, S: Shape> System<D> for G2p<D, S> {
         let n = nodes(&ctx.world);
         let nag = col::<NodeAcceleration<D::Vec>>(n);
         let na: &[NodeAcceleration<D::Vec>] = &nag;
+        let nvg = col::<NodeVelocity<D::Vec>>(n);
+        let nv: &[NodeVelocity<D::Vec>] = &nvg;
+        let flip = ctx.settings.flip;
         let mut twice_ek = 0.0;
         for arch in points_with::<Velocity<D::Vec>>(&ctx.world) {
             let (xg, mg) = (col::<Position<D::Vec>>(arch), col::<Mass>(arch));
@@ -42,9 +46,16 @@ impl<D: Dim, S: Shape> System<D> for G2p<D, S> {
                     let mut e = 0.0;
                     for (k, vp) in v.iter_mut().enumerate() {
                         let p = c * CHUNK + k;
-                        let mut a = D::Vec::ZERO;
-                        for_each_node::<D, S>(grid, x[p].0, |i, w, _| a += na[i].0 * w);
-                        vp.0 += a * dt;
+                        let (mut a, mut vg) = (D::Vec::ZERO, D::Vec::ZERO);
+                        for_each_node::<D, S>(grid, x[p].0, |i, w, _| {
+                            a += na[i].0 * w;
+                            vg += nv[i].0 * w;
+                        });
+                        vp.0 = if flip == 1.0 {
+                            vp.0 + a * dt
+                        } else {
+                            (vp.0 + a * dt) * flip + vg * (1.0 - flip)
+                        };
                         e += m[p].0 * vp.0.dot(vp.0);
                     }
                     e
