@@ -74,6 +74,21 @@ pub enum StepError {
         /// The point or node involved.
         location: String,
     },
+    /// The kinetic energy exceeds the work done on the body: the scheme is creating energy.
+    #[error(
+        "step {step}, system `convergence`: kinetic energy {kinetic_energy:.4e} J exceeds {ratio:.1}× the external \
+         work {external_work:.4e} J: the run is unstable (time step too large for the stiffness or mass?)"
+    )]
+    Unstable {
+        /// Step number.
+        step: u64,
+        /// E_k (J).
+        kinetic_energy: f64,
+        /// W_ext (J).
+        external_work: f64,
+        /// E_k / W_ext.
+        ratio: f64,
+    },
     /// A point load found no node with mass to act on.
     #[error("step {step}: point load {point} at {position:?} has no node with mass to act on")]
     LoadLost {

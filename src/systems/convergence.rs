@@ -9,6 +9,9 @@ use crate::schedule::System;
 use crate::simulation::Context;
 use crate::state::{StaticCheck, StopReason};
 
+/// K_E above which a run is declared unstable (a sound run stays at or below 1).
+pub const UNSTABLE_ENERGY_RATIO: f64 = 10.0;
+
 /// Force-ratio sums over the free degrees of freedom of nodes that carry mass.
 ///
 /// Fixed components are left out (their reaction keeps K_F near 1 for ever), and so are
@@ -148,6 +151,16 @@ impl<D: Dim> System<D> for Convergence {
         } else {
             0.0
         };
+        // Energy balance: W_ext = E_k + stored + dissipated, so K_E ≤ 1 in a sound run.
+        // Well above that the scheme is creating energy; stop before it turns into NaN.
+        if s.energy_ratio > UNSTABLE_ENERGY_RATIO && s.external_work > 0.0 {
+            return Err(StepError::Unstable {
+                step: s.step,
+                kinetic_energy: s.kinetic_energy,
+                external_work: s.external_work,
+                ratio: s.energy_ratio,
+            });
+        }
         let tol = ctx.settings.tolerance;
         let (step, time) = (s.step, s.time);
         let met = s.force_ratio(ctx.settings.force_norm) <= tol && s.energy_ratio <= tol;

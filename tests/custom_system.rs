@@ -1,0 +1,26 @@
+//! The example's user system runs inside the schedule, once per step, at its named place.
+
+#[path = "../examples/custom_system.rs"]
+#[allow(dead_code)]
+mod example;
+
+#[test]
+fn a_user_system_inserted_after_g2p_runs_every_step() {
+    let (mut sim, record) = example::bar_with_probe();
+    let names = sim.schedule.names();
+    let at = names.iter().position(|n| n == "max_speed_probe").unwrap();
+    assert_eq!(names[at - 1], "g2p");
+    sim.run(|_| {}).unwrap();
+    let speeds = record.lock().unwrap();
+    assert_eq!(speeds.len() as u64, sim.ctx.state.step);
+    // The bar's end moves at about F/(ρcA) = 1e-3 at the first peak.
+    let peak = speeds.iter().cloned().fold(0.0, f64::max);
+    assert!(peak > 5e-4 && peak < 3e-3, "peak speed {peak}");
+    let probe = sim
+        .schedule
+        .timings()
+        .into_iter()
+        .find(|t| t.name == "max_speed_probe")
+        .unwrap();
+    assert_eq!(probe.calls, sim.ctx.state.step);
+}

@@ -1,0 +1,96 @@
+//! The paper's Example 2: a 40 m cohesionless slope (φ = 20°, 30° face) that fails and comes
+//! to rest, and its stable companion (φ = 35°).
+//!
+//! Paper: the run stops at t = 24.28 s and the final surface stands at about φ = 20°.
+//! Expected angle here: Davis's effective friction angle for non-associated flow in plane
+//! strain, tan φ* = sin φ cos ψ / (1 − sin φ sin ψ) = sin 20° → φ* = 18.9°.
+
+use kdmpm::columns::{col, points_with};
+use kdmpm::components::{Mass, Position, Stress};
+use kdmpm::measure::{all_positions_finite, max_displacements, surface_angle};
+use kdmpm::scene::{build, LoadedScene};
+use kdmpm::state::StopReason;
+use kdmpm::{with_simulation, Dim, Simulation};
+use std::path::Path;
+
+fn scene(name: &str, overrides: &[&str]) -> kdmpm::AnySimulation {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes").join(name);
+    let o: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+    build(&LoadedScene::from_file(&path, &o).unwrap()).unwrap().0
+}
+
+fn positions<D: Dim>(sim: &Simulation<D>) -> Vec<[f64; 3]> {
+    points_with::<Stress>(&sim.ctx.world)
+        .flat_map(|a| {
+            col::<Position<D::Vec>>(a)
+                .iter()
+                .map(|x| D::vec_to3(x.0))
+                .collect::<Vec<_>>()
+        })
+        .collect()
+}
+
+/// Sum of point masses, compared bit for bit.
+fn mass_bits<D: Dim>(sim: &Simulation<D>) -> u64 {
+    points_with::<Mass>(&sim.ctx.world)
+        .map(|a| col::<Mass>(a).iter().map(|m| m.0).sum::<f64>())
+        .sum::<f64>()
+        .to_bits()
+}
+
+/// Runs to the stop, then 10 s more; returns (stop time, angle, max |u_x|, movement after).
+fn run_and_continue<D: Dim>(sim: &mut Simulation<D>) -> (f64, f64, f64, f64) {
+    let mass0 = mass_bits(sim);
+    sim.run(|_| {})
+        .expect("no point leaves the grid, nothing becomes NaN");
+    let s = &sim.ctx.state;
+    assert_eq!(
+        s.stop,
+        Some(StopReason::Converged),
+        "t = {}, K_F = {}, K_E = {}",
+        s.time,
+        s.force_ratio_max,
+        s.energy_ratio
+    );
+    let (t_stop, norm) = (s.time, sim.ctx.settings.force_norm);
+    assert!(s.force_ratio(norm) <= 0.01 && s.energy_ratio <= 0.01);
+    let angle = surface_angle(sim).expect("a surface").degrees;
+    let (_, max_ux) = max_displacements(sim);
+    assert_eq!(mass_bits(sim), mass0, "total mass changed");
+    assert!(all_positions_finite(sim));
+    // Static: ten more seconds move nothing by more than 1 cm.
+    let before = positions(sim);
+    let steps = (10.0 / sim.ctx.state.dt).ceil() as u64;
+    for _ in 0..steps {
+        sim.step().expect("continuing stays stable");
+    }
+    let after = positions(sim);
+    let moved = before
+        .iter()
+        .zip(&after)
+        .map(|(a, b)| ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt())
+        .fold(0.0, f64::max);
+    println!(
+        "stop t = {t_stop:.2} s, angle {angle:.2}°, max u_x {max_ux:.3} m, moved {moved:.4} m in 10 s more"
+    );
+    (t_stop, angle, max_ux, moved)
+}
+
+#[test]
+fn failing_slope_comes_to_rest_at_its_repose_angle() {
+    let mut sim = scene("slope.ron", &[]);
+    let (t, angle, max_ux, moved) = with_simulation!(&mut sim, s => run_and_continue(s));
+    assert!(t <= 120.0);
+    assert!((angle - 20.0).abs() <= 3.0, "angle {angle}");
+    assert!(max_ux > 20.0, "the φ = 20° slope fails: max u_x = {max_ux}");
+    assert!(moved <= 0.01, "not static: {moved} m in 10 s");
+}
+
+#[test]
+fn slope_steeper_friction_than_its_face_stands() {
+    let mut sim = scene("slope_stable.ron", &[]);
+    let (_, angle, max_ux, moved) = with_simulation!(&mut sim, s => run_and_continue(s));
+    assert!(max_ux < 1.0, "max u_x {max_ux}");
+    assert!((angle - 30.0).abs() <= 1.0, "angle {angle}");
+    assert!(moved <= 0.01, "not static: {moved} m in 10 s");
+}
