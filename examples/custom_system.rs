@@ -7,7 +7,6 @@
 
 use kdmpm::columns::{col, points_with};
 use kdmpm::components::Velocity;
-use kdmpm::dim::Vector;
 use kdmpm::scene::{build, LoadedScene};
 use kdmpm::{AnySimulation, Context, Dim3, FnSystem, StepError};
 use std::path::Path;
