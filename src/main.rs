@@ -40,6 +40,10 @@ enum Command {
         /// Worker threads (default: all cores). Results are identical for any count.
         #[arg(long)]
         threads: Option<usize>,
+        /// Write a Chrome trace (chrome://tracing, Perfetto) of every system call to FILE
+        /// (needs a build with `--features trace`).
+        #[arg(long, value_name = "FILE")]
+        trace: Option<PathBuf>,
     },
     /// Parse and validate a scene without running it; print the derived figures.
     Check {
@@ -66,7 +70,15 @@ fn main() -> ExitCode {
             profile,
             quiet,
             threads,
+            trace,
         } => {
+            let _trace = match trace.map(start_trace).transpose() {
+                Ok(guard) => guard,
+                Err(message) => {
+                    eprintln!("error: {message}");
+                    return ExitCode::from(BAD_INPUT);
+                }
+            };
             if let Some(n) = threads {
                 if let Err(e) = rayon::ThreadPoolBuilder::new()
                     .num_threads(n.max(1))
@@ -79,6 +91,29 @@ fn main() -> ExitCode {
             run(&scene, out, &overrides, profile, quiet)
         }
     }
+}
+
+/// Starts the Chrome-trace writer; the returned guard flushes the file when dropped.
+#[cfg(feature = "trace")]
+fn start_trace(path: PathBuf) -> Result<Box<dyn std::any::Any>, String> {
+    use tracing_subscriber::prelude::*;
+    let (layer, guard) = tracing_chrome::ChromeLayerBuilder::new()
+        .file(path)
+        .include_args(true)
+        .build();
+    tracing_subscriber::registry()
+        .with(layer)
+        .try_init()
+        .map_err(|e| e.to_string())?;
+    Ok(Box::new(guard))
+}
+
+#[cfg(not(feature = "trace"))]
+fn start_trace(_path: PathBuf) -> Result<Box<dyn std::any::Any>, String> {
+    Err(
+        "--trace needs kdmpm built with the `trace` feature: cargo run --release --features trace -- run ..."
+            .into(),
+    )
 }
 
 fn check(path: &Path, overrides: &[String]) -> ExitCode {

@@ -127,6 +127,8 @@ impl<D: Dim> Schedule<D> {
     /// Runs every system once, in order, timing each.
     pub fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
         for (i, system) in self.systems.iter_mut().enumerate() {
+            #[cfg(feature = "trace")]
+            let _span = tracing::info_span!("system", name = system.name()).entered();
             let start = Instant::now();
             let result = system.run(ctx);
             self.time[i] += start.elapsed();
