@@ -56,6 +56,8 @@ pub struct Summary {
     pub wall_seconds: f64,
     /// Points × steps per wall second of the stepping loop.
     pub particle_steps_per_second: f64,
+    /// Peak resident memory of the process (bytes; Linux only).
+    pub peak_memory_bytes: Option<u64>,
     /// Largest displacement magnitude of any point (m).
     pub max_displacement: f64,
     /// Largest |horizontal displacement| of any point (m).
@@ -115,8 +117,17 @@ impl Summary {
             } else {
                 None
             },
+            peak_memory_bytes: peak_memory_bytes(),
             traced: sim.traced_results(),
             systems: sim.schedule.timings(),
         }
     }
+}
+
+/// Peak resident set size of this process (bytes), from `/proc/self/status` (VmHWM).
+pub fn peak_memory_bytes() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024)
 }

@@ -1,0 +1,67 @@
+//! Per-system micro-benchmarks on the 2D slope after 200 steps of failure: particle-to-grid,
+//! grid-to-particle, the Mohr-Coulomb stress update and the convergence monitor.
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use kdmpm::materials::{Material, MohrCoulomb};
+use kdmpm::scene::{build, LoadedScene};
+use kdmpm::shape::QuadraticBSpline;
+use kdmpm::systems::{Convergence, G2p, GridReset, P2g, P2gPart};
+use kdmpm::tensor::Sym3;
+use kdmpm::{AnySimulation, Dim2, Simulation, System};
+use std::path::Path;
+
+fn slope() -> Simulation<Dim2> {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/slope.ron");
+    let loaded = LoadedScene::from_file(&path, &[]).unwrap();
+    let AnySimulation::Two(mut sim) = build(&loaded).unwrap().0 else {
+        unreachable!()
+    };
+    for _ in 0..200 {
+        sim.step().unwrap();
+    }
+    sim
+}
+
+fn kernels(c: &mut Criterion) {
+    let mut sim = slope();
+    let mut p2g = P2g::<Dim2, QuadraticBSpline>::new(P2gPart::All);
+    c.bench_function("p2g (2D slope, B-spline, 23k points)", |b| {
+        b.iter(|| {
+            GridReset.run(&mut sim.ctx).unwrap();
+            p2g.run(&mut sim.ctx).unwrap();
+        })
+    });
+    let mut g2p = G2p::<Dim2, QuadraticBSpline>::default();
+    c.bench_function("g2p (2D slope, B-spline, 23k points)", |b| {
+        b.iter(|| g2p.run(&mut sim.ctx).unwrap())
+    });
+    let mut conv = Convergence::default();
+    c.bench_function("convergence (2D slope grid)", |b| {
+        b.iter(|| conv.run(&mut sim.ctx).unwrap())
+    });
+    let mc = MohrCoulomb::new(2000.0, 20e6, 0.4, 0.0, 20.0, 0.0, None);
+    let start = Sym3 {
+        xx: -1.0e5,
+        yy: -2.5e5,
+        zz: -1.4e5,
+        xy: 3.0e4,
+        ..Sym3::ZERO
+    };
+    let de = Sym3 {
+        xx: 2e-5,
+        yy: -3e-5,
+        xy: 1e-5,
+        ..Sym3::ZERO
+    };
+    c.bench_function("Mohr-Coulomb update (plastic, plane strain)", |b| {
+        b.iter(|| {
+            let mut s = std::hint::black_box(start);
+            let mut eps = 0.0;
+            mc.update(&mut s, &de, Some(&mut eps));
+            s
+        })
+    });
+}
+
+criterion_group!(benches, kernels);
+criterion_main!(benches);
