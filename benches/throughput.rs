@@ -24,7 +24,22 @@ fn measure<D: Dim>(sim: &mut Simulation<D>, min_seconds: f64) -> (f64, u64) {
     (sim.point_count() as f64 * steps as f64 / wall, steps)
 }
 
+/// Cost of timing one system call: two clock reads and the bookkeeping (s).
+fn timing_cost() -> f64 {
+    let n = 1_000_000;
+    let mut total = std::time::Duration::ZERO;
+    let start = Instant::now();
+    for _ in 0..n {
+        let t = Instant::now();
+        total += std::hint::black_box(t).elapsed();
+    }
+    std::hint::black_box(total);
+    start.elapsed().as_secs_f64() / n as f64
+}
+
 fn main() {
+    let per_call = timing_cost();
+    println!("timing one system call costs {:.1} ns", per_call * 1e9);
     let filter: Option<String> = std::env::args().skip(1).find(|a| !a.starts_with('-'));
     let cases = [
         ("block_10k.ron", "3D block 10k", 2.0),
@@ -65,6 +80,12 @@ fn main() {
             );
             if threads == 2 {
                 let total: f64 = split.iter().map(|t| t.seconds).sum();
+                let calls: u64 = split.iter().map(|t| t.calls).sum();
+                println!(
+                    "{:<16} timing overhead: {:.3}% of the step",
+                    "",
+                    100.0 * per_call * calls as f64 / total
+                );
                 let parts: Vec<String> = split
                     .iter()
                     .filter(|t| t.seconds / total > 0.01)

@@ -278,3 +278,47 @@ fn overrides_that_do_not_apply_are_rejected() {
     assert!(err.contains("solver.tolerance"), "{err}");
     let _ = std::fs::remove_dir_all(&c.dir);
 }
+
+#[test]
+fn a_point_leaving_the_grid_stops_the_run_and_keeps_what_was_written() {
+    // A block with no base condition falls out of the grid under gravity.
+    let text = r#"Scene(
+        dimension: 2,
+        grid: (origin: [0.0, 0.0], cell_size: 1.0, cells: [4, 6]),
+        materials: { "m": LinearElastic(density: 2000.0, youngs_modulus: 1e6, poisson_ratio: 0.3) },
+        bodies: [(material: "m", region: Box(min: [1.0, 0.0], max: [3.0, 2.0]), points_per_cell: [2, 2])],
+        gravity: (acceleration: [0.0, -9.81]),
+        traced: [(name: "p", position: [1.25, 0.25])],
+        solver: (damping: None, time_step: Courant(0.5), max_time: 5.0),
+    )"#;
+    let c = case("falls", text);
+    let (code, err) = run(&c.scene, &c.out, &[]);
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("system `kinematics`") && err.contains("left the grid") && err.contains("point "),
+        "{err}"
+    );
+    let step: u64 = err
+        .split("step ")
+        .nth(1)
+        .unwrap()
+        .split(',')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    // history.csv holds a complete row for every step before the failure.
+    let history = std::fs::read_to_string(c.out.join("history.csv")).unwrap();
+    let rows: Vec<&str> = history.lines().collect();
+    let width = rows[0].split(',').count();
+    assert!(rows[1..]
+        .iter()
+        .all(|r| r.split(',').count() == width && r.split(',').all(|f| f.parse::<f64>().is_ok())));
+    assert_eq!(rows.len() as u64 - 1, step - 1, "one row per completed step");
+    let summary = std::fs::read_to_string(c.out.join("summary.json")).unwrap();
+    assert!(
+        summary.contains("\"error\": \"step ") && summary.contains("\"converged\": false"),
+        "{summary}"
+    );
+    let _ = std::fs::remove_dir_all(&c.dir);
+}
