@@ -77,25 +77,36 @@ fn run_and_continue<D: Dim>(sim: &mut Simulation<D>) -> (f64, f64, f64, f64) {
 }
 
 #[test]
-fn failing_slope_is_not_declared_static_while_it_still_creeps() {
-    // By t ≈ 20 s the failed slope meets K_F ≤ 0.01 and K_E ≤ 0.01 (where the paper stops),
-    // yet it still creeps by decimetres per 10 s: the static check must refuse to stop.
-    let mut sim = scene("slope.ron", &["solver.max_time=30"]);
+fn failing_slope_comes_to_rest_at_its_repose_angle() {
+    let mut sim = scene("slope.ron", &[]);
+    let (t, angle, max_ux, moved) = with_simulation!(&mut sim, s => run_and_continue(s));
+    assert!(t <= 120.0, "stopped at {t} s");
+    // About φ = 20° (paper); φ* = 18.9° for ψ = 0 (Davis).
+    assert!((angle - 20.0).abs() <= 3.0, "angle {angle}");
+    assert!(max_ux > 20.0, "the φ = 20° slope fails: max u_x = {max_ux}");
+    assert!(moved <= 0.01, "not static: {moved} m in 10 s");
+}
+
+#[test]
+fn a_creeping_slope_is_not_declared_static() {
+    // Without the virtual mass floor, nodes reached only by a point's far tail push that
+    // point with its own stress and the failed slope creeps by decimetres per 10 s, while
+    // K_F and K_E already meet the paper's tolerance (from t ≈ 20 s): the static check must
+    // refuse to stop.
+    let mut sim = scene(
+        "slope.ron",
+        &[
+            "solver.max_time=30",
+            "solver.virtual_mass_floor=0",
+            "solver.node_mass_cutoff=1e-9",
+        ],
+    );
     with_simulation!(&mut sim, s => {
-        let mass0 = mass_bits(s);
-        s.run(|_| {}).expect("no point leaves the grid, nothing becomes NaN");
+        s.run(|_| {}).expect("runs");
         let st = &s.ctx.state;
         assert_eq!(st.stop, Some(StopReason::MaxTime));
         let moved = st.static_window_movement.expect("K_F and K_E were met and a 10 s window closed");
-        assert!(moved > 0.01, "a window moved only {moved} m: static already?");
-        let angle = surface_angle(s).expect("a surface").degrees;
-        let (_, max_ux) = max_displacements(s);
-        println!("t = {:.1} s, K_F = {:.2e}, window movement {moved:.3} m, angle {angle:.2}°, max u_x {max_ux:.2} m", st.time, st.force_ratio_max);
-        // About φ = 20° (paper); φ* = 18.9° for ψ = 0 (Davis).
-        assert!((angle - 20.0).abs() <= 3.0, "angle {angle}");
-        assert!(max_ux > 20.0, "the φ = 20° slope fails: max u_x = {max_ux}");
-        assert_eq!(mass_bits(s), mass0, "total mass changed");
-        assert!(all_positions_finite(s));
+        assert!(moved > 0.01, "a window moved only {moved} m");
     });
 }
 

@@ -174,7 +174,8 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
     // Material points, body by body (cell order within a body keeps them spatially sorted).
     let cell_volume = s.grid.cell_size.powi(n as i32);
     let mut positions: Vec<([f64; 3], Entity)> = Vec::new();
-    let mut min_mass = f64::INFINITY;
+    // Mass of a node inside a filled region, ρ·h^D, for the lightest material in use.
+    let mut full_node_mass = f64::INFINITY;
     let (gmin, gmax) = (D::vec_to3(grid.origin), D::vec_to3(grid.max_corner()));
     for (b, body) in s.bodies.iter().enumerate() {
         let (lo, hi) = region_bounds(&body.region, n);
@@ -204,7 +205,7 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         let model = &table[mat].1;
         let volume = cell_volume / body.points_per_cell.iter().product::<usize>() as f64;
         let mass = model.density() * volume;
-        min_mass = min_mass.min(mass);
+        full_node_mass = full_node_mass.min(model.density() * cell_volume);
         let common = |x: &[f64; 3]| {
             (
                 Position(D::vec_from(*x)),
@@ -307,9 +308,8 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
             acceleration: pad3(&g.acceleration),
             ramp_time: g.ramp_time,
         }),
-        // A node reached only by the far tail of a point's support carries no real mass;
-        // giving it degrees of freedom would divide by almost nothing.
-        min_node_mass: 1e-9 * min_mass,
+        min_node_mass: s.solver.node_mass_cutoff * full_node_mass,
+        virtual_mass_floor: s.solver.virtual_mass_floor * full_node_mass,
     };
     let needs = Needs {
         point_loads: !s.point_loads.is_empty(),

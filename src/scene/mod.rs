@@ -214,6 +214,14 @@ pub struct SolverSpec {
     /// (see `kdmpm check` for the default list, `systems::SYSTEM_NAMES` for every name).
     #[serde(default)]
     pub schedule: Option<Vec<String>>,
+    /// A node lighter than this fraction of a full node's mass (ρ·h^D of the lightest
+    /// material) carries no degrees of freedom (default 0.001). See `Settings::min_node_mass`.
+    #[serde(default = "default_node_mass_cutoff")]
+    pub node_mass_cutoff: f64,
+    /// Virtual mass floor for nodal accelerations, as a fraction of a full node's mass
+    /// (default 0.01). See `Settings::virtual_mass_floor`.
+    #[serde(default = "default_virtual_mass_floor")]
+    pub virtual_mass_floor: f64,
     /// FLIP fraction α of the point velocity update: 1 (default) is FLIP, 0 is PIC, which
     /// damps the velocity noise of the points.
     #[serde(default = "default_flip")]
@@ -230,6 +238,14 @@ pub struct SolverSpec {
     /// Simulated-time limit (s).
     #[serde(default)]
     pub max_time: Option<f64>,
+}
+
+fn default_node_mass_cutoff() -> f64 {
+    1e-3
+}
+
+fn default_virtual_mass_floor() -> f64 {
+    0.01
 }
 
 fn default_flip() -> f64 {

@@ -8,8 +8,13 @@ use crate::schedule::System;
 use crate::simulation::Context;
 use crate::state::Damping;
 
-/// a_i = (f_i − 2β p_i)/m_i and v_i ← p_i/m_i + a_i Δt (explicit Euler on the grid).
-/// Viscous damping F_damp = 2β M v enters here; massless nodes get no motion.
+/// a_i = (f_i − 2β p_i)/max(m_i, m_floor) and v_i ← p_i/m_i + a_i Δt (explicit Euler on the
+/// grid). Viscous damping F_damp = 2β M v enters here; massless nodes get no motion.
+///
+/// m_floor ([`crate::state::Settings::virtual_mass_floor`]) is a virtual mass for nodes that
+/// only the far tail of a point's support reaches: such a node has almost no mass but takes
+/// that point's full stress-gradient force, so its acceleration (and the point's, through
+/// it) would be that of the point pushed by its own stress.
 #[derive(Debug, Default)]
 pub struct Integrate;
 
@@ -24,6 +29,7 @@ impl<D: Dim> System<D> for Integrate {
             _ => 0.0,
         };
         let min_mass = ctx.settings.min_node_mass;
+        let floor = ctx.settings.virtual_mass_floor;
         let n = nodes(&ctx.world);
         let nm = col::<NodeMass>(n);
         let np = col::<NodeMomentum<D::Vec>>(n);
@@ -33,10 +39,11 @@ impl<D: Dim> System<D> for Integrate {
         for i in 0..nm.len() {
             let m = nm[i].0;
             if m > min_mass {
-                let inv = 1.0 / m;
-                let a = (nf[i].0 - np[i].0 * beta2) * inv;
+                // Dynamic relaxation's mass matrix is fictitious: a floor on the mass that
+                // accelerates a light node changes the path, never the static answer.
+                let a = (nf[i].0 - np[i].0 * beta2) * (1.0 / m.max(floor));
                 na[i].0 = a;
-                nv[i].0 = np[i].0 * inv + a * dt;
+                nv[i].0 = np[i].0 * (1.0 / m) + a * dt;
             } else {
                 na[i].0 = D::Vec::ZERO;
                 nv[i].0 = D::Vec::ZERO;
