@@ -37,45 +37,33 @@ pub trait Vector:
     fn is_finite(self) -> bool;
 }
 
-impl Vector for DVec2 {
-    const ZERO: Self = DVec2::ZERO;
-    #[inline(always)]
-    fn get(self, axis: usize) -> f64 {
-        self[axis]
-    }
-    #[inline(always)]
-    fn set(&mut self, axis: usize, value: f64) {
-        self[axis] = value;
-    }
-    #[inline(always)]
-    fn dot(self, other: Self) -> f64 {
-        DVec2::dot(self, other)
-    }
-    #[inline(always)]
-    fn is_finite(self) -> bool {
-        DVec2::is_finite(self)
-    }
+/// The same glam methods serve both vector types.
+macro_rules! impl_vector {
+    ($t:ty) => {
+        impl Vector for $t {
+            const ZERO: Self = <$t>::ZERO;
+            #[inline(always)]
+            fn get(self, axis: usize) -> f64 {
+                self[axis]
+            }
+            #[inline(always)]
+            fn set(&mut self, axis: usize, value: f64) {
+                self[axis] = value;
+            }
+            #[inline(always)]
+            fn dot(self, other: Self) -> f64 {
+                <$t>::dot(self, other)
+            }
+            #[inline(always)]
+            fn is_finite(self) -> bool {
+                <$t>::is_finite(self)
+            }
+        }
+    };
 }
 
-impl Vector for DVec3 {
-    const ZERO: Self = DVec3::ZERO;
-    #[inline(always)]
-    fn get(self, axis: usize) -> f64 {
-        self[axis]
-    }
-    #[inline(always)]
-    fn set(&mut self, axis: usize, value: f64) {
-        self[axis] = value;
-    }
-    #[inline(always)]
-    fn dot(self, other: Self) -> f64 {
-        DVec3::dot(self, other)
-    }
-    #[inline(always)]
-    fn is_finite(self) -> bool {
-        DVec3::is_finite(self)
-    }
-}
+impl_vector!(DVec2);
+impl_vector!(DVec3);
 
 /// A spatial dimension: its vector and velocity-gradient types and the few operations that
 /// differ between plane strain and 3D.

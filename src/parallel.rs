@@ -92,31 +92,40 @@ impl Slabs {
     }
 }
 
-/// Per-slab node buffers for a scatter, reused between steps.
+/// A deterministic parallel scatter from points to nodes: the points' slabs and per-slab
+/// node buffers, reused between steps.
 #[derive(Debug)]
 pub struct ScatterBuffers<T> {
+    slabs: Slabs,
     buffers: Vec<(std::ops::Range<usize>, Vec<T>)>,
 }
 
 impl<T> Default for ScatterBuffers<T> {
     fn default() -> Self {
-        ScatterBuffers { buffers: Vec::new() }
+        ScatterBuffers {
+            slabs: Slabs::default(),
+            buffers: Vec::new(),
+        }
     }
 }
 
 impl<T: Copy + Send + Sync> ScatterBuffers<T> {
-    /// Runs `scatter(points, buffer, first_node)` for every non-empty slab in parallel, each
-    /// into a zeroed buffer that covers the slab's node ids from `first_node` on. Then hands
-    /// every buffer entry to `target(node, value)` in slab order.
+    /// Groups the points at `positions` into slabs, then runs
+    /// `scatter(points, buffer, first_node)` for every non-empty slab in parallel, each into
+    /// a zeroed buffer that covers the slab's node ids from `first_node` on (`points` are
+    /// indices into `positions`). Then hands every buffer entry to `target(node, value)` in
+    /// slab order.
     pub fn scatter<D: Dim>(
         &mut self,
         grid: &Grid<D>,
-        slabs: &Slabs,
+        positions: impl ExactSizeIterator<Item = D::Vec>,
         support: usize,
         zero: T,
         scatter: impl Fn(&[u32], &mut [T], usize) + Sync,
         mut target: impl FnMut(usize, T),
     ) {
+        self.slabs.build(grid, positions, slab_rows(grid, support));
+        let slabs = &self.slabs;
         self.buffers.resize_with(slabs.len(), || (0..0, Vec::new()));
         self.buffers
             .par_iter_mut()

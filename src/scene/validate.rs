@@ -205,23 +205,16 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
             );
         }
     }
-    if !(0.0..1.0).contains(&s.solver.node_mass_cutoff) {
-        return bad(
-            "solver.node_mass_cutoff",
-            format!(
-                "must be in [0, 1) (a fraction of a full node's mass), found {}",
-                s.solver.node_mass_cutoff
-            ),
-        );
-    }
-    if !(0.0..=1.0).contains(&s.solver.virtual_mass_floor) {
-        return bad(
-            "solver.virtual_mass_floor",
-            format!(
-                "must be in [0, 1] (a fraction of a full node's mass), found {}",
-                s.solver.virtual_mass_floor
-            ),
-        );
+    for (field, value) in [
+        ("solver.node_mass_cutoff", s.solver.node_mass_cutoff),
+        ("solver.virtual_mass_floor", s.solver.virtual_mass_floor),
+    ] {
+        if !(0.0..1.0).contains(&value) {
+            return bad(
+                field,
+                format!("must be in [0, 1) (a fraction of a full node's mass), found {value}"),
+            );
+        }
     }
     if !(0.0..=1.0).contains(&s.solver.flip) {
         return bad(

@@ -4,7 +4,7 @@ use crate::columns::{col, col_mut, nodes, points_with};
 use crate::components::*;
 use crate::dim::{Dim, Vector};
 use crate::error::StepError;
-use crate::parallel::{slab_rows, ScatterBuffers, Slabs};
+use crate::parallel::ScatterBuffers;
 use crate::schedule::System;
 use crate::shape::{for_each_node, Shape};
 use crate::simulation::Context;
@@ -36,7 +36,6 @@ struct NodeShare<V> {
 #[derive(Debug)]
 pub struct P2g<D: Dim, S> {
     part: P2gPart,
-    slabs: Slabs,
     buffers: ScatterBuffers<NodeShare<D::Vec>>,
     _marker: PhantomData<fn() -> S>,
 }
@@ -46,7 +45,6 @@ impl<D: Dim, S: Shape> P2g<D, S> {
     pub fn new(part: P2gPart) -> Self {
         P2g {
             part,
-            slabs: Slabs::default(),
             buffers: ScatterBuffers::default(),
             _marker: PhantomData,
         }
@@ -73,7 +71,6 @@ impl<D: Dim, S: Shape> System<D> for P2g<D, S> {
             P2gPart::MassMomentum => (true, false),
             P2gPart::InternalForce => (false, true),
         };
-        let rows = slab_rows(grid, S::SUPPORT);
         for arch in points_with::<Position<D::Vec>>(&ctx.world) {
             let xg = col::<Position<D::Vec>>(arch);
             let mg = col::<Mass>(arch);
@@ -88,7 +85,6 @@ impl<D: Dim, S: Shape> System<D> for P2g<D, S> {
             }
             let (x, m): (&[Position<D::Vec>], &[Mass]) = (&xg, &mg);
             let v: &[Velocity<D::Vec>] = &vg;
-            self.slabs.build(grid, x.iter().map(|p| p.0), rows);
             let zero = NodeShare {
                 mass: 0.0,
                 momentum: D::Vec::ZERO,
@@ -96,7 +92,7 @@ impl<D: Dim, S: Shape> System<D> for P2g<D, S> {
             };
             self.buffers.scatter(
                 grid,
-                &self.slabs,
+                x.iter().map(|p| p.0),
                 S::SUPPORT,
                 zero,
                 |points, buf, lo| {

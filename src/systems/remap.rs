@@ -5,7 +5,7 @@ use crate::columns::{col, col_mut, nodes, points_with};
 use crate::components::*;
 use crate::dim::{Dim, Vector};
 use crate::error::StepError;
-use crate::parallel::{slab_rows, ScatterBuffers, Slabs};
+use crate::parallel::ScatterBuffers;
 use crate::schedule::System;
 use crate::shape::{for_each_node, Shape};
 use crate::simulation::Context;
@@ -15,7 +15,6 @@ use std::marker::PhantomData;
 /// After a kinetic-damping reset all v_p are zero, and so is the remapped field.
 #[derive(Debug)]
 pub struct Remap<D: Dim, S> {
-    slabs: Slabs,
     buffers: ScatterBuffers<D::Vec>,
     _marker: PhantomData<fn() -> S>,
 }
@@ -23,7 +22,6 @@ pub struct Remap<D: Dim, S> {
 impl<D: Dim, S> Default for Remap<D, S> {
     fn default() -> Self {
         Remap {
-            slabs: Slabs::default(),
             buffers: ScatterBuffers::default(),
             _marker: PhantomData,
         }
@@ -44,7 +42,6 @@ impl<D: Dim, S: Shape> System<D> for Remap<D, S> {
             let grid = &ctx.grid;
             let mut np = col_mut::<NodeMomentum<D::Vec>>(n);
             np.fill(NodeMomentum(D::Vec::ZERO));
-            let rows = slab_rows(grid, S::SUPPORT);
             for arch in points_with::<Velocity<D::Vec>>(&ctx.world) {
                 let (xg, mg, vg) = (
                     col::<Position<D::Vec>>(arch),
@@ -53,10 +50,9 @@ impl<D: Dim, S: Shape> System<D> for Remap<D, S> {
                 );
                 let (x, m): (&[Position<D::Vec>], &[Mass]) = (&xg, &mg);
                 let v: &[Velocity<D::Vec>] = &vg;
-                self.slabs.build(grid, x.iter().map(|p| p.0), rows);
                 self.buffers.scatter(
                     grid,
-                    &self.slabs,
+                    x.iter().map(|p| p.0),
                     S::SUPPORT,
                     D::Vec::ZERO,
                     |points, buf, lo| {

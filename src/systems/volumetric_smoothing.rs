@@ -5,7 +5,7 @@ use crate::columns::{col, col_mut, points_with};
 use crate::components::*;
 use crate::dim::Dim;
 use crate::error::StepError;
-use crate::parallel::{slab_rows, ScatterBuffers, Slabs, CHUNK};
+use crate::parallel::{ScatterBuffers, CHUNK};
 use crate::schedule::System;
 use crate::shape::{for_each_node, Shape};
 use crate::simulation::Context;
@@ -24,7 +24,6 @@ use std::marker::PhantomData;
 /// volume see the same smoothed rate.
 #[derive(Debug)]
 pub struct VolumetricSmoothing<D: Dim, S> {
-    slabs: Slabs,
     buffers: ScatterBuffers<[f64; 2]>,
     nodal: Vec<f64>,
     _marker: PhantomData<fn() -> (D, S)>,
@@ -33,7 +32,6 @@ pub struct VolumetricSmoothing<D: Dim, S> {
 impl<D: Dim, S> Default for VolumetricSmoothing<D, S> {
     fn default() -> Self {
         VolumetricSmoothing {
-            slabs: Slabs::default(),
             buffers: ScatterBuffers::default(),
             nodal: Vec::new(),
             _marker: PhantomData,
@@ -56,7 +54,6 @@ impl<D: Dim, S: Shape> System<D> for VolumetricSmoothing<D, S> {
             return Ok(());
         }
         let grid = &ctx.grid;
-        let rows = slab_rows(grid, S::SUPPORT);
         let mut sums = vec![[0.0f64; 2]; grid.node_count()];
         for arch in points_with::<Volume>(&ctx.world) {
             let (xg, vg, lg) = (
@@ -66,10 +63,9 @@ impl<D: Dim, S: Shape> System<D> for VolumetricSmoothing<D, S> {
             );
             let (x, vol): (&[Position<D::Vec>], &[Volume]) = (&xg, &vg);
             let l: &[VelocityGradient<D::Mat>] = &lg;
-            self.slabs.build(grid, x.iter().map(|p| p.0), rows);
             self.buffers.scatter(
                 grid,
-                &self.slabs,
+                x.iter().map(|p| p.0),
                 S::SUPPORT,
                 [0.0; 2],
                 |points, buf, lo| {
