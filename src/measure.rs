@@ -84,3 +84,20 @@ pub fn all_positions_finite<D: Dim>(sim: &Simulation<D>) -> bool {
     points_with::<Position<D::Vec>>(&sim.ctx.world)
         .all(|a| col::<Position<D::Vec>>(a).iter().all(|x| x.0.is_finite()))
 }
+
+/// Positions of every point (load carriers included), padded to x y z (m), in storage order.
+pub fn positions<D: Dim>(world: &hecs::World, out: &mut Vec<[f64; 3]>) {
+    out.clear();
+    for arch in points_with::<Position<D::Vec>>(world) {
+        out.extend(col::<Position<D::Vec>>(arch).iter().map(|x| D::vec_to3(x.0)));
+    }
+}
+
+/// Largest distance between matching entries of two position lists (m).
+pub fn max_movement(before: &[[f64; 3]], after: &[[f64; 3]]) -> f64 {
+    before
+        .iter()
+        .zip(after)
+        .map(|(a, b)| ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt())
+        .fold(0.0, f64::max)
+}

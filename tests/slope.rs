@@ -6,8 +6,8 @@
 //! strain, tan φ* = sin φ cos ψ / (1 − sin φ sin ψ) = sin 20° → φ* = 18.9°.
 
 use kdmpm::columns::{col, points_with};
-use kdmpm::components::{Mass, Position, Stress};
-use kdmpm::measure::{all_positions_finite, max_displacements, surface_angle};
+use kdmpm::components::Mass;
+use kdmpm::measure::{all_positions_finite, max_displacements, max_movement, positions, surface_angle};
 use kdmpm::scene::{build, LoadedScene};
 use kdmpm::state::StopReason;
 use kdmpm::{with_simulation, Dim, Simulation};
@@ -17,17 +17,6 @@ fn scene(name: &str, overrides: &[&str]) -> kdmpm::AnySimulation {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes").join(name);
     let o: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
     build(&LoadedScene::from_file(&path, &o).unwrap()).unwrap().0
-}
-
-fn positions<D: Dim>(sim: &Simulation<D>) -> Vec<[f64; 3]> {
-    points_with::<Stress>(&sim.ctx.world)
-        .flat_map(|a| {
-            col::<Position<D::Vec>>(a)
-                .iter()
-                .map(|x| D::vec_to3(x.0))
-                .collect::<Vec<_>>()
-        })
-        .collect()
 }
 
 /// Sum of point masses, compared bit for bit.
@@ -59,17 +48,14 @@ fn run_and_continue<D: Dim>(sim: &mut Simulation<D>) -> (f64, f64, f64, f64) {
     assert_eq!(mass_bits(sim), mass0, "total mass changed");
     assert!(all_positions_finite(sim));
     // Static: ten more seconds move nothing by more than 1 cm.
-    let before = positions(sim);
+    let (mut before, mut after) = (Vec::new(), Vec::new());
+    positions::<D>(&sim.ctx.world, &mut before);
     let steps = (10.0 / sim.ctx.state.dt).ceil() as u64;
     for _ in 0..steps {
         sim.step().expect("continuing stays stable");
     }
-    let after = positions(sim);
-    let moved = before
-        .iter()
-        .zip(&after)
-        .map(|(a, b)| ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt())
-        .fold(0.0, f64::max);
+    positions::<D>(&sim.ctx.world, &mut after);
+    let moved = max_movement(&before, &after);
     println!(
         "stop t = {t_stop:.2} s, angle {angle:.2}°, max u_x {max_ux:.3} m, moved {moved:.4} m in 10 s more"
     );

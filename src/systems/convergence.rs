@@ -1,10 +1,11 @@
 //! Convergence monitor: force ratio K_F (eq. 3), external work (eq. 6), energy ratio K_E
 //! (eq. 4), and the stopping rule (paper step 7).
 
-use crate::columns::{col, nodes, points_with};
+use crate::columns::{col, nodes};
 use crate::components::*;
 use crate::dim::{Dim, Vector};
 use crate::error::StepError;
+use crate::measure::{max_movement, positions};
 use crate::schedule::System;
 use crate::simulation::Context;
 use crate::state::{StaticCheck, StopReason};
@@ -82,26 +83,13 @@ pub struct Convergence {
 }
 
 impl Convergence {
-    fn positions<D: Dim>(ctx: &Context<D>, out: &mut Vec<[f64; 3]>) {
-        out.clear();
-        for arch in points_with::<Position<D::Vec>>(&ctx.world) {
-            out.extend(col::<Position<D::Vec>>(arch).iter().map(|x| D::vec_to3(x.0)));
-        }
-    }
-
     fn confirm_static<D: Dim>(&mut self, ctx: &mut Context<D>, met: bool, check: StaticCheck) -> bool {
         let now = ctx.state.time;
         match ctx.state.static_window_start {
             Some(start) if now >= start + check.window * (1.0 - 1e-12) => {
                 let mut current = Vec::with_capacity(self.snapshot.len());
-                Self::positions(ctx, &mut current);
-                let moved = current
-                    .iter()
-                    .zip(&self.snapshot)
-                    .map(|(a, b)| {
-                        ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
-                    })
-                    .fold(0.0, f64::max);
+                positions::<D>(&ctx.world, &mut current);
+                let moved = max_movement(&self.snapshot, &current);
                 ctx.state.static_window_movement = Some(moved);
                 ctx.state.static_window_start = None;
                 if met && moved <= check.max_displacement {
@@ -118,7 +106,7 @@ impl Convergence {
             None => {
                 if met {
                     ctx.state.static_window_start = Some(now);
-                    Self::positions(ctx, &mut self.snapshot);
+                    positions::<D>(&ctx.world, &mut self.snapshot);
                 }
                 false
             }

@@ -34,6 +34,8 @@ impl<D: Dim, S: Shape> System<D> for G2p<D, S> {
         let nvg = col::<NodeVelocity<D::Vec>>(n);
         let nv: &[NodeVelocity<D::Vec>] = &nvg;
         let flip = ctx.settings.flip;
+        // Pure FLIP (the default) never reads the interpolated nodal velocity.
+        let pic = flip < 1.0;
         let mut twice_ek = 0.0;
         for arch in points_with::<Velocity<D::Vec>>(&ctx.world) {
             let (xg, mg) = (col::<Position<D::Vec>>(arch), col::<Mass>(arch));
@@ -49,12 +51,14 @@ impl<D: Dim, S: Shape> System<D> for G2p<D, S> {
                         let (mut a, mut vg) = (D::Vec::ZERO, D::Vec::ZERO);
                         for_each_node::<D, S>(grid, x[p].0, |i, w, _| {
                             a += na[i].0 * w;
-                            vg += nv[i].0 * w;
+                            if pic {
+                                vg += nv[i].0 * w;
+                            }
                         });
-                        vp.0 = if flip == 1.0 {
-                            vp.0 + a * dt
-                        } else {
+                        vp.0 = if pic {
                             (vp.0 + a * dt) * flip + vg * (1.0 - flip)
+                        } else {
+                            vp.0 + a * dt
                         };
                         e += m[p].0 * vp.0.dot(vp.0);
                     }
