@@ -86,6 +86,40 @@ impl<D: Dim> Grid<D> {
         [i, rest % self.nodes[1], rest / self.nodes[1]]
     }
 
+    /// Share of a full cell volume h^D that node `id` stands for: ½ for each grid face it
+    /// lies on. A node on a face (or an edge, a corner) can gather at most this share of the
+    /// mass of an interior node in the same material.
+    #[inline]
+    pub fn node_share(&self, id: usize) -> f64 {
+        let ijk = self.node_ijk(id);
+        let mut share = 1.0;
+        for (a, &i) in ijk.iter().enumerate().take(D::N) {
+            if i == 0 || i == self.cells[a] {
+                share *= 0.5;
+            }
+        }
+        share
+    }
+
+    /// True when node `id` with mass `m` (kg) carries degrees of freedom: `m` exceeds
+    /// `cutoff` (kg, for an interior node) times the node's share.
+    #[inline(always)]
+    pub fn carries(&self, id: usize, m: f64, cutoff: f64) -> bool {
+        // The share is only worked out for the few nodes between the two bounds.
+        m > cutoff || (m > cutoff * 0.5f64.powi(D::N as i32) && m > cutoff * self.node_share(id))
+    }
+
+    /// Mass (kg) that accelerates node `id` of mass `m`: at least `floor` (kg, for an interior
+    /// node) times the node's share.
+    #[inline(always)]
+    pub fn inertia(&self, id: usize, m: f64, floor: f64) -> f64 {
+        if m >= floor {
+            m
+        } else {
+            m.max(floor * self.node_share(id))
+        }
+    }
+
     /// Position of node (i, j, k) (m).
     pub fn node_position(&self, ijk: [usize; 3]) -> D::Vec {
         let mut x = self.origin;
@@ -154,5 +188,21 @@ mod tests {
         assert_eq!(g.node_count(), 4 * 3);
         assert_eq!(g.cell_of(DVec2::new(3.0, 2.0)), Some([2, 1, 0]));
         assert_eq!(g.cell_of(DVec2::new(3.01, 1.0)), None);
+    }
+
+    #[test]
+    fn node_share_halves_per_grid_face() {
+        let g = Grid::<Dim3>::new(DVec3::ZERO, 1.0, [4, 3, 2]);
+        assert_eq!(g.node_share(g.node_id([2, 1, 1])), 1.0);
+        assert_eq!(g.node_share(g.node_id([0, 1, 1])), 0.5);
+        assert_eq!(g.node_share(g.node_id([4, 3, 1])), 0.25);
+        assert_eq!(g.node_share(g.node_id([0, 0, 2])), 0.125);
+        let g2 = Grid::<Dim2>::new(DVec2::ZERO, 1.0, [4, 3, 0]);
+        assert_eq!(g2.node_share(g2.node_id([4, 1, 0])), 0.5);
+        assert_eq!(g2.node_share(g2.node_id([2, 1, 0])), 1.0);
+        // Between the two bounds the share decides.
+        assert!(g.carries(g.node_id([0, 1, 1]), 0.6, 1.0));
+        assert!(!g.carries(g.node_id([2, 1, 1]), 0.6, 1.0));
+        assert_eq!(g.inertia(g.node_id([0, 0, 2]), 0.1, 1.0), 0.125);
     }
 }

@@ -108,9 +108,11 @@ pub struct Settings {
     pub flip: f64,
     /// Smooth the volumetric strain rate through the grid before each stress update.
     pub volumetric_smoothing: bool,
-    /// Smallest mass that accelerates a node (kg): a_i = f_i / max(m_i, floor).
+    /// Smallest mass that accelerates an interior node (kg): a_i = f_i / max(m_i, floor),
+    /// scaled on the grid's faces by the node's share ([`crate::grid::Grid::inertia`]).
     pub virtual_mass_floor: f64,
-    /// Nodes lighter than this carry no degrees of freedom (kg).
+    /// Interior nodes lighter than this carry no degrees of freedom (kg); scaled on the
+    /// grid's faces by the node's share ([`crate::grid::Grid::carries`]).
     ///
     /// Leaving a node out drops its share of Σ_i ∇w_ip = 0, which acts as a spurious force
     /// V_p σ_p ∇w_ip: keep this tiny and tame light nodes with `virtual_mass_floor`.

@@ -215,11 +215,12 @@ pub struct SolverSpec {
     #[serde(default)]
     pub schedule: Option<Vec<String>>,
     /// A node lighter than this fraction of a full node's mass (ρ·h^D of the lightest
-    /// material) carries no degrees of freedom (default 0.001). See `Settings::min_node_mass`.
+    /// material, halved per grid face the node lies on) carries no degrees of freedom
+    /// (default 0.001). See `Settings::min_node_mass`.
     #[serde(default = "default_node_mass_cutoff")]
     pub node_mass_cutoff: f64,
     /// Virtual mass floor for nodal accelerations, as a fraction of a full node's mass
-    /// (default 0.01). See `Settings::virtual_mass_floor`.
+    /// (halved per grid face the node lies on; default 0.01). See `Settings::virtual_mass_floor`.
     #[serde(default = "default_virtual_mass_floor")]
     pub virtual_mass_floor: f64,
     /// FLIP fraction α of the point velocity update: 1 (default) is FLIP, 0 is PIC, which

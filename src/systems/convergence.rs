@@ -35,7 +35,7 @@ pub fn force_ratios<D: Dim>(ctx: &Context<D>) -> ForceRatios {
     let fix = col::<NodeFixity>(n);
     let (mut max_u, mut max_e, mut sum_u, mut sum_e) = (0.0f64, 0.0f64, 0.0, 0.0);
     for i in 0..nm.len() {
-        if nm[i].0 <= min_mass {
+        if !ctx.grid.carries(i, nm[i].0, min_mass) {
             continue;
         }
         for a in 0..D::N {

@@ -38,10 +38,10 @@ impl<D: Dim> System<D> for Integrate {
         let mut nv = col_mut::<NodeVelocity<D::Vec>>(n);
         for i in 0..nm.len() {
             let m = nm[i].0;
-            if m > min_mass {
+            if ctx.grid.carries(i, m, min_mass) {
                 // Dynamic relaxation's mass matrix is fictitious: a floor on the mass that
                 // accelerates a light node changes the path, never the static answer.
-                let a = (nf[i].0 - np[i].0 * beta2) * (1.0 / m.max(floor));
+                let a = (nf[i].0 - np[i].0 * beta2) * (1.0 / ctx.grid.inertia(i, m, floor));
                 na[i].0 = a;
                 nv[i].0 = np[i].0 * (1.0 / m) + a * dt;
             } else {

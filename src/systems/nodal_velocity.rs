@@ -18,7 +18,7 @@ pub fn velocity_from_momentum<D: Dim>(ctx: &Context<D>) {
     let fix = col::<NodeFixity>(n);
     let mut nv = col_mut::<NodeVelocity<D::Vec>>(n);
     for i in 0..nm.len() {
-        let mut v = if nm[i].0 > min_mass {
+        let mut v = if ctx.grid.carries(i, nm[i].0, min_mass) {
             np[i].0 * (1.0 / nm[i].0)
         } else {
             D::Vec::ZERO

@@ -41,7 +41,7 @@ impl<D: Dim, S: Shape> System<D> for PointLoads<D, S> {
             for p in 0..x.len() {
                 let mut carried = 0.0;
                 for_each_node::<D, S>(grid, x[p].0, |i, w, _| {
-                    if nm[i].0 > min_mass {
+                    if grid.carries(i, nm[i].0, min_mass) {
                         carried += w;
                     }
                 });
@@ -54,7 +54,7 @@ impl<D: Dim, S: Shape> System<D> for PointLoads<D, S> {
                 }
                 let f = load[p].0 * (1.0 / carried);
                 for_each_node::<D, S>(grid, x[p].0, |i, w, _| {
-                    if nm[i].0 > min_mass {
+                    if grid.carries(i, nm[i].0, min_mass) {
                         nf[i].0 += f * w;
                         ne[i].0 += f * w;
                     }
