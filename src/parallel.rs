@@ -1,13 +1,15 @@
 //! Deterministic parallel building blocks.
 //!
 //! Work is split into pieces whose boundaries depend only on the data (fixed-size chunks of
-//! points, fixed slabs of grid rows), never on the number of threads, and partial results
-//! are combined in piece order. So a run gives the same bits on 1 or 2 threads, and from
+//! points, slabs of grid rows), never on the number of threads, and partial results are
+//! combined in piece order. So a run gives the same bits on 1 or 2 threads, and from
 //! run to run. No atomics are involved.
 
 use crate::dim::Dim;
 use crate::grid::Grid;
 use rayon::prelude::*;
+use std::marker::PhantomData;
+use std::ops::Range;
 
 /// Points per chunk in point-local loops.
 pub const CHUNK: usize = 2048;
@@ -22,48 +24,40 @@ pub fn sum_chunks(n: usize, f: impl Fn(std::ops::Range<usize>) -> f64 + Sync) ->
     parts.iter().sum()
 }
 
-/// Points grouped into slabs of grid rows along the slowest axis (y in 2D, z in 3D), so that
-/// each slab scatters into its own contiguous range of node ids.
+/// Points grouped into slabs of one cell row along the slowest axis (y in 2D, z in 3D), so
+/// that each slab scatters into its own contiguous range of node ids.
 #[derive(Debug, Default)]
 pub struct Slabs {
-    /// Cell rows per slab.
-    rows: usize,
     /// `order[offsets[s]..offsets[s + 1]]` are the point indices in slab `s`, ascending.
     offsets: Vec<usize>,
     order: Vec<u32>,
-    slab_of: Vec<u32>,
 }
 
 impl Slabs {
-    /// Groups `positions` by slab. `rows` is the slab thickness in cells.
-    pub fn build<D: Dim>(
-        &mut self,
-        grid: &Grid<D>,
-        positions: impl ExactSizeIterator<Item = D::Vec>,
-        rows: usize,
-    ) {
+    /// Groups the `n` points whose positions `position(p)` gives into one slab per cell row.
+    pub fn build<D: Dim>(&mut self, grid: &Grid<D>, n: usize, position: impl Fn(usize) -> D::Vec) {
         let axis = D::N - 1;
-        let slabs = grid.cells[axis].div_ceil(rows);
-        self.rows = rows;
-        self.slab_of.clear();
-        self.slab_of.extend(positions.map(|x| {
-            let c = (grid.grid_coordinate(x, axis).max(0.0) as usize).min(grid.cells[axis] - 1);
-            (c / rows) as u32
-        }));
+        let rows = grid.cells[axis];
+        let slab = |p: usize| {
+            let c = grid.grid_coordinate(position(p), axis).max(0.0) as usize;
+            c.min(rows - 1)
+        };
         self.offsets.clear();
-        self.offsets.resize(slabs + 1, 0);
-        for &s in &self.slab_of {
-            self.offsets[s as usize + 1] += 1;
+        self.offsets.resize(rows + 1, 0);
+        for p in 0..n {
+            self.offsets[slab(p) + 1] += 1;
         }
-        for s in 0..slabs {
+        for s in 0..rows {
             self.offsets[s + 1] += self.offsets[s];
         }
+        // A counting sort; the slab of a point is worked out again rather than stored.
         let mut fill = self.offsets.clone();
         self.order.clear();
-        self.order.resize(self.slab_of.len(), 0);
-        for (p, &s) in self.slab_of.iter().enumerate() {
-            self.order[fill[s as usize]] = p as u32;
-            fill[s as usize] += 1;
+        self.order.resize(n, 0);
+        for p in 0..n {
+            let s = slab(p);
+            self.order[fill[s]] = p as u32;
+            fill[s] += 1;
         }
     }
 
@@ -82,74 +76,148 @@ impl Slabs {
         &self.order[self.offsets[s]..self.offsets[s + 1]]
     }
 
-    /// The node ids slab `s` can touch with a support of `support` nodes per axis.
-    pub fn node_range<D: Dim>(&self, grid: &Grid<D>, s: usize, support: usize) -> std::ops::Range<usize> {
+    /// The node ids slab `s` can touch with a support of `support` nodes per axis: node
+    /// layers `s − 1 .. s + support` (a stencil starts at the point's cell layer or the one
+    /// below, both shape functions clamp it inside the grid, and it spans `support` layers).
+    pub fn node_range<D: Dim>(grid: &Grid<D>, s: usize, support: usize) -> Range<usize> {
         let axis = D::N - 1;
         let layer = grid.node_count() / grid.nodes[axis];
-        let first = (s * self.rows).saturating_sub(1);
-        let last = ((s + 1) * self.rows + support).min(grid.nodes[axis]);
+        let first = s.saturating_sub(1);
+        let last = (s + support).min(grid.nodes[axis]);
         first * layer..last * layer
     }
 }
 
-/// A deterministic parallel scatter from points to nodes: the points' slabs and per-slab
-/// node buffers, reused between steps.
-#[derive(Debug)]
-pub struct ScatterBuffers<T> {
-    slabs: Slabs,
-    buffers: Vec<(std::ops::Range<usize>, Vec<T>)>,
+/// Node columns that slabs write to, each slab its own contiguous range of node ids.
+///
+/// Implemented for [`Disjoint`] views of node columns and for tuples of them.
+pub trait NodeTarget: Sync {
+    /// The part of the columns one slab writes to.
+    type Part<'p>
+    where
+        Self: 'p;
+
+    /// The columns' entries for node ids `nodes`.
+    ///
+    /// # Safety
+    /// Parts alive at the same time must cover disjoint node ranges.
+    unsafe fn part(&self, nodes: Range<usize>) -> Self::Part<'_>;
 }
 
-impl<T> Default for ScatterBuffers<T> {
-    fn default() -> Self {
-        ScatterBuffers {
-            slabs: Slabs::default(),
-            buffers: Vec::new(),
+/// A node column lent to slabs that write to disjoint node ranges at the same time.
+pub struct Disjoint<'a, T> {
+    ptr: *mut T,
+    len: usize,
+    _column: PhantomData<&'a mut [T]>,
+}
+
+impl<'a, T> Disjoint<'a, T> {
+    /// Lends `column` for the duration of one scatter.
+    pub fn new(column: &'a mut [T]) -> Self {
+        Disjoint {
+            ptr: column.as_mut_ptr(),
+            len: column.len(),
+            _column: PhantomData,
         }
     }
 }
 
-impl<T: Copy + Send + Sync> ScatterBuffers<T> {
-    /// Groups the points at `positions` into slabs, then runs
-    /// `scatter(points, buffer, first_node)` for every non-empty slab in parallel, each into
-    /// a zeroed buffer that covers the slab's node ids from `first_node` on (`points` are
-    /// indices into `positions`). Then hands every buffer entry to `target(node, value)` in
-    /// slab order.
-    pub fn scatter<D: Dim>(
+// SAFETY: a `Disjoint` is only read through `NodeTarget::part`, whose contract keeps
+// concurrently used parts apart, so it behaves as `&mut [T]` split among threads.
+unsafe impl<T: Send> Sync for Disjoint<'_, T> {}
+unsafe impl<T: Send> Send for Disjoint<'_, T> {}
+
+impl<T: Send> NodeTarget for Disjoint<'_, T> {
+    type Part<'p>
+        = &'p mut [T]
+    where
+        Self: 'p;
+
+    unsafe fn part(&self, nodes: Range<usize>) -> &mut [T] {
+        assert!(nodes.start <= nodes.end && nodes.end <= self.len);
+        // SAFETY: in bounds (checked above); disjoint from other live parts by contract.
+        unsafe { std::slice::from_raw_parts_mut(self.ptr.add(nodes.start), nodes.len()) }
+    }
+}
+
+impl<A: NodeTarget, B: NodeTarget> NodeTarget for (A, B) {
+    type Part<'p>
+        = (A::Part<'p>, B::Part<'p>)
+    where
+        Self: 'p;
+
+    unsafe fn part(&self, nodes: Range<usize>) -> Self::Part<'_> {
+        // SAFETY: forwarded contract.
+        unsafe { (self.0.part(nodes.clone()), self.1.part(nodes)) }
+    }
+}
+
+impl<A: NodeTarget, B: NodeTarget, C: NodeTarget> NodeTarget for (A, B, C) {
+    type Part<'p>
+        = (A::Part<'p>, B::Part<'p>, C::Part<'p>)
+    where
+        Self: 'p;
+
+    unsafe fn part(&self, nodes: Range<usize>) -> Self::Part<'_> {
+        // SAFETY: forwarded contract.
+        unsafe {
+            (
+                self.0.part(nodes.clone()),
+                self.1.part(nodes.clone()),
+                self.2.part(nodes),
+            )
+        }
+    }
+}
+
+/// A deterministic parallel scatter from points to nodes, straight into the node columns.
+///
+/// Points are grouped in slabs of one cell row. A slab touches `support + 1` node layers,
+/// so slabs `support + 1` apart never share a node: the scatter runs in `support + 1`
+/// phases, and within a phase every slab writes to its own node range in parallel. A node
+/// therefore receives its contributions slab by slab in phase order, and within a slab in
+/// point order, whatever the number of threads. No per-thread buffers, no reduction pass.
+#[derive(Debug, Default)]
+pub struct SlabScatter {
+    slabs: Slabs,
+}
+
+impl SlabScatter {
+    /// Groups the `n` points at `position(p)` into slabs, then runs
+    /// `kernel(points, part, first_node)` for every non-empty slab, where `part` is the slab's
+    /// range of `target` starting at node id `first_node` and `points` are point indices.
+    pub fn scatter<'t, D: Dim, T: NodeTarget>(
         &mut self,
         grid: &Grid<D>,
-        positions: impl ExactSizeIterator<Item = D::Vec>,
+        n: usize,
+        position: impl Fn(usize) -> D::Vec,
         support: usize,
-        zero: T,
-        scatter: impl Fn(&[u32], &mut [T], usize) + Sync,
-        mut target: impl FnMut(usize, T),
+        target: &'t T,
+        kernel: impl Fn(&[u32], T::Part<'t>, usize) + Sync,
     ) {
-        self.slabs.build(grid, positions, slab_rows(grid, support));
+        self.slabs.build(grid, n, position);
         let slabs = &self.slabs;
-        self.buffers.resize_with(slabs.len(), || (0..0, Vec::new()));
-        self.buffers
-            .par_iter_mut()
-            .enumerate()
-            .for_each(|(s, (range, buf))| {
-                let points = slabs.points(s);
-                if points.is_empty() {
-                    *range = 0..0;
-                    return;
-                }
-                *range = slabs.node_range(grid, s, support);
-                buf.clear();
-                buf.resize(range.len(), zero);
-                scatter(points, buf, range.start);
-            });
-        for (range, buf) in &self.buffers {
-            for (k, v) in buf.iter().enumerate().take(range.len()) {
-                target(range.start + k, *v);
+        let phases = support + 1;
+        for phase in 0..phases {
+            let members: Vec<usize> = (phase..slabs.len())
+                .step_by(phases)
+                .filter(|&s| !slabs.points(s).is_empty())
+                .collect();
+            for pair in members.windows(2) {
+                let (a, b) = (
+                    Slabs::node_range(grid, pair[0], support),
+                    Slabs::node_range(grid, pair[1], support),
+                );
+                assert!(a.end <= b.start, "slabs of one phase share nodes");
             }
+            members.par_iter().for_each(|&s| {
+                let nodes = Slabs::node_range(grid, s, support);
+                let first = nodes.start;
+                // SAFETY: the slabs of one phase cover disjoint node ranges (asserted above),
+                // and the phase's parts are dropped before the next phase starts.
+                let part = unsafe { target.part(nodes) };
+                kernel(slabs.points(s), part, first);
+            });
         }
     }
-}
-
-/// Slab thickness for a grid: at least the shape support, and about 64 slabs at most.
-pub fn slab_rows<D: Dim>(grid: &Grid<D>, support: usize) -> usize {
-    grid.cells[D::N - 1].div_ceil(64).max(support)
 }

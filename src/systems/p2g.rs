@@ -2,9 +2,9 @@
 
 use crate::columns::{col, col_mut, nodes, points_with};
 use crate::components::*;
-use crate::dim::{Dim, Vector};
+use crate::dim::Dim;
 use crate::error::StepError;
-use crate::parallel::ScatterBuffers;
+use crate::parallel::{Disjoint, SlabScatter};
 use crate::schedule::System;
 use crate::shape::{for_each_node, Shape};
 use crate::simulation::Context;
@@ -21,23 +21,15 @@ pub enum P2gPart {
     InternalForce,
 }
 
-/// What one point adds to one node.
-#[derive(Clone, Copy, Debug)]
-struct NodeShare<V> {
-    mass: f64,
-    momentum: V,
-    force: V,
-}
-
 /// Maps point mass m_p, momentum m_p v_p and internal force −V_p σ_p·∇w_ip to the grid.
 ///
-/// Points are grouped in slabs of grid rows; slabs scatter in parallel into their own node
-/// buffers, which are then added to the grid in slab order (see [`crate::parallel`]).
+/// Points are grouped in slabs of grid rows that scatter in parallel, slabs that share no
+/// node at a time (see [`SlabScatter`]).
 #[derive(Debug)]
 pub struct P2g<D: Dim, S> {
     part: P2gPart,
-    buffers: ScatterBuffers<NodeShare<D::Vec>>,
-    _marker: PhantomData<fn() -> S>,
+    scatter: SlabScatter,
+    _marker: PhantomData<fn() -> (D, S)>,
 }
 
 impl<D: Dim, S: Shape> P2g<D, S> {
@@ -45,7 +37,7 @@ impl<D: Dim, S: Shape> P2g<D, S> {
     pub fn new(part: P2gPart) -> Self {
         P2g {
             part,
-            buffers: ScatterBuffers::default(),
+            scatter: SlabScatter::default(),
             _marker: PhantomData,
         }
     }
@@ -85,17 +77,18 @@ impl<D: Dim, S: Shape> System<D> for P2g<D, S> {
             }
             let (x, m): (&[Position<D::Vec>], &[Mass]) = (&xg, &mg);
             let v: &[Velocity<D::Vec>] = &vg;
-            let zero = NodeShare {
-                mass: 0.0,
-                momentum: D::Vec::ZERO,
-                force: D::Vec::ZERO,
-            };
-            self.buffers.scatter(
+            let target = (
+                Disjoint::new(&mut nm),
+                Disjoint::new(&mut np),
+                Disjoint::new(&mut nf),
+            );
+            self.scatter.scatter(
                 grid,
-                x.iter().map(|p| p.0),
+                x.len(),
+                |p| x[p].0,
                 S::SUPPORT,
-                zero,
-                |points, buf, lo| {
+                &target,
+                |points, (nm, np, nf), lo| {
                     for &p in points {
                         let p = p as usize;
                         let (mp, mv) = (m[p].0, v[p].0 * m[p].0);
@@ -104,21 +97,16 @@ impl<D: Dim, S: Shape> System<D> for P2g<D, S> {
                             _ => None,
                         };
                         for_each_node::<D, S>(grid, x[p].0, |i, w, grad| {
-                            let b = &mut buf[i - lo];
+                            let k = i - lo;
                             if mass_momentum {
-                                b.mass += w * mp;
-                                b.momentum += mv * w;
+                                nm[k].0 += w * mp;
+                                np[k].0 += mv * w;
                             }
                             if let Some((s, neg_vol)) = f {
-                                b.force += D::stress_dot(s, grad) * neg_vol;
+                                nf[k].0 += D::stress_dot(s, grad) * neg_vol;
                             }
                         });
                     }
-                },
-                |i, share| {
-                    nm[i].0 += share.mass;
-                    np[i].0 += share.momentum;
-                    nf[i].0 += share.force;
                 },
             );
         }

@@ -5,7 +5,7 @@ use crate::columns::{col, col_mut, nodes, points_with};
 use crate::components::*;
 use crate::dim::{Dim, Vector};
 use crate::error::StepError;
-use crate::parallel::ScatterBuffers;
+use crate::parallel::{Disjoint, SlabScatter};
 use crate::schedule::System;
 use crate::shape::{for_each_node, Shape};
 use crate::simulation::Context;
@@ -15,14 +15,14 @@ use std::marker::PhantomData;
 /// After a kinetic-damping reset all v_p are zero, and so is the remapped field.
 #[derive(Debug)]
 pub struct Remap<D: Dim, S> {
-    buffers: ScatterBuffers<D::Vec>,
-    _marker: PhantomData<fn() -> S>,
+    scatter: SlabScatter,
+    _marker: PhantomData<fn() -> (D, S)>,
 }
 
 impl<D: Dim, S> Default for Remap<D, S> {
     fn default() -> Self {
         Remap {
-            buffers: ScatterBuffers::default(),
+            scatter: SlabScatter::default(),
             _marker: PhantomData,
         }
     }
@@ -50,19 +50,19 @@ impl<D: Dim, S: Shape> System<D> for Remap<D, S> {
                 );
                 let (x, m): (&[Position<D::Vec>], &[Mass]) = (&xg, &mg);
                 let v: &[Velocity<D::Vec>] = &vg;
-                self.buffers.scatter(
+                self.scatter.scatter(
                     grid,
-                    x.iter().map(|p| p.0),
+                    x.len(),
+                    |p| x[p].0,
                     S::SUPPORT,
-                    D::Vec::ZERO,
-                    |points, buf, lo| {
+                    &Disjoint::new(&mut np),
+                    |points, np, lo| {
                         for &p in points {
                             let p = p as usize;
                             let mv = v[p].0 * m[p].0;
-                            for_each_node::<D, S>(grid, x[p].0, |i, w, _| buf[i - lo] += mv * w);
+                            for_each_node::<D, S>(grid, x[p].0, |i, w, _| np[i - lo].0 += mv * w);
                         }
                     },
-                    |i, share| np[i].0 += share,
                 );
             }
         }

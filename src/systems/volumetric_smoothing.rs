@@ -5,7 +5,7 @@ use crate::columns::{col, col_mut, points_with};
 use crate::components::*;
 use crate::dim::Dim;
 use crate::error::StepError;
-use crate::parallel::{ScatterBuffers, CHUNK};
+use crate::parallel::{Disjoint, SlabScatter, CHUNK};
 use crate::schedule::System;
 use crate::shape::{for_each_node, Shape};
 use crate::simulation::Context;
@@ -24,7 +24,7 @@ use std::marker::PhantomData;
 /// volume see the same smoothed rate.
 #[derive(Debug)]
 pub struct VolumetricSmoothing<D: Dim, S> {
-    buffers: ScatterBuffers<[f64; 2]>,
+    scatter: SlabScatter,
     nodal: Vec<f64>,
     _marker: PhantomData<fn() -> (D, S)>,
 }
@@ -32,7 +32,7 @@ pub struct VolumetricSmoothing<D: Dim, S> {
 impl<D: Dim, S> Default for VolumetricSmoothing<D, S> {
     fn default() -> Self {
         VolumetricSmoothing {
-            buffers: ScatterBuffers::default(),
+            scatter: SlabScatter::default(),
             nodal: Vec::new(),
             _marker: PhantomData,
         }
@@ -63,24 +63,21 @@ impl<D: Dim, S: Shape> System<D> for VolumetricSmoothing<D, S> {
             );
             let (x, vol): (&[Position<D::Vec>], &[Volume]) = (&xg, &vg);
             let l: &[VelocityGradient<D::Mat>] = &lg;
-            self.buffers.scatter(
+            self.scatter.scatter(
                 grid,
-                x.iter().map(|p| p.0),
+                x.len(),
+                |p| x[p].0,
                 S::SUPPORT,
-                [0.0; 2],
-                |points, buf, lo| {
+                &Disjoint::new(&mut sums),
+                |points, sums, lo| {
                     for &p in points {
                         let p = p as usize;
                         let (v, t) = (vol[p].0, trace::<D>(&l[p].0));
                         for_each_node::<D, S>(grid, x[p].0, |i, w, _| {
-                            buf[i - lo][0] += w * v * t;
-                            buf[i - lo][1] += w * v;
+                            sums[i - lo][0] += w * v * t;
+                            sums[i - lo][1] += w * v;
                         });
                     }
-                },
-                |i, s| {
-                    sums[i][0] += s[0];
-                    sums[i][1] += s[1];
                 },
             );
         }
