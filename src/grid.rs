@@ -37,6 +37,60 @@ impl Face {
     }
 }
 
+/// A box of nodes, `lo[a] ≤ ijk[a] < hi[a]` on every axis: the nodes the points reach.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct NodeBox {
+    /// First node index on each axis.
+    pub lo: [usize; 3],
+    /// One past the last node index on each axis (`lo == hi`: empty).
+    pub hi: [usize; 3],
+}
+
+impl NodeBox {
+    /// True when the box holds no node.
+    pub fn is_empty(&self) -> bool {
+        (0..3).any(|a| self.hi[a] <= self.lo[a])
+    }
+
+    /// The smallest box holding both.
+    pub fn union(self, other: NodeBox) -> NodeBox {
+        if self.is_empty() {
+            return other;
+        }
+        if other.is_empty() {
+            return self;
+        }
+        let mut b = self;
+        for a in 0..3 {
+            b.lo[a] = b.lo[a].min(other.lo[a]);
+            b.hi[a] = b.hi[a].max(other.hi[a]);
+        }
+        b
+    }
+
+    /// Number of nodes in the box.
+    pub fn len(&self) -> usize {
+        (0..3).map(|a| self.hi[a].saturating_sub(self.lo[a])).product()
+    }
+
+    /// The box's nodes as runs of consecutive node ids (one run per row along x).
+    pub fn rows<D: Dim>(self, grid: &Grid<D>) -> impl Iterator<Item = std::ops::Range<usize>> + '_ {
+        let (lo, hi) = (self.lo, self.hi);
+        let width = if self.is_empty() { 0 } else { hi[0] - lo[0] };
+        let (ks, js) = if width == 0 {
+            (0..0, 0..0)
+        } else {
+            (lo[2]..hi[2], lo[1]..hi[1])
+        };
+        ks.flat_map(move |k| {
+            js.clone().map(move |j| {
+                let first = grid.node_id([lo[0], j, k]);
+                first..first + width
+            })
+        })
+    }
+}
+
 /// Geometry of a uniform background grid of square (cubic) cells.
 #[derive(Clone, Debug)]
 pub struct Grid<D: Dim> {
@@ -120,6 +174,30 @@ impl<D: Dim> Grid<D> {
         }
     }
 
+    /// Index of the cell holding `x` along each axis, clamped into the grid.
+    #[inline(always)]
+    pub fn clamped_cell(&self, x: D::Vec) -> [usize; 3] {
+        let mut c = [0usize; 3];
+        for (a, ca) in c.iter_mut().enumerate().take(D::N) {
+            *ca = (self.grid_coordinate(x, a).max(0.0) as usize).min(self.cells[a] - 1);
+        }
+        c
+    }
+
+    /// The nodes a stencil of `support` nodes per axis can reach from cells `lo ..= hi`: it
+    /// starts at the point's cell or the one below and never leaves the grid.
+    pub fn reach(&self, lo: [usize; 3], hi: [usize; 3], support: usize) -> NodeBox {
+        let mut b = NodeBox {
+            lo: [0; 3],
+            hi: [1; 3],
+        };
+        for a in 0..D::N {
+            b.lo[a] = lo[a].saturating_sub(1);
+            b.hi[a] = (hi[a] + support).min(self.nodes[a]);
+        }
+        b
+    }
+
     /// Position of node (i, j, k) (m).
     pub fn node_position(&self, ijk: [usize; 3]) -> D::Vec {
         let mut x = self.origin;
@@ -188,6 +266,28 @@ mod tests {
         assert_eq!(g.node_count(), 4 * 3);
         assert_eq!(g.cell_of(DVec2::new(3.0, 2.0)), Some([2, 1, 0]));
         assert_eq!(g.cell_of(DVec2::new(3.01, 1.0)), None);
+    }
+
+    #[test]
+    fn node_box_rows_cover_the_box_once() {
+        let g = Grid::<Dim3>::new(DVec3::ZERO, 1.0, [5, 4, 3]);
+        let b = g.reach([1, 0, 2], [2, 1, 2], 2);
+        assert_eq!(
+            b,
+            NodeBox {
+                lo: [0, 0, 1],
+                hi: [4, 3, 4]
+            }
+        );
+        let ids: Vec<usize> = b.rows(&g).flatten().collect();
+        assert_eq!(ids.len(), b.len());
+        for id in ids {
+            let [i, j, k] = g.node_ijk(id);
+            assert!(i < 4 && j < 3 && (1..4).contains(&k));
+        }
+        assert_eq!(NodeBox::default().rows(&g).count(), 0);
+        let g2 = Grid::<Dim2>::new(DVec2::ZERO, 1.0, [5, 4, 0]);
+        assert_eq!(g2.reach([0, 3, 0], [4, 3, 0], 3).len(), 6 * 3);
     }
 
     #[test]

@@ -6,7 +6,7 @@
 //! run to run. No atomics are involved.
 
 use crate::dim::Dim;
-use crate::grid::Grid;
+use crate::grid::{Grid, NodeBox};
 use rayon::prelude::*;
 use std::marker::PhantomData;
 use std::ops::Range;
@@ -31,6 +31,8 @@ pub struct Slabs {
     /// `order[offsets[s]..offsets[s + 1]]` are the point indices in slab `s`, ascending.
     offsets: Vec<usize>,
     order: Vec<u32>,
+    /// Lowest and highest cell index holding a point, per axis.
+    cells: ([usize; 3], [usize; 3]),
 }
 
 impl Slabs {
@@ -38,15 +40,19 @@ impl Slabs {
     pub fn build<D: Dim>(&mut self, grid: &Grid<D>, n: usize, position: impl Fn(usize) -> D::Vec) {
         let axis = D::N - 1;
         let rows = grid.cells[axis];
-        let slab = |p: usize| {
-            let c = grid.grid_coordinate(position(p), axis).max(0.0) as usize;
-            c.min(rows - 1)
-        };
+        let slab = |p: usize| grid.clamped_cell(position(p))[axis];
         self.offsets.clear();
         self.offsets.resize(rows + 1, 0);
+        let (mut lo, mut hi) = ([usize::MAX; 3], [0usize; 3]);
         for p in 0..n {
-            self.offsets[slab(p) + 1] += 1;
+            let c = grid.clamped_cell(position(p));
+            for a in 0..D::N {
+                lo[a] = lo[a].min(c[a]);
+                hi[a] = hi[a].max(c[a]);
+            }
+            self.offsets[c[axis] + 1] += 1;
         }
+        self.cells = (lo, hi);
         for s in 0..rows {
             self.offsets[s + 1] += self.offsets[s];
         }
@@ -69,6 +75,14 @@ impl Slabs {
     /// True when there are no slabs.
     pub fn is_empty(&self) -> bool {
         self.len() == 0
+    }
+
+    /// The nodes the points reach with a support of `support` nodes per axis.
+    pub fn reach<D: Dim>(&self, grid: &Grid<D>, support: usize) -> NodeBox {
+        if self.order.is_empty() {
+            return NodeBox::default();
+        }
+        grid.reach(self.cells.0, self.cells.1, support)
     }
 
     /// Point indices of slab `s`.
@@ -186,6 +200,7 @@ impl SlabScatter {
     /// Groups the `n` points at `position(p)` into slabs, then runs
     /// `kernel(points, part, first_node)` for every non-empty slab, where `part` is the slab's
     /// range of `target` starting at node id `first_node` and `points` are point indices.
+    /// Returns the box of nodes the points reach.
     pub fn scatter<'t, D: Dim, T: NodeTarget>(
         &mut self,
         grid: &Grid<D>,
@@ -194,7 +209,7 @@ impl SlabScatter {
         support: usize,
         target: &'t T,
         kernel: impl Fn(&[u32], T::Part<'t>, usize) + Sync,
-    ) {
+    ) -> NodeBox {
         self.slabs.build(grid, n, position);
         let slabs = &self.slabs;
         let phases = support + 1;
@@ -219,5 +234,6 @@ impl SlabScatter {
                 kernel(slabs.points(s), part, first);
             });
         }
+        slabs.reach(grid, support)
     }
 }

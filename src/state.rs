@@ -1,5 +1,6 @@
 //! Solver-wide state and settings: plain structs outside the ECS world.
 
+use crate::grid::NodeBox;
 use serde::{Deserialize, Serialize};
 
 /// Where the stress update sits in the step.
@@ -161,6 +162,10 @@ pub struct SolverState {
     pub static_window_start: Option<f64>,
     /// Largest point movement over the last completed static-check window (m).
     pub static_window_movement: Option<f64>,
+    /// The nodes the points reached this step. Every node outside holds zeros (mass,
+    /// momentum, forces, acceleration, velocity), so grid passes skip it: a scatter adds the nodes it reaches, the grid
+    /// reset zeroes the box and empties it.
+    pub active_nodes: NodeBox,
 }
 
 impl SolverState {

@@ -21,7 +21,8 @@ impl<D: Dim> System<D> for Boundary {
         let fix = col::<NodeFixity>(n);
         let mut np = col_mut::<NodeMomentum<D::Vec>>(n);
         let mut nf = col_mut::<NodeForce<D::Vec>>(n);
-        for (i, f) in fix.iter().enumerate() {
+        for i in ctx.state.active_nodes.rows(&ctx.grid).flatten() {
+            let f = fix[i];
             if f.0 == 0 {
                 continue;
             }

@@ -34,7 +34,7 @@ pub fn force_ratios<D: Dim>(ctx: &Context<D>) -> ForceRatios {
     let ne = col::<NodeExternalForce<D::Vec>>(n);
     let fix = col::<NodeFixity>(n);
     let (mut max_u, mut max_e, mut sum_u, mut sum_e) = (0.0f64, 0.0f64, 0.0, 0.0);
-    for i in 0..nm.len() {
+    for i in ctx.state.active_nodes.rows(&ctx.grid).flatten() {
         if !ctx.grid.carries(i, nm[i].0, min_mass) {
             continue;
         }
@@ -126,7 +126,11 @@ impl<D: Dim> System<D> for Convergence {
             let n = nodes(&ctx.world);
             let ne = col::<NodeExternalForce<D::Vec>>(n);
             let nv = col::<NodeVelocity<D::Vec>>(n);
-            ne.iter().zip(nv.iter()).map(|(f, v)| f.0.dot(v.0)).sum::<f64>() * ctx.state.dt
+            let box_ = ctx.state.active_nodes;
+            box_.rows(&ctx.grid)
+                .map(|r| r.map(|i| ne[i].0.dot(nv[i].0)).sum::<f64>())
+                .sum::<f64>()
+                * ctx.state.dt
         };
         let s = &mut ctx.state;
         s.external_work += dw;

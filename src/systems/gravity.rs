@@ -35,11 +35,13 @@ impl<D: Dim> System<D> for Gravity {
         let nm = col::<NodeMass>(n);
         let mut nf = col_mut::<NodeForce<D::Vec>>(n);
         let mut ne = col_mut::<NodeExternalForce<D::Vec>>(n);
-        for ((m, f), e) in nm.iter().zip(nf.iter_mut()).zip(ne.iter_mut()) {
-            if m.0 > 0.0 {
-                let w = gv * m.0;
-                f.0 += w;
-                e.0 += w;
+        for r in ctx.state.active_nodes.rows(&ctx.grid) {
+            for i in r {
+                if nm[i].0 > 0.0 {
+                    let w = gv * nm[i].0;
+                    nf[i].0 += w;
+                    ne[i].0 += w;
+                }
             }
         }
         Ok(())

@@ -36,7 +36,7 @@ impl<D: Dim> System<D> for Integrate {
         let nf = col::<NodeForce<D::Vec>>(n);
         let mut na = col_mut::<NodeAcceleration<D::Vec>>(n);
         let mut nv = col_mut::<NodeVelocity<D::Vec>>(n);
-        for i in 0..nm.len() {
+        for i in ctx.state.active_nodes.rows(&ctx.grid).flatten() {
             let m = nm[i].0;
             if ctx.grid.carries(i, m, min_mass) {
                 // Dynamic relaxation's mass matrix is fictitious: a floor on the mass that

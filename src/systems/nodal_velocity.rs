@@ -17,7 +17,7 @@ pub fn velocity_from_momentum<D: Dim>(ctx: &Context<D>) {
     let np = col::<NodeMomentum<D::Vec>>(n);
     let fix = col::<NodeFixity>(n);
     let mut nv = col_mut::<NodeVelocity<D::Vec>>(n);
-    for i in 0..nm.len() {
+    for i in ctx.state.active_nodes.rows(&ctx.grid).flatten() {
         let mut v = if ctx.grid.carries(i, nm[i].0, min_mass) {
             np[i].0 * (1.0 / nm[i].0)
         } else {

@@ -54,6 +54,7 @@ impl<D: Dim, S: Shape> System<D> for P2g<D, S> {
 
     fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
         let grid = &ctx.grid;
+        let mut reached = ctx.state.active_nodes;
         let n = nodes(&ctx.world);
         let mut nm = col_mut::<NodeMass>(n);
         let mut np = col_mut::<NodeMomentum<D::Vec>>(n);
@@ -82,7 +83,7 @@ impl<D: Dim, S: Shape> System<D> for P2g<D, S> {
                 Disjoint::new(&mut np),
                 Disjoint::new(&mut nf),
             );
-            self.scatter.scatter(
+            reached = reached.union(self.scatter.scatter(
                 grid,
                 x.len(),
                 |p| x[p].0,
@@ -108,8 +109,9 @@ impl<D: Dim, S: Shape> System<D> for P2g<D, S> {
                         });
                     }
                 },
-            );
+            ));
         }
+        ctx.state.active_nodes = reached;
         Ok(())
     }
 }

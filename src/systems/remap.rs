@@ -35,13 +35,19 @@ impl<D: Dim, S: Shape> System<D> for Remap<D, S> {
     fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
         let n = nodes(&ctx.world);
         if ctx.state.reset_this_step {
-            col_mut::<NodeVelocity<D::Vec>>(n).fill(NodeVelocity(D::Vec::ZERO));
+            let mut nv = col_mut::<NodeVelocity<D::Vec>>(n);
+            for r in ctx.state.active_nodes.rows(&ctx.grid) {
+                nv[r].fill(NodeVelocity(D::Vec::ZERO));
+            }
             return Ok(());
         }
         {
             let grid = &ctx.grid;
             let mut np = col_mut::<NodeMomentum<D::Vec>>(n);
-            np.fill(NodeMomentum(D::Vec::ZERO));
+            for r in ctx.state.active_nodes.rows(grid) {
+                np[r].fill(NodeMomentum(D::Vec::ZERO));
+            }
+            let mut reached = ctx.state.active_nodes;
             for arch in points_with::<Velocity<D::Vec>>(&ctx.world) {
                 let (xg, mg, vg) = (
                     col::<Position<D::Vec>>(arch),
@@ -50,7 +56,7 @@ impl<D: Dim, S: Shape> System<D> for Remap<D, S> {
                 );
                 let (x, m): (&[Position<D::Vec>], &[Mass]) = (&xg, &mg);
                 let v: &[Velocity<D::Vec>] = &vg;
-                self.scatter.scatter(
+                reached = reached.union(self.scatter.scatter(
                     grid,
                     x.len(),
                     |p| x[p].0,
@@ -63,8 +69,9 @@ impl<D: Dim, S: Shape> System<D> for Remap<D, S> {
                             for_each_node::<D, S>(grid, x[p].0, |i, w, _| np[i - lo].0 += mv * w);
                         }
                     },
-                );
+                ));
             }
+            ctx.state.active_nodes = reached;
         }
         velocity_from_momentum(ctx);
         Ok(())

@@ -5,6 +5,7 @@ use crate::columns::{col, col_mut, points_with};
 use crate::components::*;
 use crate::dim::Dim;
 use crate::error::StepError;
+use crate::grid::NodeBox;
 use crate::parallel::{Disjoint, SlabScatter, CHUNK};
 use crate::schedule::System;
 use crate::shape::{for_each_node, Shape};
@@ -25,7 +26,9 @@ use std::marker::PhantomData;
 #[derive(Debug)]
 pub struct VolumetricSmoothing<D: Dim, S> {
     scatter: SlabScatter,
-    nodal: Vec<f64>,
+    /// Per node: Σ w V tr(L), Σ w V; then θ_i in the first entry. Zero outside the points'
+    /// box between runs.
+    sums: Vec<[f64; 2]>,
     _marker: PhantomData<fn() -> (D, S)>,
 }
 
@@ -33,7 +36,7 @@ impl<D: Dim, S> Default for VolumetricSmoothing<D, S> {
     fn default() -> Self {
         VolumetricSmoothing {
             scatter: SlabScatter::default(),
-            nodal: Vec::new(),
+            sums: Vec::new(),
             _marker: PhantomData,
         }
     }
@@ -54,7 +57,9 @@ impl<D: Dim, S: Shape> System<D> for VolumetricSmoothing<D, S> {
             return Ok(());
         }
         let grid = &ctx.grid;
-        let mut sums = vec![[0.0f64; 2]; grid.node_count()];
+        let mut active = NodeBox::default();
+        let sums = &mut self.sums;
+        sums.resize(grid.node_count(), [0.0; 2]);
         for arch in points_with::<Volume>(&ctx.world) {
             let (xg, vg, lg) = (
                 col::<Position<D::Vec>>(arch),
@@ -63,12 +68,12 @@ impl<D: Dim, S: Shape> System<D> for VolumetricSmoothing<D, S> {
             );
             let (x, vol): (&[Position<D::Vec>], &[Volume]) = (&xg, &vg);
             let l: &[VelocityGradient<D::Mat>] = &lg;
-            self.scatter.scatter(
+            active = active.union(self.scatter.scatter(
                 grid,
                 x.len(),
                 |p| x[p].0,
                 S::SUPPORT,
-                &Disjoint::new(&mut sums),
+                &Disjoint::new(sums),
                 |points, sums, lo| {
                     for &p in points {
                         let p = p as usize;
@@ -79,12 +84,13 @@ impl<D: Dim, S: Shape> System<D> for VolumetricSmoothing<D, S> {
                         });
                     }
                 },
-            );
+            ));
         }
-        self.nodal.clear();
-        self.nodal
-            .extend(sums.iter().map(|s| if s[1] > 0.0 { s[0] / s[1] } else { 0.0 }));
-        let nodal: &[f64] = &self.nodal;
+        for i in active.rows(grid).flatten() {
+            let s = sums[i];
+            sums[i] = [if s[1] > 0.0 { s[0] / s[1] } else { 0.0 }, 0.0];
+        }
+        let nodal: &[[f64; 2]] = sums;
         let n = D::N as f64;
         for arch in points_with::<Volume>(&ctx.world) {
             let xg = col::<Position<D::Vec>>(arch);
@@ -93,11 +99,14 @@ impl<D: Dim, S: Shape> System<D> for VolumetricSmoothing<D, S> {
             lg.par_chunks_mut(CHUNK).enumerate().for_each(|(c, l)| {
                 for (k, lp) in l.iter_mut().enumerate() {
                     let mut theta = 0.0;
-                    for_each_node::<D, S>(grid, x[c * CHUNK + k].0, |i, w, _| theta += w * nodal[i]);
+                    for_each_node::<D, S>(grid, x[c * CHUNK + k].0, |i, w, _| theta += w * nodal[i][0]);
                     let shift = (theta - trace::<D>(&lp.0)) / n;
                     D::add_identity(&mut lp.0, shift);
                 }
             });
+        }
+        for r in active.rows(grid) {
+            sums[r].fill([0.0; 2]);
         }
         Ok(())
     }
