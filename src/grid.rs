@@ -1,8 +1,11 @@
 //! The structured background grid: geometry and node numbering.
 //!
 //! Nodes sit at `origin + h·(i, j, k)` for `i ≤ cells[0]` and so on; node `(i, j, k)` has id
-//! `i + nx·(j + ny·k)` where `nx = cells[0] + 1`. In 2D the third count is zero, so a 2D grid
-//! has one layer of nodes.
+//! `i·stride[0] + j·stride[1] + k·stride[2]`. x runs fastest (stride 1, the inner loop of
+//! every stencil); of y and z, the axis with more cells runs slowest: it is the axis that
+//! parallel scatters cut into slabs, each slab a contiguous range of node ids (see
+//! [`crate::parallel`]), so a long thin 3D slab between rollers still splits into many.
+//! In 2D the third count is zero, so a 2D grid has one layer of nodes.
 
 use crate::dim::{Dim, Vector};
 
@@ -73,18 +76,20 @@ impl NodeBox {
         (0..3).map(|a| self.hi[a].saturating_sub(self.lo[a])).product()
     }
 
-    /// The box's nodes as runs of consecutive node ids (one run per row along x).
+    /// The box's nodes as runs of consecutive node ids (one run per row along x), in
+    /// ascending id order.
     pub fn rows<D: Dim>(self, grid: &Grid<D>) -> impl Iterator<Item = std::ops::Range<usize>> + '_ {
         let (lo, hi) = (self.lo, self.hi);
+        let (s, m) = (grid.slab_axis, 3 - grid.slab_axis);
         let width = if self.is_empty() { 0 } else { hi[0] - lo[0] };
-        let (ks, js) = if width == 0 {
+        let (outer, inner) = if width == 0 {
             (0..0, 0..0)
         } else {
-            (lo[2]..hi[2], lo[1]..hi[1])
+            (lo[s]..hi[s], lo[m]..hi[m])
         };
-        ks.flat_map(move |k| {
-            js.clone().map(move |j| {
-                let first = grid.node_id([lo[0], j, k]);
+        outer.flat_map(move |a| {
+            inner.clone().map(move |b| {
+                let first = lo[0] * grid.strides[0] + a * grid.strides[s] + b * grid.strides[m];
                 first..first + width
             })
         })
@@ -104,6 +109,10 @@ pub struct Grid<D: Dim> {
     pub cells: [usize; 3],
     /// Nodes along each axis (`cells + 1`; unused axes: 1).
     pub nodes: [usize; 3],
+    /// Node-id step along each axis.
+    pub strides: [usize; 3],
+    /// The axis with the largest stride (y in 2D; y or z in 3D).
+    pub slab_axis: usize,
 }
 
 impl<D: Dim> Grid<D> {
@@ -112,12 +121,19 @@ impl<D: Dim> Grid<D> {
         let mut c = [0usize; 3];
         c[..D::N].copy_from_slice(&cells[..D::N]);
         let nodes = [c[0] + 1, c[1] + 1, c[2] + 1];
+        let slab_axis = if D::N == 3 && c[2] >= c[1] { 2 } else { 1 };
+        let middle = 3 - slab_axis;
+        let mut strides = [1usize; 3];
+        strides[middle] = nodes[0];
+        strides[slab_axis] = nodes[0] * nodes[middle];
         Grid {
             origin,
             cell_size,
             inv_h: 1.0 / cell_size,
             cells: c,
             nodes,
+            strides,
+            slab_axis,
         }
     }
 
@@ -129,15 +145,24 @@ impl<D: Dim> Grid<D> {
     /// Id of node (i, j, k).
     #[inline(always)]
     pub fn node_id(&self, ijk: [usize; 3]) -> usize {
-        ijk[0] + self.nodes[0] * (ijk[1] + self.nodes[1] * ijk[2])
+        ijk[0] * self.strides[0] + ijk[1] * self.strides[1] + ijk[2] * self.strides[2]
+    }
+
+    /// Nodes in one layer across the slab axis (the slab axis's stride).
+    pub fn layer(&self) -> usize {
+        self.strides[self.slab_axis]
     }
 
     /// Integer coordinates of a node id.
     #[inline]
     pub fn node_ijk(&self, id: usize) -> [usize; 3] {
-        let i = id % self.nodes[0];
-        let rest = id / self.nodes[0];
-        [i, rest % self.nodes[1], rest / self.nodes[1]]
+        let (s, m) = (self.slab_axis, 3 - self.slab_axis);
+        let mut ijk = [0; 3];
+        ijk[s] = id / self.strides[s];
+        let rest = id % self.strides[s];
+        ijk[m] = rest / self.strides[m];
+        ijk[0] = rest % self.strides[m];
+        ijk
     }
 
     /// Share of a full cell volume h^D that node `id` stands for: ½ for each grid face it
@@ -252,11 +277,23 @@ mod tests {
 
     #[test]
     fn node_ids_round_trip() {
-        let g = Grid::<Dim3>::new(DVec3::ZERO, 0.5, [4, 3, 2]);
-        assert_eq!(g.node_count(), 5 * 4 * 3);
-        for id in 0..g.node_count() {
-            assert_eq!(g.node_id(g.node_ijk(id)), id);
+        for cells in [[4, 3, 2], [4, 2, 3]] {
+            let g = Grid::<Dim3>::new(DVec3::ZERO, 0.5, cells);
+            assert_eq!(g.node_count(), 5 * 4 * 3);
+            for id in 0..g.node_count() {
+                assert_eq!(g.node_id(g.node_ijk(id)), id);
+            }
         }
+    }
+
+    #[test]
+    fn the_longer_of_y_and_z_runs_slowest() {
+        let thin = Grid::<Dim3>::new(DVec3::ZERO, 1.0, [180, 45, 2]);
+        assert_eq!((thin.slab_axis, thin.strides), (1, [1, 181 * 3, 181]));
+        let block = Grid::<Dim3>::new(DVec3::ZERO, 1.0, [50, 50, 52]);
+        assert_eq!((block.slab_axis, block.strides), (2, [1, 51, 51 * 51]));
+        let plane = Grid::<Dim2>::new(DVec2::ZERO, 1.0, [180, 45, 0]);
+        assert_eq!((plane.slab_axis, plane.strides[..2].to_vec()), (1, vec![1, 181]));
     }
 
     #[test]

@@ -24,7 +24,7 @@ pub fn sum_chunks(n: usize, f: impl Fn(std::ops::Range<usize>) -> f64 + Sync) ->
     parts.iter().sum()
 }
 
-/// Points grouped into slabs of one cell row along the slowest axis (y in 2D, z in 3D), so
+/// Points grouped into slabs of one cell row along the grid's slab axis (its slowest), so
 /// that each slab scatters into its own contiguous range of node ids.
 #[derive(Debug, Default)]
 pub struct Slabs {
@@ -38,7 +38,7 @@ pub struct Slabs {
 impl Slabs {
     /// Groups the `n` points whose positions `position(p)` gives into one slab per cell row.
     pub fn build<D: Dim>(&mut self, grid: &Grid<D>, n: usize, position: impl Fn(usize) -> D::Vec) {
-        let axis = D::N - 1;
+        let axis = grid.slab_axis;
         let rows = grid.cells[axis];
         let slab = |p: usize| grid.clamped_cell(position(p))[axis];
         self.offsets.clear();
@@ -94,8 +94,8 @@ impl Slabs {
     /// layers `s − 1 .. s + support` (a stencil starts at the point's cell layer or the one
     /// below, both shape functions clamp it inside the grid, and it spans `support` layers).
     pub fn node_range<D: Dim>(grid: &Grid<D>, s: usize, support: usize) -> Range<usize> {
-        let axis = D::N - 1;
-        let layer = grid.node_count() / grid.nodes[axis];
+        let axis = grid.slab_axis;
+        let layer = grid.layer();
         let first = s.saturating_sub(1);
         let last = (s + support).min(grid.nodes[axis]);
         first * layer..last * layer

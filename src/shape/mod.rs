@@ -42,10 +42,10 @@ pub trait Shape: Copy + Send + Sync + Default + std::fmt::Debug + 'static {
 pub fn for_each_node<D: Dim, S: Shape>(grid: &Grid<D>, x: D::Vec, mut f: impl FnMut(usize, f64, D::Vec)) {
     let sx = S::eval_1d(grid.grid_coordinate(x, 0), grid.cells[0], grid.inv_h);
     let sy = S::eval_1d(grid.grid_coordinate(x, 1), grid.cells[1], grid.inv_h);
-    let nx = grid.nodes[0];
+    let [_, stride_y, stride_z] = grid.strides;
     if D::N == 2 {
         for j in 0..S::SUPPORT {
-            let row = (sy.base + j) * nx + sx.base;
+            let row = (sy.base + j) * stride_y + sx.base;
             for i in 0..S::SUPPORT {
                 let grad = D::vec_from([sx.dw[i] * sy.w[j], sx.w[i] * sy.dw[j], 0.0]);
                 f(row + i, sx.w[i] * sy.w[j], grad);
@@ -53,10 +53,9 @@ pub fn for_each_node<D: Dim, S: Shape>(grid: &Grid<D>, x: D::Vec, mut f: impl Fn
         }
     } else {
         let sz = S::eval_1d(grid.grid_coordinate(x, 2), grid.cells[2], grid.inv_h);
-        let ny = grid.nodes[1];
         for k in 0..S::SUPPORT {
             for j in 0..S::SUPPORT {
-                let row = ((sz.base + k) * ny + sy.base + j) * nx + sx.base;
+                let row = (sz.base + k) * stride_z + (sy.base + j) * stride_y + sx.base;
                 let wyz = sy.w[j] * sz.w[k];
                 let dyz = sy.dw[j] * sz.w[k];
                 let ydz = sy.w[j] * sz.dw[k];
