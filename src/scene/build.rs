@@ -3,6 +3,7 @@
 
 use super::validate::{self, Checked, Derived};
 use super::{Condition, LoadedScene, Region, Scene};
+use crate::columns::{col, points_with};
 use crate::components::*;
 use crate::dim::{Dim, Dim2, Dim3, Vector};
 use crate::error::SceneError;
@@ -93,8 +94,13 @@ fn region_contains(region: &Region, x: [f64; 3], n: usize) -> bool {
     }
 }
 
-/// Positions of the points filling `region`: centres of equal sub-cells of every grid cell.
-fn fill_points<D: Dim>(grid: &Grid<D>, region: &Region, ppc: &[usize]) -> Vec<[f64; 3]> {
+/// Positions of the points filling `region`: centres of equal sub-cells of every grid cell,
+/// generated on demand (a body of a million points is never held twice in memory).
+fn fill_points<'a, D: Dim>(
+    grid: &Grid<D>,
+    region: &'a Region,
+    ppc: &[usize],
+) -> impl Iterator<Item = [f64; 3]> + Clone + 'a {
     let n = D::N;
     let (lo, hi) = region_bounds(region, n);
     let mut range = [(0usize, 1usize); 3];
@@ -104,35 +110,45 @@ fn fill_points<D: Dim>(grid: &Grid<D>, region: &Region, ppc: &[usize]) -> Vec<[f
         let last = (((hi[a] - o) * grid.inv_h).ceil().max(0.0) as usize).min(grid.cells[a]);
         range[a] = (first, last);
     }
-    let sub = [ppc[0], ppc[1], ppc.get(2).copied().unwrap_or(1)];
+    let sub = [ppc[0], ppc[1], if n == 3 { ppc[2] } else { 1 }];
     let o = D::vec_to3(grid.origin);
     let h = grid.cell_size;
-    let mut out = Vec::new();
-    for k in range[2].0..range[2].1 {
-        for j in range[1].0..range[1].1 {
-            for i in range[0].0..range[0].1 {
-                for sk in 0..if n == 3 { sub[2] } else { 1 } {
-                    for sj in 0..sub[1] {
-                        for si in 0..sub[0] {
-                            let mut x = [
-                                o[0] + h * (i as f64 + (si as f64 + 0.5) / sub[0] as f64),
-                                o[1] + h * (j as f64 + (sj as f64 + 0.5) / sub[1] as f64),
-                                0.0,
-                            ];
-                            if n == 3 {
-                                x[2] = o[2] + h * (k as f64 + (sk as f64 + 0.5) / sub[2] as f64);
-                            }
-                            if region_contains(region, x, n) {
-                                out.push(x);
-                            }
-                        }
-                    }
-                }
-            }
-        }
-    }
-    out
+    // Along each axis: cell index and sub-cell index, flattened.
+    let along = move |a: usize| (range[a].0 * sub[a]..range[a].1 * sub[a]).map(move |q| (q, a));
+    let coordinate = move |(q, a): (usize, usize)| {
+        o[a] + h * ((q / sub[a]) as f64 + ((q % sub[a]) as f64 + 0.5) / sub[a] as f64)
+    };
+    along(2).flat_map(move |z| {
+        along(1).flat_map(move |y| {
+            along(0).filter_map(move |x| {
+                let z = if n == 3 { coordinate(z) } else { 0.0 };
+                let p = [coordinate(x), coordinate(y), z];
+                region_contains(region, p, n).then_some(p)
+            })
+        })
+    })
 }
+
+/// An iterator that knows its length, so that `spawn_batch` reserves the columns once.
+#[derive(Clone)]
+struct Counted<I> {
+    inner: I,
+    left: usize,
+}
+
+impl<I: Iterator> Iterator for Counted<I> {
+    type Item = I::Item;
+    fn next(&mut self) -> Option<I::Item> {
+        let item = self.inner.next()?;
+        self.left -= 1;
+        Some(item)
+    }
+    fn size_hint(&self) -> (usize, Option<usize>) {
+        (self.left, Some(self.left))
+    }
+}
+
+impl<I: Iterator> ExactSizeIterator for Counted<I> {}
 
 fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulation<D>, Derived), SceneError> {
     let (table, c_p, dt_crit, dt) = checked;
@@ -173,7 +189,6 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
 
     // Material points, body by body (cell order within a body keeps them spatially sorted).
     let cell_volume = s.grid.cell_size.powi(n as i32);
-    let mut positions: Vec<([f64; 3], Entity)> = Vec::new();
     // Mass of a node inside a filled region, ρ·h^D, for the lightest material in use.
     let mut full_node_mass = f64::INFINITY;
     let (gmin, gmax) = (D::vec_to3(grid.origin), D::vec_to3(grid.max_corner()));
@@ -191,8 +206,12 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
                 ),
             ));
         }
-        let xs = fill_points(&grid, &body.region, &body.points_per_cell);
-        if xs.is_empty() {
+        let points = fill_points(&grid, &body.region, &body.points_per_cell);
+        let xs = Counted {
+            left: points.clone().count(),
+            inner: points,
+        };
+        if xs.left == 0 {
             return Err(loaded.invalid(
                 &format!("bodies[{b}].region"),
                 "the body holds no material point (is it smaller than a sub-cell?)",
@@ -206,9 +225,9 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         let volume = cell_volume / body.points_per_cell.iter().product::<usize>() as f64;
         let mass = model.density() * volume;
         full_node_mass = full_node_mass.min(model.density() * cell_volume);
-        let common = |x: &[f64; 3]| {
+        let common = |x: [f64; 3]| {
             (
-                Position(D::vec_from(*x)),
+                Position(D::vec_from(x)),
                 Velocity(z),
                 Displacement(z),
                 Mass(mass),
@@ -219,23 +238,24 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
             )
         };
         // Plastic state only where the material needs it.
-        let entities: Vec<Entity> = if model.is_plastic() {
-            world
-                .spawn_batch(xs.iter().map(|x| {
-                    let (a, b, c, d, e, f, g, h) = common(x);
-                    (a, b, c, d, e, f, g, h, PlasticStrain(0.0))
-                }))
-                .collect()
+        // The spawned entities are not kept: points are found again through the columns,
+        // which keeps the set-up's peak memory near the run's.
+        if model.is_plastic() {
+            world.spawn_batch(xs.map(|x| {
+                let (a, b, c, d, e, f, g, h) = common(x);
+                (a, b, c, d, e, f, g, h, PlasticStrain(0.0))
+            }));
         } else {
-            world.spawn_batch(xs.iter().map(common)).collect()
-        };
-        positions.extend(xs.into_iter().zip(entities));
+            world.spawn_batch(xs.map(common));
+        }
     }
 
     // Which nodes the points touch at the start.
     let mut touched = vec![false; grid.node_count()];
-    for (x, _) in &positions {
-        visit_support(&grid, s.shape, D::vec_from(*x), |i, w| touched[i] |= w > 0.0);
+    for arch in points_with::<Position<D::Vec>>(&world) {
+        for x in col::<Position<D::Vec>>(arch).iter() {
+            visit_support(&grid, s.shape, x.0, |i, w| touched[i] |= w > 0.0);
+        }
     }
 
     // Point loads: massless carriers that move with the body.
@@ -258,7 +278,7 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
                 ),
             ));
         }
-        let e = world.spawn((
+        world.spawn((
             Position(x),
             Velocity(z),
             Displacement(z),
@@ -266,7 +286,6 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
             VelocityGradient(D::MAT_ZERO),
             PointLoad(D::vec_from(pad3(&l.force))),
         ));
-        positions.push((pad3(&l.position), e));
     }
 
     // Traced points: the nearest point within one cell.
@@ -274,12 +293,16 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
     for (i, t) in s.traced.iter().enumerate() {
         let want = pad3(&t.position);
         let dist = |x: &[f64; 3]| (0..3).map(|a| (x[a] - want[a]).powi(2)).sum::<f64>().sqrt();
-        let best = positions.iter().min_by(|a, b| dist(&a.0).total_cmp(&dist(&b.0)));
+        let mut query = world.query::<(Entity, &Position<D::Vec>)>();
+        let best = query
+            .iter()
+            .map(|(e, x)| (D::vec_to3(x.0), e))
+            .min_by(|a, b| dist(&a.0).total_cmp(&dist(&b.0)));
         match best {
-            Some((x, e)) if dist(x) <= s.grid.cell_size => traced.push(TracedPoint {
+            Some((x, e)) if dist(&x) <= s.grid.cell_size => traced.push(TracedPoint {
                 name: t.name.clone(),
-                entity: *e,
-                initial_position: *x,
+                entity: e,
+                initial_position: x,
             }),
             _ => {
                 return Err(loaded.invalid(
@@ -329,7 +352,9 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         p_wave_speed: c_p,
         critical_time_step: dt_crit,
         time_step: dt,
-        points: positions.len(),
+        points: points_with::<Position<D::Vec>>(&world)
+            .map(|a| a.len() as usize)
+            .sum(),
         active_nodes: touched.iter().filter(|&&t| t).count(),
         grid_nodes: grid.node_count(),
         systems: schedule.names(),
