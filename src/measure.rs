@@ -67,16 +67,18 @@ pub fn surface_angle<D: Dim>(sim: &Simulation<D>) -> Option<SurfaceAngle> {
 }
 
 /// Largest displacement magnitude and largest |horizontal (x) displacement| over the
-/// points (m).
-pub fn max_displacements<D: Dim>(sim: &Simulation<D>) -> (f64, f64) {
+/// points (m), or `None` when the scene keeps no displacements (`output.displacements`).
+pub fn max_displacements<D: Dim>(sim: &Simulation<D>) -> Option<(f64, f64)> {
     let (mut total, mut horizontal) = (0.0f64, 0.0f64);
+    let mut kept = false;
     for arch in points_with::<Displacement<D::Vec>>(&sim.ctx.world) {
+        kept = true;
         for u in col::<Displacement<D::Vec>>(arch).iter() {
             total = total.max(u.0.dot(u.0).sqrt());
             horizontal = horizontal.max(u.0.get(0).abs());
         }
     }
-    (total, horizontal)
+    kept.then_some((total, horizontal))
 }
 
 /// True when every point position is finite.

@@ -37,6 +37,20 @@ pub struct TracedPoint {
     pub initial_position: [f64; 3],
 }
 
+impl TracedPoint {
+    /// Displacement from the start (m, x y z), from the position alone: traced points need
+    /// no displacement column.
+    pub fn displacement<D: Dim>(&self, world: &World) -> [f64; 3] {
+        let x = D::vec_to3(
+            world
+                .get::<&Position<D::Vec>>(self.entity)
+                .expect("traced point exists")
+                .0,
+        );
+        std::array::from_fn(|a| x[a] - self.initial_position[a])
+    }
+}
+
 /// What a traced point reports at the end of a run.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct TracedResult {
@@ -104,15 +118,11 @@ impl<D: Dim> Simulation<D> {
             .iter()
             .map(|t| {
                 let e = self.ctx.world.entity(t.entity).expect("traced point exists");
-                let u = e
-                    .get::<&Displacement<D::Vec>>()
-                    .map(|u| D::vec_to3(u.0))
-                    .unwrap_or_default();
                 let stress = e.get::<&Stress>().map(|s| s.0).unwrap_or_default();
                 TracedResult {
                     name: t.name.clone(),
                     initial_position: t.initial_position,
-                    displacement: u,
+                    displacement: t.displacement::<D>(&self.ctx.world),
                     stress,
                 }
             })

@@ -79,3 +79,29 @@ fn a_run_whose_time_step_is_far_too_large_stops_with_a_located_error() {
         "{msg}"
     );
 }
+
+#[test]
+fn displacements_are_kept_only_when_asked_for_and_traced_points_do_without() {
+    use kdmpm::components::Displacement;
+    use kdmpm::measure::max_displacements;
+    let AnySimulation::Three(mut bar) =
+        load("bar.ron", &["output.displacements=false", "solver.max_steps=50"])
+    else {
+        panic!()
+    };
+    assert_eq!(
+        points_with::<Displacement<glam::DVec3>>(&bar.ctx.world).count(),
+        0
+    );
+    bar.run(|_| {}).unwrap();
+    assert_eq!(max_displacements(&bar), None);
+    let without = bar.traced_results()[0].displacement;
+    let AnySimulation::Three(mut kept) = load("bar.ron", &["solver.max_steps=50"]) else {
+        panic!()
+    };
+    kept.run(|_| {}).unwrap();
+    let with = kept.traced_results()[0].displacement;
+    assert!(with[0] != 0.0 && without == with, "{without:?} vs {with:?}");
+    let (max_u, _) = max_displacements(&kept).expect("kept by default");
+    assert!(max_u >= with[0].abs());
+}

@@ -1,11 +1,9 @@
 //! The `history` output system: one CSV row per output interval.
 
-use crate::components::Displacement;
 use crate::dim::Dim;
 use crate::error::StepError;
 use crate::schedule::System;
 use crate::simulation::{Context, TracedPoint};
-use hecs::Entity;
 use std::fs::File;
 use std::io::BufWriter;
 use std::marker::PhantomData;
@@ -18,7 +16,7 @@ use std::path::Path;
 pub struct History<D> {
     writer: csv::Writer<BufWriter<File>>,
     every: u64,
-    traced: Vec<Entity>,
+    traced: Vec<TracedPoint>,
     _marker: PhantomData<fn() -> D>,
 }
 
@@ -48,7 +46,7 @@ impl<D: Dim> History<D> {
         Ok(History {
             writer,
             every,
-            traced: traced.iter().map(|t| t.entity).collect(),
+            traced: traced.to_vec(),
             _marker: PhantomData,
         })
     }
@@ -74,13 +72,9 @@ impl<D: Dim> System<D> for History<D> {
             format!("{:.9e}", s.energy_ratio),
             s.resets.to_string(),
         ];
-        for &e in &self.traced {
+        for t in &self.traced {
             // A handful of traced points: an entity lookup is fine here.
-            let u = ctx
-                .world
-                .get::<&Displacement<D::Vec>>(e)
-                .map(|u| D::vec_to3(u.0))
-                .unwrap_or_default();
+            let u = t.displacement::<D>(&ctx.world);
             row.extend(u.iter().take(D::N).map(|c| format!("{c:.9e}")));
         }
         self.writer.write_record(&row).map_err(std::io::Error::other)?;

@@ -58,10 +58,10 @@ pub struct Summary {
     pub particle_steps_per_second: f64,
     /// Peak resident memory of the process (bytes; Linux only).
     pub peak_memory_bytes: Option<u64>,
-    /// Largest displacement magnitude of any point (m).
-    pub max_displacement: f64,
-    /// Largest |horizontal displacement| of any point (m).
-    pub max_horizontal_displacement: f64,
+    /// Largest displacement magnitude of any point (m), unless the scene keeps none.
+    pub max_displacement: Option<f64>,
+    /// Largest |horizontal displacement| of any point (m), unless the scene keeps none.
+    pub max_horizontal_displacement: Option<f64>,
     /// Free-surface angle, when the scene asks for it (`output.surface_angle`).
     pub surface_angle: Option<SurfaceAngle>,
     /// Traced points.
@@ -81,7 +81,7 @@ impl Summary {
         let s = &sim.ctx.state;
         let st = &sim.ctx.settings;
         let particles = sim.point_count();
-        let (max_u, max_ux) = max_displacements(sim);
+        let max_u = max_displacements(sim);
         Summary {
             scene: scene.to_string(),
             dimension: D::N,
@@ -110,8 +110,8 @@ impl Summary {
             } else {
                 0.0
             },
-            max_displacement: max_u,
-            max_horizontal_displacement: max_ux,
+            max_displacement: max_u.map(|u| u.0),
+            max_horizontal_displacement: max_u.map(|u| u.1),
             surface_angle: if sim.measure_surface_angle {
                 surface_angle(sim)
             } else {

@@ -7,7 +7,7 @@ use crate::simulation::Simulation;
 use std::fmt::Write as _;
 use std::path::Path;
 
-/// Writes every material point (load carriers excluded) with its displacement (m), stress
+/// Writes every material point (load carriers excluded) with its displacement (m, when kept), stress
 /// (Pa, tension positive: xx yy zz xy yz zx), mean stress (Pa), volume (m³) and, when
 /// present, accumulated plastic strain.
 pub fn write_points<D: Dim>(sim: &Simulation<D>, path: &Path) -> std::io::Result<()> {
@@ -15,14 +15,16 @@ pub fn write_points<D: Dim>(sim: &Simulation<D>, path: &Path) -> std::io::Result
         (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for arch in points_with::<Stress>(&sim.ctx.world) {
         let plastic = arch.get::<&PlasticStrain>();
-        for (p, ((x, u), (s, v))) in col::<Position<D::Vec>>(arch)
+        let displacement = arch.get::<&Displacement<D::Vec>>();
+        for (p, (x, (s, v))) in col::<Position<D::Vec>>(arch)
             .iter()
-            .zip(col::<Displacement<D::Vec>>(arch).iter())
             .zip(col::<Stress>(arch).iter().zip(col::<Volume>(arch).iter()))
             .enumerate()
         {
             xs.push(D::vec_to3(x.0));
-            us.push(D::vec_to3(u.0));
+            if let Some(u) = &displacement {
+                us.push(D::vec_to3(u[p].0));
+            }
             ss.push(s.0);
             vols.push(v.0);
             eps.push(plastic.as_ref().map_or(0.0, |e| e[p].0));
@@ -52,13 +54,17 @@ pub fn write_points<D: Dim>(sim: &Simulation<D>, path: &Path) -> std::io::Result
     out.push_str("\n</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n");
     out.push_str(&"1 ".repeat(n));
     out.push_str("\n</DataArray>\n</Cells>\n<PointData>\n");
-    out.push_str(
-        "<DataArray type=\"Float64\" Name=\"displacement\" NumberOfComponents=\"3\" format=\"ascii\">\n",
-    );
-    for u in &us {
-        let _ = writeln!(out, "{:e} {:e} {:e}", u[0], u[1], u[2]);
+    // Displacements only when the scene keeps them (`output.displacements`).
+    if us.len() == n && n > 0 {
+        out.push_str(
+            "<DataArray type=\"Float64\" Name=\"displacement\" NumberOfComponents=\"3\" format=\"ascii\">\n",
+        );
+        for u in &us {
+            let _ = writeln!(out, "{:e} {:e} {:e}", u[0], u[1], u[2]);
+        }
+        out.push_str("</DataArray>\n");
     }
-    out.push_str("</DataArray>\n<DataArray type=\"Float64\" Name=\"stress\" NumberOfComponents=\"6\" format=\"ascii\">\n");
+    out.push_str("<DataArray type=\"Float64\" Name=\"stress\" NumberOfComponents=\"6\" format=\"ascii\">\n");
     for s in &ss {
         let _ = writeln!(
             out,

@@ -229,7 +229,6 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
             (
                 Position(D::vec_from(x)),
                 Velocity(z),
-                Displacement(z),
                 Mass(mass),
                 Volume(volume),
                 Stress(Sym3::ZERO),
@@ -237,16 +236,31 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
                 MaterialId(mat as u16),
             )
         };
-        // Plastic state only where the material needs it.
+        // Plastic state only where the material needs it, displacements only when asked for.
         // The spawned entities are not kept: points are found again through the columns,
         // which keeps the set-up's peak memory near the run's.
-        if model.is_plastic() {
-            world.spawn_batch(xs.map(|x| {
-                let (a, b, c, d, e, f, g, h) = common(x);
-                (a, b, c, d, e, f, g, h, PlasticStrain(0.0))
-            }));
-        } else {
-            world.spawn_batch(xs.map(common));
+        match (model.is_plastic(), s.output.displacements) {
+            (true, true) => {
+                world.spawn_batch(xs.map(|x| {
+                    let (a, b, c, d, e, f, g) = common(x);
+                    (a, b, c, d, e, f, g, PlasticStrain(0.0), Displacement(z))
+                }));
+            }
+            (true, false) => {
+                world.spawn_batch(xs.map(|x| {
+                    let (a, b, c, d, e, f, g) = common(x);
+                    (a, b, c, d, e, f, g, PlasticStrain(0.0))
+                }));
+            }
+            (false, true) => {
+                world.spawn_batch(xs.map(|x| {
+                    let (a, b, c, d, e, f, g) = common(x);
+                    (a, b, c, d, e, f, g, Displacement(z))
+                }));
+            }
+            (false, false) => {
+                world.spawn_batch(xs.map(common));
+            }
         }
     }
 
@@ -278,14 +292,16 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
                 ),
             ));
         }
-        world.spawn((
+        let carrier = world.spawn((
             Position(x),
             Velocity(z),
-            Displacement(z),
             Mass(0.0),
             VelocityGradient(D::MAT_ZERO),
             PointLoad(D::vec_from(pad3(&l.force))),
         ));
+        if s.output.displacements {
+            world.insert_one(carrier, Displacement(z)).expect("just spawned");
+        }
     }
 
     // Traced points: the nearest point within one cell.

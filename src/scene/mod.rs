@@ -267,6 +267,15 @@ pub struct OutputSpec {
     /// Measure the free-surface angle at the end (see `measure::surface_angle`).
     #[serde(default)]
     pub surface_angle: bool,
+    /// Keep every point's displacement from its start (default true; 16 bytes a point in
+    /// 2D, 24 in 3D): the maximum displacements in `summary.json` and the displacement field
+    /// of `points.vtu` need it. Traced points do not.
+    #[serde(default = "default_true")]
+    pub displacements: bool,
+}
+
+fn default_true() -> bool {
+    true
 }
 
 fn default_every() -> u64 {
@@ -278,6 +287,7 @@ impl Default for OutputSpec {
         OutputSpec {
             history_every: 1,
             surface_angle: false,
+            displacements: true,
         }
     }
 }

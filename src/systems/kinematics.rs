@@ -71,15 +71,20 @@ impl<D: Dim, S: Shape> System<D> for Kinematics<D, S> {
         for arch in points_with::<Position<D::Vec>>(&ctx.world) {
             let mut xg = col_mut::<Position<D::Vec>>(arch);
             let mut lg = col_mut::<VelocityGradient<D::Mat>>(arch);
-            let mut ug = col_mut::<Displacement<D::Vec>>(arch);
+            let mut ug = arch.get::<&mut Displacement<D::Vec>>();
+            // Displacements are kept only when the scene asks for them.
+            let u_chunks: Vec<Option<&mut [Displacement<D::Vec>]>> = match ug.as_deref_mut() {
+                Some(u) => u.chunks_mut(CHUNK).map(Some).collect(),
+                None => (0..xg.len().div_ceil(CHUNK)).map(|_| None).collect(),
+            };
             // Each chunk reports the first point that left the grid; the first in chunk order
             // wins, so the error is the same for any thread count.
             let escaped = xg
                 .par_chunks_mut(CHUNK)
                 .zip(lg.par_chunks_mut(CHUNK))
-                .zip(ug.par_chunks_mut(CHUNK))
+                .zip(u_chunks.into_par_iter())
                 .enumerate()
-                .map(|(c, ((x, l), u))| {
+                .map(|(c, ((x, l), mut u))| {
                     for k in 0..x.len() {
                         let mut lp = D::MAT_ZERO;
                         let mut vel = D::Vec::ZERO;
@@ -100,7 +105,9 @@ impl<D: Dim, S: Shape> System<D> for Kinematics<D, S> {
                                 return Some((c * CHUNK + k, D::vec_to3(xp)));
                             }
                             x[k].0 = xp;
-                            u[k].0 += du;
+                            if let Some(u) = u.as_deref_mut() {
+                                u[k].0 += du;
+                            }
                         }
                     }
                     None
