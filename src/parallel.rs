@@ -33,38 +33,88 @@ pub struct Slabs {
     order: Vec<u32>,
     /// Lowest and highest cell index holding a point, per axis.
     cells: ([usize; 3], [usize; 3]),
+    /// Per chunk of points and slab: a count, then a position in `order` (set-up scratch).
+    counts: Vec<u32>,
+}
+
+/// Slots of a vector that parallel tasks write to, each task to its own slots.
+struct SharedSlots(*mut u32);
+
+// SAFETY: tasks write disjoint slots (see `Slabs::build`); nothing reads during the writes.
+unsafe impl Sync for SharedSlots {}
+
+impl SharedSlots {
+    /// # Safety
+    /// `i` is in bounds and no other task writes slot `i`.
+    unsafe fn write(&self, i: usize, value: u32) {
+        unsafe { *self.0.add(i) = value };
+    }
 }
 
 impl Slabs {
     /// Groups the `n` points whose positions `position(p)` gives into one slab per cell row.
-    pub fn build<D: Dim>(&mut self, grid: &Grid<D>, n: usize, position: impl Fn(usize) -> D::Vec) {
+    ///
+    /// A counting sort in parallel over fixed chunks of points: every chunk counts its points
+    /// per slab, the counts give every (slab, chunk) pair its own range of `order`, and the
+    /// chunks fill their ranges. Within a slab points stay in ascending order, whatever the
+    /// number of threads. The slab of a point is worked out twice rather than stored.
+    pub fn build<D: Dim>(&mut self, grid: &Grid<D>, n: usize, position: impl Fn(usize) -> D::Vec + Sync) {
         let axis = grid.slab_axis;
         let rows = grid.cells[axis];
-        let slab = |p: usize| grid.clamped_cell(position(p))[axis];
+        let chunk = |c: usize| c * CHUNK..((c + 1) * CHUNK).min(n);
+        self.counts.clear();
+        self.counts.resize(n.div_ceil(CHUNK) * rows, 0);
+        let bounds: Vec<([usize; 3], [usize; 3])> = self
+            .counts
+            .par_chunks_mut(rows)
+            .enumerate()
+            .map(|(c, count)| {
+                let (mut lo, mut hi) = ([usize::MAX; 3], [0usize; 3]);
+                for p in chunk(c) {
+                    let cell = grid.clamped_cell(position(p));
+                    for a in 0..D::N {
+                        lo[a] = lo[a].min(cell[a]);
+                        hi[a] = hi[a].max(cell[a]);
+                    }
+                    count[cell[axis]] += 1;
+                }
+                (lo, hi)
+            })
+            .collect();
+        self.cells = bounds.iter().fold(([usize::MAX; 3], [0; 3]), |(lo, hi), b| {
+            (
+                std::array::from_fn(|a| lo[a].min(b.0[a])),
+                std::array::from_fn(|a| hi[a].max(b.1[a])),
+            )
+        });
+        // Counts become the first index in `order` of each (chunk, slab) pair.
         self.offsets.clear();
         self.offsets.resize(rows + 1, 0);
-        let (mut lo, mut hi) = ([usize::MAX; 3], [0usize; 3]);
-        for p in 0..n {
-            let c = grid.clamped_cell(position(p));
-            for a in 0..D::N {
-                lo[a] = lo[a].min(c[a]);
-                hi[a] = hi[a].max(c[a]);
-            }
-            self.offsets[c[axis] + 1] += 1;
-        }
-        self.cells = (lo, hi);
+        let mut next = 0usize;
         for s in 0..rows {
-            self.offsets[s + 1] += self.offsets[s];
+            self.offsets[s] = next;
+            for count in self.counts.chunks_mut(rows) {
+                let k = count[s] as usize;
+                count[s] = next as u32;
+                next += k;
+            }
         }
-        // A counting sort; the slab of a point is worked out again rather than stored.
-        let mut fill = self.offsets.clone();
+        self.offsets[rows] = next;
         self.order.clear();
         self.order.resize(n, 0);
-        for p in 0..n {
-            let s = slab(p);
-            self.order[fill[s]] = p as u32;
-            fill[s] += 1;
-        }
+        let order = SharedSlots(self.order.as_mut_ptr());
+        self.counts
+            .par_chunks_mut(rows)
+            .enumerate()
+            .for_each(|(c, first)| {
+                for p in chunk(c) {
+                    let s = grid.clamped_cell(position(p))[axis];
+                    // SAFETY: `first[s]` walks the range of `order` that belongs to this chunk's
+                    // points in slab `s` alone, and stays below `n`.
+                    unsafe { order.write(first[s] as usize, p as u32) };
+                    first[s] += 1;
+                }
+            });
     }
 
     /// Number of slabs.
@@ -205,7 +255,7 @@ impl SlabScatter {
         &mut self,
         grid: &Grid<D>,
         n: usize,
-        position: impl Fn(usize) -> D::Vec,
+        position: impl Fn(usize) -> D::Vec + Sync,
         support: usize,
         target: &'t T,
         kernel: impl Fn(&[u32], T::Part<'t>, usize) + Sync,
