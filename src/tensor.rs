@@ -70,6 +70,15 @@ impl Sym3 {
             + 2.0 * (self.xy * b.xy + self.yz * b.yz + self.zx * b.zx)
     }
 
+    /// Mean stress p = tr/3 and the norm of the deviatoric part |s| = sqrt(s:s).
+    #[inline(always)]
+    pub fn mean_and_deviatoric_norm(&self) -> (f64, f64) {
+        let p = self.trace() / 3.0;
+        let (a, b, c) = (self.xx - p, self.yy - p, self.zz - p);
+        let off = self.xy * self.xy + self.yz * self.yz + self.zx * self.zx;
+        (p, (a * a + b * b + c * c + 2.0 * off).sqrt())
+    }
+
     /// Frobenius norm sqrt(a:a).
     #[inline(always)]
     pub fn norm(&self) -> f64 {

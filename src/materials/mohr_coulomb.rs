@@ -106,6 +106,20 @@ impl MohrCoulomb {
         self.k * p[0] - p[2] - self.sigma_c
     }
 
+    /// True when the stress is inside the yield surface and below the tension cut-off by a
+    /// bound from its invariants alone, so most elastic points skip the eigen-decomposition.
+    ///
+    /// The deviatoric principal values lie within ±sqrt(2/3)|s|, so
+    /// f = (k − 1) p + k s1 − s3 − σc ≤ (k − 1) p + (k + 1) sqrt(2/3) |s| − σc and
+    /// σ1 ≤ p + sqrt(2/3) |s|. The bound is loose only near the surface, where the exact test
+    /// runs anyway.
+    #[inline(always)]
+    pub fn surely_elastic(&self, stress: &Sym3) -> bool {
+        let (p, s) = stress.mean_and_deviatoric_norm();
+        let r = (2.0f64 / 3.0).sqrt() * s;
+        (self.k - 1.0) * p + (self.k + 1.0) * r - self.sigma_c <= 0.0 && p + r <= self.tension_cutoff
+    }
+
     /// Returns sorted principal trial stresses to the yield surface.
     pub fn return_principal(&self, trial: [f64; 3]) -> ([f64; 3], Return) {
         let t = DVec3::from_array(trial);
@@ -219,6 +233,10 @@ impl Material for MohrCoulomb {
     #[inline]
     fn update(&self, stress: &mut Sym3, de: &Sym3, plastic: Option<&mut f64>) {
         let trial = *stress + self.elasticity.stress_increment(de);
+        if self.surely_elastic(&trial) {
+            *stress = trial;
+            return;
+        }
         let (p, r) = trial.eigen();
         if self.yield_function(p) <= 0.0 && p[0] <= self.tension_cutoff {
             *stress = trial;
@@ -246,6 +264,29 @@ mod tests {
         v
     }
 
+    #[test]
+    fn an_at_rest_stress_passes_the_invariant_bound_and_a_yielding_one_does_not() {
+        let mc = soil(0.0, 20.0, 0.0);
+        // K0 = ν/(1 − ν) = 0.667 at 100 kPa vertical: far inside the surface.
+        let at_rest = Sym3 {
+            xx: -66.7e3,
+            yy: -100e3,
+            zz: -66.7e3,
+            xy: 0.0,
+            yz: 0.0,
+            zx: 0.0,
+        };
+        assert!(mc.surely_elastic(&at_rest));
+        // σ1 = σ3/k lies on the surface (c = 0).
+        let on = Sym3 {
+            xx: -100e3 / mc.k,
+            yy: -100e3,
+            zz: -100e3 / mc.k,
+            ..at_rest
+        };
+        assert!(!mc.surely_elastic(&on));
+    }
+
     proptest! {
         #[test]
         fn returned_stress_lies_on_or_inside_the_yield_surface(
@@ -262,6 +303,22 @@ mod tests {
                 prop_assert!(f.abs() <= 1e-9 * scale, "not on the surface: f = {f} ({kind:?})");
             }
             prop_assert!(sorted(s)[0] <= mc.tension_cutoff + 1e-9 * scale);
+        }
+
+        #[test]
+        fn the_invariant_bound_never_passes_a_stress_that_yields(
+            xx in -1e6f64..3e5, yy in -1e6f64..3e5, zz in -1e6f64..3e5,
+            xy in -3e5f64..3e5, yz in -3e5f64..3e5, zx in -3e5f64..3e5,
+            coh in 0.0f64..5e4, phi in 0.0f64..45.0,
+        ) {
+            let mc = soil(coh, phi, 0.0);
+            let s = Sym3 { xx, yy, zz, xy, yz, zx };
+            if mc.surely_elastic(&s) {
+                let p = s.principal_values();
+                let scale = p.iter().fold(0.0f64, |m, v| m.max(v.abs())).max(1.0);
+                prop_assert!(mc.yield_function(p) <= 1e-12 * scale, "{s:?}");
+                prop_assert!(p[0] <= mc.tension_cutoff + 1e-12 * scale);
+            }
         }
 
         #[test]
