@@ -156,16 +156,15 @@ impl Slabs {
 ///
 /// Implemented for [`Disjoint`] views of node columns and for tuples of them.
 pub trait NodeTarget: Sync {
-    /// The part of the columns one slab writes to.
-    type Part<'p>
-    where
-        Self: 'p;
+    /// The part of the columns one slab writes to, borrowed for one kernel call.
+    type Part<'p>;
 
-    /// The columns' entries for node ids `nodes`.
+    /// The columns' entries for node ids `nodes`, for a lifetime the caller picks.
     ///
     /// # Safety
-    /// Parts alive at the same time must cover disjoint node ranges.
-    unsafe fn part(&self, nodes: Range<usize>) -> Self::Part<'_>;
+    /// Parts alive at the same time must cover disjoint node ranges, and no part may outlive
+    /// the borrow of the columns the target was made from.
+    unsafe fn part<'p>(&self, nodes: Range<usize>) -> Self::Part<'p>;
 }
 
 /// A node column lent to slabs that write to disjoint node ranges at the same time.
@@ -191,13 +190,10 @@ impl<'a, T> Disjoint<'a, T> {
 unsafe impl<T: Send> Sync for Disjoint<'_, T> {}
 unsafe impl<T: Send> Send for Disjoint<'_, T> {}
 
-impl<T: Send> NodeTarget for Disjoint<'_, T> {
-    type Part<'p>
-        = &'p mut [T]
-    where
-        Self: 'p;
+impl<T: Send + 'static> NodeTarget for Disjoint<'_, T> {
+    type Part<'p> = &'p mut [T];
 
-    unsafe fn part(&self, nodes: Range<usize>) -> &mut [T] {
+    unsafe fn part<'p>(&self, nodes: Range<usize>) -> &'p mut [T] {
         assert!(nodes.start <= nodes.end && nodes.end <= self.len);
         // SAFETY: in bounds (checked above); disjoint from other live parts by contract.
         unsafe { std::slice::from_raw_parts_mut(self.ptr.add(nodes.start), nodes.len()) }
@@ -205,24 +201,18 @@ impl<T: Send> NodeTarget for Disjoint<'_, T> {
 }
 
 impl<A: NodeTarget, B: NodeTarget> NodeTarget for (A, B) {
-    type Part<'p>
-        = (A::Part<'p>, B::Part<'p>)
-    where
-        Self: 'p;
+    type Part<'p> = (A::Part<'p>, B::Part<'p>);
 
-    unsafe fn part(&self, nodes: Range<usize>) -> Self::Part<'_> {
+    unsafe fn part<'p>(&self, nodes: Range<usize>) -> Self::Part<'p> {
         // SAFETY: forwarded contract.
         unsafe { (self.0.part(nodes.clone()), self.1.part(nodes)) }
     }
 }
 
 impl<A: NodeTarget, B: NodeTarget, C: NodeTarget> NodeTarget for (A, B, C) {
-    type Part<'p>
-        = (A::Part<'p>, B::Part<'p>, C::Part<'p>)
-    where
-        Self: 'p;
+    type Part<'p> = (A::Part<'p>, B::Part<'p>, C::Part<'p>);
 
-    unsafe fn part(&self, nodes: Range<usize>) -> Self::Part<'_> {
+    unsafe fn part<'p>(&self, nodes: Range<usize>) -> Self::Part<'p> {
         // SAFETY: forwarded contract.
         unsafe {
             (
@@ -251,14 +241,17 @@ impl SlabScatter {
     /// `kernel(points, part, first_node)` for every non-empty slab, where `part` is the slab's
     /// range of `target` starting at node id `first_node` and `points` are point indices.
     /// Returns the box of nodes the points reach.
-    pub fn scatter<'t, D: Dim, T: NodeTarget>(
+    ///
+    /// The kernel takes each part for the length of one call (it is generic over the part's
+    /// lifetime), so no part can outlive its phase and meet a part of the next one.
+    pub fn scatter<D: Dim, T: NodeTarget>(
         &mut self,
         grid: &Grid<D>,
         n: usize,
         position: impl Fn(usize) -> D::Vec + Sync,
         support: usize,
-        target: &'t T,
-        kernel: impl Fn(&[u32], T::Part<'t>, usize) + Sync,
+        target: &T,
+        kernel: impl for<'p> Fn(&[u32], T::Part<'p>, usize) + Sync,
     ) -> NodeBox {
         self.slabs.build(grid, n, position);
         let slabs = &self.slabs;
@@ -279,7 +272,8 @@ impl SlabScatter {
                 let nodes = Slabs::node_range(grid, s, support);
                 let first = nodes.start;
                 // SAFETY: the slabs of one phase cover disjoint node ranges (asserted above),
-                // and the phase's parts are dropped before the next phase starts.
+                // and the kernel cannot keep its part past the call, so none survives into
+                // the next phase.
                 let part = unsafe { target.part(nodes) };
                 kernel(slabs.points(s), part, first);
             });
