@@ -76,6 +76,13 @@ impl NodeBox {
         (0..3).map(|a| self.hi[a].saturating_sub(self.lo[a])).product()
     }
 
+    /// Sets `column`'s entries for every node of the box to `value`.
+    pub fn fill<D: Dim, T: Copy>(self, grid: &Grid<D>, column: &mut [T], value: T) {
+        for r in self.rows(grid) {
+            column[r].fill(value);
+        }
+    }
+
     /// The box's nodes as runs of consecutive node ids (one run per row along x), in
     /// ascending id order.
     pub fn rows<D: Dim>(self, grid: &Grid<D>) -> impl Iterator<Item = std::ops::Range<usize>> + '_ {

@@ -163,8 +163,8 @@ pub struct SolverState {
     /// Largest point movement over the last completed static-check window (m).
     pub static_window_movement: Option<f64>,
     /// The nodes the points reached this step. Every node outside holds zeros (mass,
-    /// momentum, forces, acceleration, velocity), so grid passes skip it: a scatter adds the nodes it reaches, the grid
-    /// reset zeroes the box and empties it.
+    /// momentum, forces, acceleration, velocity), so grid passes skip it: a scatter adds the
+    /// nodes it reaches, the grid reset zeroes the box and empties it.
     pub active_nodes: NodeBox,
 }
 

@@ -126,11 +126,13 @@ impl<D: Dim> System<D> for Convergence {
             let n = nodes(&ctx.world);
             let ne = col::<NodeExternalForce<D::Vec>>(n);
             let nv = col::<NodeVelocity<D::Vec>>(n);
-            let box_ = ctx.state.active_nodes;
-            box_.rows(&ctx.grid)
+            let power: f64 = ctx
+                .state
+                .active_nodes
+                .rows(&ctx.grid)
                 .map(|r| r.map(|i| ne[i].0.dot(nv[i].0)).sum::<f64>())
-                .sum::<f64>()
-                * ctx.state.dt
+                .sum();
+            power * ctx.state.dt
         };
         let s = &mut ctx.state;
         s.external_work += dw;

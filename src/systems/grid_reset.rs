@@ -18,22 +18,22 @@ impl<D: Dim> System<D> for GridReset {
     }
     fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
         let n = nodes(&ctx.world);
-        let mut nm = col_mut::<NodeMass>(n);
-        let mut np = col_mut::<NodeMomentum<D::Vec>>(n);
-        let mut nf = col_mut::<NodeForce<D::Vec>>(n);
-        let mut ne = col_mut::<NodeExternalForce<D::Vec>>(n);
-        let mut na = col_mut::<NodeAcceleration<D::Vec>>(n);
-        let mut nv = col_mut::<NodeVelocity<D::Vec>>(n);
+        let (b, grid, z) = (ctx.state.active_nodes, &ctx.grid, D::Vec::ZERO);
         // Only last step's box can hold anything (see `SolverState::active_nodes`).
-        for r in ctx.state.active_nodes.rows(&ctx.grid) {
-            nm[r.clone()].fill(NodeMass(0.0));
-            np[r.clone()].fill(NodeMomentum(D::Vec::ZERO));
-            nf[r.clone()].fill(NodeForce(D::Vec::ZERO));
-            ne[r.clone()].fill(NodeExternalForce(D::Vec::ZERO));
-            na[r.clone()].fill(NodeAcceleration(D::Vec::ZERO));
-            nv[r].fill(NodeVelocity(D::Vec::ZERO));
-        }
-        drop((nm, np, nf, ne, na, nv));
+        b.fill(grid, &mut col_mut::<NodeMass>(n), NodeMass(0.0));
+        b.fill(grid, &mut col_mut::<NodeMomentum<D::Vec>>(n), NodeMomentum(z));
+        b.fill(grid, &mut col_mut::<NodeForce<D::Vec>>(n), NodeForce(z));
+        b.fill(
+            grid,
+            &mut col_mut::<NodeExternalForce<D::Vec>>(n),
+            NodeExternalForce(z),
+        );
+        b.fill(
+            grid,
+            &mut col_mut::<NodeAcceleration<D::Vec>>(n),
+            NodeAcceleration(z),
+        );
+        b.fill(grid, &mut col_mut::<NodeVelocity<D::Vec>>(n), NodeVelocity(z));
         ctx.state.active_nodes = NodeBox::default();
         Ok(())
     }

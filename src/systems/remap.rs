@@ -36,17 +36,17 @@ impl<D: Dim, S: Shape> System<D> for Remap<D, S> {
         let n = nodes(&ctx.world);
         if ctx.state.reset_this_step {
             let mut nv = col_mut::<NodeVelocity<D::Vec>>(n);
-            for r in ctx.state.active_nodes.rows(&ctx.grid) {
-                nv[r].fill(NodeVelocity(D::Vec::ZERO));
-            }
+            ctx.state
+                .active_nodes
+                .fill(&ctx.grid, &mut nv, NodeVelocity(D::Vec::ZERO));
             return Ok(());
         }
         {
             let grid = &ctx.grid;
             let mut np = col_mut::<NodeMomentum<D::Vec>>(n);
-            for r in ctx.state.active_nodes.rows(grid) {
-                np[r].fill(NodeMomentum(D::Vec::ZERO));
-            }
+            ctx.state
+                .active_nodes
+                .fill(grid, &mut np, NodeMomentum(D::Vec::ZERO));
             let mut reached = ctx.state.active_nodes;
             for arch in points_with::<Velocity<D::Vec>>(&ctx.world) {
                 let (xg, mg, vg) = (

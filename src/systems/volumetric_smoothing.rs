@@ -105,9 +105,7 @@ impl<D: Dim, S: Shape> System<D> for VolumetricSmoothing<D, S> {
                 }
             });
         }
-        for r in active.rows(grid) {
-            sums[r].fill([0.0; 2]);
-        }
+        active.fill(grid, sums, [0.0; 2]);
         Ok(())
     }
 }
