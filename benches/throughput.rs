@@ -7,11 +7,44 @@
 //! The 100k block is also run in a grid with ten times as many nodes (50 × 50 × 54 cells
 //! instead of 23 × 23 × 25): only the nodes the points reach should cost time, so the
 //! per-step cost should stay within 1.2× (issue #5).
+//!
+//! And the 100k block with its points stored in random order (as after a flow has mixed
+//! them), left so (`sort_every = 0`) and after one spatial sort: what cell order is worth.
 
+use kdmpm::columns::{col_mut, points_with};
+use kdmpm::components::Position;
 use kdmpm::scene::{build, LoadedScene};
-use kdmpm::{with_simulation, Dim, Simulation};
+use kdmpm::systems::SpatialSort;
+use kdmpm::{with_simulation, Dim, Simulation, System};
 use std::path::Path;
 use std::time::Instant;
+
+/// How the points are stored when the timing starts.
+#[derive(Clone, Copy, PartialEq)]
+enum Order {
+    /// As set-up left them: cell order, body by body.
+    AsBuilt,
+    /// Shuffled, and never sorted.
+    Mixed,
+    /// Shuffled, then sorted once.
+    MixedThenSorted,
+}
+
+/// Stores the points in a random order. The blocks' points differ only in position at the
+/// start (same mass, volume, material, zero velocity and stress), so shuffling the
+/// positions alone relabels them without changing the problem.
+fn shuffle<D: Dim>(sim: &mut Simulation<D>) {
+    let mut state = 0x9E37_79B9_7F4A_7C15u64;
+    for arch in points_with::<Position<D::Vec>>(&sim.ctx.world) {
+        let mut x = col_mut::<Position<D::Vec>>(arch);
+        for i in (1..x.len()).rev() {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            x.swap(i, (state >> 33) as usize % (i + 1));
+        }
+    }
+}
 
 /// Times steps until `min_seconds` have passed (after a short warm-up).
 fn measure<D: Dim>(sim: &mut Simulation<D>, min_seconds: f64) -> (f64, u64) {
@@ -46,12 +79,21 @@ fn main() {
     println!("timing one system call costs {:.1} ns", per_call * 1e9);
     let filter: Option<String> = std::env::args().skip(1).find(|a| !a.starts_with('-'));
     let big_grid: &[&str] = &["grid.cells=[50, 50, 54]"];
-    let cases: [(&str, &str, f64, &[&str]); 5] = [
-        ("block_10k.ron", "3D block 10k", 2.0, &[]),
-        ("block_100k.ron", "3D block 100k", 3.0, &[]),
-        ("block_100k.ron", "  in 10× grid", 3.0, big_grid),
-        ("block_1m.ron", "3D block 1M", 6.0, &[]),
-        ("slope.ron", "2D slope", 3.0, &[]),
+    let unsorted: &[&str] = &["solver.sort_every=0"];
+    let cases: [(&str, &str, f64, &[&str], Order); 7] = [
+        ("block_10k.ron", "3D block 10k", 2.0, &[], Order::AsBuilt),
+        ("block_100k.ron", "3D block 100k", 3.0, &[], Order::AsBuilt),
+        ("block_100k.ron", "  in 10× grid", 3.0, big_grid, Order::AsBuilt),
+        ("block_100k.ron", "  mixed", 3.0, unsorted, Order::Mixed),
+        (
+            "block_100k.ron",
+            "  mixed, sorted",
+            3.0,
+            unsorted,
+            Order::MixedThenSorted,
+        ),
+        ("block_1m.ron", "3D block 1M", 6.0, &[], Order::AsBuilt),
+        ("slope.ron", "2D slope", 3.0, &[], Order::AsBuilt),
     ];
     // 2-thread rate of the 100k block in its own grid, to compare the 10× grid with.
     let mut block_100k = None;
@@ -59,7 +101,7 @@ fn main() {
         "{:<16} {:>9} {:>8} {:>14} {:>9}",
         "case", "points", "threads", "M pt-steps/s", "speed-up"
     );
-    for (file, label, seconds, overrides) in cases {
+    for (file, label, seconds, overrides, order) in cases {
         if filter.as_ref().is_some_and(|f| !file.contains(f.as_str())) {
             continue;
         }
@@ -76,6 +118,12 @@ fn main() {
             let (mut any, _) = build(&loaded).unwrap();
             let (rate, points, split) = pool.install(|| {
                 with_simulation!(&mut any, sim => {
+                    if order != Order::AsBuilt {
+                        shuffle(sim);
+                    }
+                    if order == Order::MixedThenSorted {
+                        SpatialSort::new(1).run(&mut sim.ctx).expect("sort");
+                    }
                     let (rate, _) = measure(sim, seconds);
                     (rate, sim.point_count(), sim.schedule.timings())
                 })
@@ -92,7 +140,7 @@ fn main() {
                 match block_100k {
                     None => block_100k = Some(rate),
                     Some(own) => println!(
-                        "{:<16} per-step cost in the 10× grid: {:.2}× its own grid's",
+                        "{:<16} per-step cost: {:.2}× the block's own, as built",
                         "",
                         own / rate
                     ),

@@ -37,6 +37,12 @@ pub struct Stress(pub Sym3);
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct VelocityGradient<M>(pub M);
 
+/// Label of a material point (or load carrier), given at set-up in spawn order and kept
+/// for the whole run. The spatial sort moves a point's data to another row of its
+/// archetype, so this label, not the entity or the row, is what identifies a point.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct PointId(pub u32);
+
 /// Index of the point's material in the simulation's material table.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct MaterialId(pub u16);

@@ -57,8 +57,8 @@ pub enum StepError {
         step: u64,
         /// System that detected it.
         system: &'static str,
-        /// Index of the point in storage order.
-        point: usize,
+        /// The point's [`PointId`](crate::components::PointId).
+        point: u32,
         /// Where it went (m).
         position: [f64; 3],
     },
@@ -94,10 +94,20 @@ pub enum StepError {
     LoadLost {
         /// Step number.
         step: u64,
-        /// Index of the loaded point.
-        point: usize,
+        /// The load carrier's [`PointId`](crate::components::PointId).
+        point: u32,
         /// Its position (m).
         position: [f64; 3],
+    },
+    /// The spatial sort met a point component it does not know (added by user code), which
+    /// it could not move along with the point's other data.
+    #[error(
+        "step {step}, system `spatial_sort`: a point carries a component added outside kdmpm, \
+         which the sort cannot move with the point: set solver.sort_every: 0 or drop `spatial_sort`"
+    )]
+    Unsortable {
+        /// Step number.
+        step: u64,
     },
     /// Writing output failed.
     #[error("writing output: {0}")]

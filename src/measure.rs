@@ -1,7 +1,7 @@
 //! Measurements of a state: free-surface angle, displacements, mass.
 
 use crate::columns::{col, points_with};
-use crate::components::{Displacement, Mass, Position};
+use crate::components::{Displacement, Mass, PointId, Position};
 use crate::dim::{Dim, Vector};
 use crate::simulation::Simulation;
 use serde::Serialize;
@@ -87,11 +87,20 @@ pub fn all_positions_finite<D: Dim>(sim: &Simulation<D>) -> bool {
         .all(|a| col::<Position<D::Vec>>(a).iter().all(|x| x.0.is_finite()))
 }
 
-/// Positions of every point (load carriers included), padded to x y z (m), in storage order.
+/// Positions of every point (load carriers included), padded to x y z (m), indexed by
+/// [`PointId`]: lists taken at two times compare point by point even if a spatial sort
+/// moved the points between rows in between.
 pub fn positions<D: Dim>(world: &hecs::World, out: &mut Vec<[f64; 3]>) {
     out.clear();
     for arch in points_with::<Position<D::Vec>>(world) {
-        out.extend(col::<Position<D::Vec>>(arch).iter().map(|x| D::vec_to3(x.0)));
+        let (x, id) = (col::<Position<D::Vec>>(arch), col::<PointId>(arch));
+        for (x, id) in x.iter().zip(id.iter()) {
+            let i = id.0 as usize;
+            if out.len() <= i {
+                out.resize(i + 1, [f64::NAN; 3]);
+            }
+            out[i] = D::vec_to3(x.0);
+        }
     }
 }
 

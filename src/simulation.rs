@@ -31,24 +31,44 @@ pub struct Context<D: Dim> {
 pub struct TracedPoint {
     /// Name given in the scene.
     pub name: String,
-    /// Its entity.
+    /// The point.
+    pub id: PointId,
+    /// The entity whose row held the point when last looked up: the spatial sort moves
+    /// point data between rows, so this is checked against `id` before use.
     pub entity: Entity,
     /// Position at the start (m).
     pub initial_position: [f64; 3],
 }
 
 impl TracedPoint {
+    /// The entity that holds the point now.
+    pub fn current_entity(&self, world: &World) -> Entity {
+        match world.get::<&PointId>(self.entity) {
+            Ok(id) if *id == self.id => self.entity,
+            _ => find_point(world, self.id).expect("traced point exists"),
+        }
+    }
+
     /// Displacement from the start (m, x y z), from the position alone: traced points need
     /// no displacement column.
     pub fn displacement<D: Dim>(&self, world: &World) -> [f64; 3] {
         let x = D::vec_to3(
             world
-                .get::<&Position<D::Vec>>(self.entity)
+                .get::<&Position<D::Vec>>(self.current_entity(world))
                 .expect("traced point exists")
                 .0,
         );
         std::array::from_fn(|a| x[a] - self.initial_position[a])
     }
+}
+
+/// The entity holding point `id`, by a scan of the point ids.
+pub fn find_point(world: &World, id: PointId) -> Option<Entity> {
+    world
+        .query::<(Entity, &PointId)>()
+        .iter()
+        .find(|(_, p)| **p == id)
+        .map(|(e, _)| e)
 }
 
 /// What a traced point reports at the end of a run.
@@ -84,7 +104,13 @@ impl<D: Dim> Simulation<D> {
         // time = n·Δt rather than a running sum, so long runs do not drift.
         s.time = s.step as f64 * s.dt;
         s.reset_this_step = false;
-        self.schedule.run(&mut self.ctx)
+        let result = self.schedule.run(&mut self.ctx);
+        if self.ctx.state.points_reordered {
+            for t in &mut self.traced {
+                t.entity = t.current_entity(&self.ctx.world);
+            }
+        }
+        result
     }
 
     /// Steps until a stop reason is set (convergence or a limit) or an error occurs.
@@ -117,7 +143,11 @@ impl<D: Dim> Simulation<D> {
         self.traced
             .iter()
             .map(|t| {
-                let e = self.ctx.world.entity(t.entity).expect("traced point exists");
+                let e = self
+                    .ctx
+                    .world
+                    .entity(t.current_entity(&self.ctx.world))
+                    .expect("traced point exists");
                 let stress = e.get::<&Stress>().map(|s| s.0).unwrap_or_default();
                 TracedResult {
                     name: t.name.clone(),

@@ -109,6 +109,8 @@ pub struct Settings {
     pub flip: f64,
     /// Smooth the volumetric strain rate through the grid before each stress update.
     pub volumetric_smoothing: bool,
+    /// Put the points back in cell order every this many steps (0: never).
+    pub sort_every: u64,
     /// Smallest mass that accelerates an interior node (kg): a_i = f_i / max(m_i, floor),
     /// scaled on the grid's faces by the node's share ([`crate::grid::Grid::inertia`]).
     pub virtual_mass_floor: f64,
@@ -154,6 +156,11 @@ pub struct SolverState {
     pub resets: u64,
     /// True when this step's peak watch zeroed the velocities (points do not move).
     pub reset_this_step: bool,
+    /// True when this step's spatial sort moved point data between rows: holders of row
+    /// indices or entities (traced points) must look their points up again by [`PointId`].
+    ///
+    /// [`PointId`]: crate::components::PointId
+    pub points_reordered: bool,
     /// Every peak at which velocities were reset.
     pub peaks: Vec<Peak>,
     /// Set when the run should stop after this step.

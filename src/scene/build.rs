@@ -192,6 +192,7 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
     // Mass of a node inside a filled region, ρ·h^D, for the lightest material in use.
     let mut full_node_mass = f64::INFINITY;
     let (gmin, gmax) = (D::vec_to3(grid.origin), D::vec_to3(grid.max_corner()));
+    let mut next_id = 0u32;
     for (b, body) in s.bodies.iter().enumerate() {
         let (lo, hi) = region_bounds(&body.region, n);
         if (0..n).any(|a| lo[a] < gmin[a] - 1e-9 || hi[a] > gmax[a] + 1e-9) {
@@ -207,9 +208,10 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
             ));
         }
         let points = fill_points(&grid, &body.region, &body.points_per_cell);
+        let count = points.clone().count();
         let xs = Counted {
-            left: points.clone().count(),
-            inner: points,
+            left: count,
+            inner: points.zip(next_id..),
         };
         if xs.left == 0 {
             return Err(loaded.invalid(
@@ -225,8 +227,18 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         let volume = cell_volume / body.points_per_cell.iter().product::<usize>() as f64;
         let mass = model.density() * volume;
         full_node_mass = full_node_mass.min(model.density() * cell_volume);
-        let common = |x: [f64; 3]| {
+        next_id = u32::try_from(count)
+            .ok()
+            .and_then(|c| next_id.checked_add(c))
+            .ok_or_else(|| {
+                loaded.invalid(
+                    &format!("bodies[{b}].points_per_cell"),
+                    "more than 4 294 967 295 points in all",
+                )
+            })?;
+        let common = |(x, id): ([f64; 3], u32)| {
             (
+                PointId(id),
                 Position(D::vec_from(x)),
                 Velocity(z),
                 Mass(mass),
@@ -242,20 +254,20 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         match (model.is_plastic(), s.output.displacements) {
             (true, true) => {
                 world.spawn_batch(xs.map(|x| {
-                    let (a, b, c, d, e, f, g) = common(x);
-                    (a, b, c, d, e, f, g, PlasticStrain(0.0), Displacement(z))
+                    let (a, b, c, d, e, f, g, h) = common(x);
+                    (a, b, c, d, e, f, g, h, PlasticStrain(0.0), Displacement(z))
                 }));
             }
             (true, false) => {
                 world.spawn_batch(xs.map(|x| {
-                    let (a, b, c, d, e, f, g) = common(x);
-                    (a, b, c, d, e, f, g, PlasticStrain(0.0))
+                    let (a, b, c, d, e, f, g, h) = common(x);
+                    (a, b, c, d, e, f, g, h, PlasticStrain(0.0))
                 }));
             }
             (false, true) => {
                 world.spawn_batch(xs.map(|x| {
-                    let (a, b, c, d, e, f, g) = common(x);
-                    (a, b, c, d, e, f, g, Displacement(z))
+                    let (a, b, c, d, e, f, g, h) = common(x);
+                    (a, b, c, d, e, f, g, h, Displacement(z))
                 }));
             }
             (false, false) => {
@@ -293,12 +305,19 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
             ));
         }
         let carrier = world.spawn((
+            PointId(next_id),
             Position(x),
             Velocity(z),
             Mass(0.0),
             VelocityGradient(D::MAT_ZERO),
             PointLoad(D::vec_from(pad3(&l.force))),
         ));
+        next_id = next_id.checked_add(1).ok_or_else(|| {
+            loaded.invalid(
+                &format!("point_loads[{i}]"),
+                "more than 4 294 967 295 points in all",
+            )
+        })?;
         if s.output.displacements {
             world.insert_one(carrier, Displacement(z)).expect("just spawned");
         }
@@ -309,15 +328,16 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
     for (i, t) in s.traced.iter().enumerate() {
         let want = pad3(&t.position);
         let dist = |x: &[f64; 3]| (0..3).map(|a| (x[a] - want[a]).powi(2)).sum::<f64>().sqrt();
-        let mut query = world.query::<(Entity, &Position<D::Vec>)>();
+        let mut query = world.query::<(Entity, &Position<D::Vec>, &PointId)>();
         let best = query
             .iter()
-            .map(|(e, x)| (D::vec_to3(x.0), e))
+            .map(|(e, x, id)| (D::vec_to3(x.0), e, *id))
             .min_by(|a, b| dist(&a.0).total_cmp(&dist(&b.0)));
         match best {
-            Some((x, e)) if dist(&x) <= s.grid.cell_size => traced.push(TracedPoint {
+            Some((x, entity, id)) if dist(&x) <= s.grid.cell_size => traced.push(TracedPoint {
                 name: t.name.clone(),
-                entity: e,
+                id,
+                entity,
                 initial_position: x,
             }),
             _ => {
@@ -342,6 +362,7 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         max_time: s.solver.max_time,
         static_check: s.solver.static_check,
         volumetric_smoothing: s.solver.volumetric_smoothing,
+        sort_every: s.solver.sort_every,
         flip: s.solver.flip,
         gravity: s.gravity.as_ref().map(|g| Gravity {
             acceleration: pad3(&g.acceleration),

@@ -230,6 +230,10 @@ pub struct SolverSpec {
     /// Smooth the volumetric strain rate through the grid (against volumetric locking).
     #[serde(default)]
     pub volumetric_smoothing: bool,
+    /// Put the points back in cell order every this many steps so that neighbours in space
+    /// stay neighbours in memory (default 100; 0 never sorts).
+    #[serde(default = "default_sort_every")]
+    pub sort_every: u64,
     /// Confirm a converged state is static before stopping: `(window: s, max_displacement: m)`.
     #[serde(default)]
     pub static_check: Option<StaticCheck>,
@@ -247,6 +251,10 @@ fn default_node_mass_cutoff() -> f64 {
 
 fn default_virtual_mass_floor() -> f64 {
     0.01
+}
+
+fn default_sort_every() -> u64 {
+    100
 }
 
 fn default_flip() -> f64 {

@@ -67,7 +67,6 @@ impl<D: Dim, S: Shape> System<D> for Kinematics<D, S> {
         let n = nodes(&ctx.world);
         let nvg = col::<NodeVelocity<D::Vec>>(n);
         let nv: &[NodeVelocity<D::Vec>] = &nvg;
-        let mut offset = 0;
         for arch in points_with::<Position<D::Vec>>(&ctx.world) {
             let mut xg = col_mut::<Position<D::Vec>>(arch);
             let mut lg = col_mut::<VelocityGradient<D::Mat>>(arch);
@@ -117,11 +116,12 @@ impl<D: Dim, S: Shape> System<D> for Kinematics<D, S> {
                 .flatten()
                 .next();
             if let Some((p, position)) = escaped {
+                let point = col::<PointId>(arch)[p].0;
                 return Err(if position.iter().all(|c| c.is_finite()) {
                     StepError::PointLeftGrid {
                         step,
                         system: name,
-                        point: offset + p,
+                        point,
                         position,
                     }
                 } else {
@@ -129,11 +129,10 @@ impl<D: Dim, S: Shape> System<D> for Kinematics<D, S> {
                         step,
                         system: name,
                         what: "position",
-                        location: format!("point {}", offset + p),
+                        location: format!("point {point}"),
                     }
                 });
             }
-            offset += xg.len();
         }
         Ok(())
     }

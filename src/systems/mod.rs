@@ -5,6 +5,7 @@
 //! | system          | file                 | what it does                                   |
 //! |-----------------|----------------------|------------------------------------------------|
 //! | `grid_reset`    | `grid_reset.rs`      | empty, undeformed grid                          |
+//! | `spatial_sort`  | `spatial_sort.rs`    | points back in cell order (every N steps)       |
 //! | `p2g`           | `p2g.rs`             | mass, momentum, internal force to the nodes     |
 //! | `gravity`       | `gravity.rs`         | body force m_i g (only with gravity)            |
 //! | `point_loads`   | `point_loads.rs`     | concentrated loads (only with loads)            |
@@ -35,6 +36,7 @@ pub mod p2g;
 pub mod peak_watch;
 pub mod point_loads;
 pub mod remap;
+pub mod spatial_sort;
 pub mod stress_update;
 pub mod volume_update;
 pub mod volumetric_smoothing;
@@ -51,6 +53,7 @@ pub use p2g::{P2g, P2gPart};
 pub use peak_watch::PeakWatch;
 pub use point_loads::PointLoads;
 pub use remap::Remap;
+pub use spatial_sort::SpatialSort;
 pub use stress_update::StressUpdate;
 pub use volume_update::VolumeUpdate;
 pub use volumetric_smoothing::VolumetricSmoothing;
@@ -70,6 +73,7 @@ pub struct Needs {
 /// Every system a scene may name in `solver.schedule`.
 pub const SYSTEM_NAMES: &[&str] = &[
     "grid_reset",
+    "spatial_sort",
     "p2g",
     "p2g_momentum",
     "nodal_velocity",
@@ -92,6 +96,16 @@ pub const SYSTEM_NAMES: &[&str] = &[
 
 /// Pairs (a, b): when both are scheduled, a must run before b.
 const ORDER: &[(&str, &str, &str)] = &[
+    (
+        "spatial_sort",
+        "p2g",
+        "the points are put in cell order before the step maps them",
+    ),
+    (
+        "spatial_sort",
+        "p2g_momentum",
+        "the points are put in cell order before the step maps them",
+    ),
     ("p2g", "gravity", "gravity acts on the nodal mass that p2g maps"),
     (
         "p2g_momentum",
@@ -212,6 +226,9 @@ const ORDER: &[(&str, &str, &str)] = &[
 /// The default list of system names for a scene's settings.
 pub fn default_names(settings: &Settings, needs: Needs) -> Vec<&'static str> {
     let mut n = vec!["grid_reset"];
+    if settings.sort_every > 0 {
+        n.push("spatial_sort");
+    }
     let forces = |n: &mut Vec<&'static str>| {
         if settings.gravity.is_some() {
             n.push("gravity");
@@ -307,6 +324,11 @@ pub fn check_names(names: &[String], settings: &Settings, needs: Needs) -> Resul
         }
     }
     let optional = [
+        (
+            "spatial_sort",
+            settings.sort_every > 0,
+            "solver.sort_every is above 0",
+        ),
         ("gravity", settings.gravity.is_some(), "the scene has gravity"),
         ("point_loads", needs.point_loads, "the scene has point loads"),
         (
@@ -363,6 +385,7 @@ pub fn schedule_from_names<D: Dim>(names: &[String], settings: &Settings, shape:
 fn make<D: Dim, S: Shape>(name: &str, settings: &Settings) -> Box<dyn System<D>> {
     match name {
         "grid_reset" => Box::new(GridReset),
+        "spatial_sort" => Box::new(SpatialSort::new(settings.sort_every)),
         "p2g" => Box::new(P2g::<D, S>::new(P2gPart::All)),
         "p2g_momentum" => Box::new(P2g::<D, S>::new(P2gPart::MassMomentum)),
         "p2g_force" => Box::new(P2g::<D, S>::new(P2gPart::InternalForce)),
@@ -406,6 +429,7 @@ mod tests {
                 ramp_time: 0.0,
             }),
             volumetric_smoothing: false,
+            sort_every: 100,
             flip: 1.0,
             min_node_mass: 0.0,
             virtual_mass_floor: 0.0,
@@ -439,7 +463,7 @@ mod tests {
         n[1] = "p2g_fast".into();
         let e = check_names(&n, &st, Needs::default()).unwrap_err();
         assert!(
-            e.contains("unknown system `p2g_fast`") && e.contains("grid_reset, p2g,"),
+            e.contains("unknown system `p2g_fast`") && e.contains("grid_reset, spatial_sort, p2g,"),
             "{e}"
         );
     }

@@ -38,6 +38,7 @@ impl<D: Dim, S: Shape> System<D> for PointLoads<D, S> {
         for arch in points_with::<PointLoad<D::Vec>>(&ctx.world) {
             let x = col::<Position<D::Vec>>(arch);
             let load = col::<PointLoad<D::Vec>>(arch);
+            let id = col::<PointId>(arch);
             for p in 0..x.len() {
                 let mut carried = 0.0;
                 for_each_node::<D, S>(grid, x[p].0, |i, w, _| {
@@ -48,7 +49,7 @@ impl<D: Dim, S: Shape> System<D> for PointLoads<D, S> {
                 if carried <= 0.0 {
                     return Err(StepError::LoadLost {
                         step: ctx.state.step,
-                        point: p,
+                        point: id[p].0,
                         position: D::vec_to3(x[p].0),
                     });
                 }

@@ -1,0 +1,189 @@
+//! Spatial sort: the points put back in cell order every few steps.
+//!
+//! The scatters group points by slab of cells every step, but read each point's data
+//! wherever it is stored. Points start in cell order; once a flow mixes them, neighbours in
+//! space end up far apart in memory and every transfer misses the cache. Reordering the
+//! columns by cell every `sort_every` steps keeps neighbours together.
+
+use crate::columns::{col, points_with};
+use crate::components::*;
+use crate::dim::Dim;
+use crate::error::StepError;
+use crate::grid::Grid;
+use crate::schedule::System;
+use crate::simulation::Context;
+use hecs::Archetype;
+use rayon::prelude::*;
+use std::any::TypeId;
+
+/// Every `every` steps, reorders each point archetype's rows by the id of the cell holding
+/// the point (a stable counting sort, so points of one cell keep their relative order).
+///
+/// All columns of the archetype move together, so the state is the same set of points with
+/// the same data; entities and row indices change meaning, [`PointId`] does not. The sort
+/// runs before the step maps anything, so no system sees a half-sorted state.
+#[derive(Debug)]
+pub struct SpatialSort {
+    every: u64,
+    /// `order[r]`: the row whose data goes to row `r` (reused between sorts).
+    order: Vec<u32>,
+    /// Points per cell key, then the next free row of each key.
+    counts: Vec<u32>,
+}
+
+impl SpatialSort {
+    /// A sort every `every` steps (≥ 1).
+    pub fn new(every: u64) -> Self {
+        SpatialSort {
+            every: every.max(1),
+            order: Vec::new(),
+            counts: Vec::new(),
+        }
+    }
+}
+
+impl<D: Dim> System<D> for SpatialSort {
+    fn name(&self) -> &str {
+        "spatial_sort"
+    }
+
+    fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
+        ctx.state.points_reordered = false;
+        if ctx.state.step % self.every != 0 {
+            return Ok(());
+        }
+        for arch in points_with::<Position<D::Vec>>(&ctx.world) {
+            if has_foreign_component::<D>(arch) {
+                return Err(StepError::Unsortable { step: ctx.state.step });
+            }
+            let sorted = {
+                let x = col::<Position<D::Vec>>(arch);
+                cell_order(&ctx.grid, &x, &mut self.counts, &mut self.order)
+            };
+            if !sorted {
+                reorder_columns::<D>(arch, &self.order);
+                ctx.state.points_reordered = true;
+            }
+        }
+        // The buffers are as large as the point set: give them back between sorts, so that
+        // they do not add to the memory a point costs for the whole run.
+        self.order = Vec::new();
+        self.counts = Vec::new();
+        Ok(())
+    }
+}
+
+/// Fills `order` with the rows of `x` in cell order (stable). Returns true when the rows
+/// already are in that order, so nothing needs to move.
+fn cell_order<D: Dim>(
+    grid: &Grid<D>,
+    x: &[Position<D::Vec>],
+    counts: &mut Vec<u32>,
+    order: &mut Vec<u32>,
+) -> bool {
+    // The id of a cell's lowest node orders cells as nodes are numbered: slab axis slowest,
+    // so a slab's points end up contiguous.
+    let key = |p: &Position<D::Vec>| grid.node_id(grid.clamped_cell(p.0));
+    if x.windows(2).all(|w| key(&w[0]) <= key(&w[1])) {
+        return true;
+    }
+    counts.clear();
+    counts.resize(grid.node_count() + 1, 0);
+    for p in x {
+        counts[key(p) + 1] += 1;
+    }
+    for k in 1..counts.len() {
+        counts[k] += counts[k - 1];
+    }
+    order.clear();
+    order.resize(x.len(), 0);
+    for (row, p) in x.iter().enumerate() {
+        let slot = &mut counts[key(p)];
+        order[*slot as usize] = row as u32;
+        *slot += 1;
+    }
+    false
+}
+
+/// A column whose rows can be permuted in place.
+trait Reorder: Send {
+    /// Row `r` receives the old row `order[r]`.
+    fn reorder(&mut self, order: &[u32]);
+}
+
+impl<T: Copy + Send> Reorder for &mut [T] {
+    fn reorder(&mut self, order: &[u32]) {
+        // Cycle by cycle, so the only extra memory is one bit a row.
+        let mut done = vec![0u64; order.len().div_ceil(64)];
+        for start in 0..order.len() {
+            if done[start / 64] & (1 << (start % 64)) != 0 {
+                continue;
+            }
+            let first = self[start];
+            let mut row = start;
+            loop {
+                done[row / 64] |= 1 << (row % 64);
+                let from = order[row] as usize;
+                if from == start {
+                    self[row] = first;
+                    break;
+                }
+                self[row] = self[from];
+                row = from;
+            }
+        }
+    }
+}
+
+/// Calls `$body` with `$ty` bound to every component type a point can carry.
+macro_rules! point_components {
+    ($d:ty, $mac:ident) => {
+        $mac!(
+            Position<<$d as Dim>::Vec>,
+            Velocity<<$d as Dim>::Vec>,
+            Displacement<<$d as Dim>::Vec>,
+            PointLoad<<$d as Dim>::Vec>,
+            VelocityGradient<<$d as Dim>::Mat>,
+            Mass,
+            Volume,
+            Stress,
+            MaterialId,
+            PlasticStrain,
+            PointId
+        )
+    };
+}
+
+/// True when `arch` holds a component that is none of the point components above (added
+/// by user code): the sort could not move it along with the rest.
+fn has_foreign_component<D: Dim>(arch: &Archetype) -> bool {
+    macro_rules! known {
+        ($($t:ty),*) => { [$(TypeId::of::<$t>()),*] };
+    }
+    let known = point_components!(D, known);
+    arch.component_types().any(|t| !known.contains(&t))
+}
+
+/// Moves every column of `arch` by `order`, one column per task.
+fn reorder_columns<D: Dim>(arch: &Archetype, order: &[u32]) {
+    macro_rules! borrow_all {
+        (@push $g:ident $jobs:ident; $($t:ty),*) => {
+            borrow_all!(@zip $g $jobs; [0 1 2 3 4 5 6 7 8 9 10] [$($t),*])
+        };
+        (@zip $g:ident $jobs:ident; [$i:tt $($is:tt)*] [$t:ty $(, $ts:ty)*]) => {
+            if let Some(c) = $g.$i.as_deref_mut() {
+                $jobs.push(Box::new(c));
+            }
+            borrow_all!(@zip $g $jobs; [$($is)*] [$($ts),*])
+        };
+        (@zip $g:ident $jobs:ident; [$($is:tt)*] []) => {};
+        ($($t:ty),*) => {{
+            // The column borrows live here, on this thread; the tasks get plain slices.
+            let mut guards = ($(arch.get::<&mut $t>(),)*);
+            let mut jobs: Vec<Box<dyn Reorder + '_>> = Vec::new();
+            borrow_all!(@push guards jobs; $($t),*);
+            jobs.into_par_iter().for_each(|mut j| j.reorder(order));
+        }};
+    }
+    point_components!(D, borrow_all);
+}
