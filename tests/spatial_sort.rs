@@ -13,9 +13,8 @@ use kdmpm::{AnySimulation, Dim2, Simulation, StepError, System};
 use std::collections::BTreeMap;
 use std::path::Path;
 
-/// A cohesionless (plastic) bank with a heap spawned after it *below* its top and a load
-/// on its crest: the heap's points come later in memory than the bank's points above them,
-/// so the scene starts out of cell order.
+/// A cohesionless (plastic) bank on a layer, spawned after it, with a load on its crest.
+/// Set-up sorts the points; as the bank fails, points cross cells and fall out of order.
 const SCENE: &str = r#"Scene(
     dimension: 2,
     grid: (origin: [0.0, 0.0], cell_size: 0.5, cells: [40, 16]),
@@ -99,14 +98,25 @@ fn is_sorted(keys: &[usize]) -> bool {
 }
 
 #[test]
+fn set_up_leaves_the_points_in_cell_order() {
+    // Bodies are filled row of points by row of points, and the layer after the bank.
+    let sim = simulation(1, 0);
+    assert!(cell_keys(&sim).iter().all(|k| is_sorted(k)));
+    let ids: Vec<u32> = points_with::<PointId>(&sim.ctx.world)
+        .flat_map(|a| col::<PointId>(a).iter().map(|id| id.0).collect::<Vec<_>>())
+        .collect();
+    assert!(ids.windows(2).any(|w| w[0] > w[1]), "the sort reordered the fill");
+}
+
+#[test]
 fn sorting_puts_rows_in_cell_order_and_every_point_keeps_all_its_data() {
-    // 60 steps without sorting: the bank yields, so velocities, gradients, stresses and
-    // plastic strains are all non-trivial.
-    let mut sim = simulation(60, 0);
+    // 400 steps without sorting: the bank fails, so points have crossed cells, and
+    // velocities, gradients, stresses and plastic strains are all non-trivial.
+    let mut sim = simulation(400, 0);
     sim.run(|_| {}).unwrap();
     assert!(
         cell_keys(&sim).iter().any(|k| !is_sorted(k)),
-        "the scene should start out of cell order"
+        "the failing bank should have mixed the points"
     );
     let before = records(&sim);
     assert!(

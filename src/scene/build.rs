@@ -12,6 +12,7 @@ use crate::materials::Material;
 use crate::shape::{for_each_node, Linear, QuadraticBSpline, ShapeKind};
 use crate::simulation::{AnySimulation, Context, Simulation, TracedPoint};
 use crate::state::{Gravity, Settings, SolverState};
+use crate::systems::spatial_sort::sort_points;
 use crate::systems::{check_names, default_names, schedule_from_names, Needs};
 use crate::tensor::Sym3;
 use hecs::{Entity, World};
@@ -187,7 +188,7 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         )
     }));
 
-    // Material points, body by body (cell order within a body keeps them spatially sorted).
+    // Material points, body by body.
     let cell_volume = s.grid.cell_size.powi(n as i32);
     // Mass of a node inside a filled region, ρ·h^D, for the lightest material in use.
     let mut full_node_mass = f64::INFINITY;
@@ -322,6 +323,10 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
             world.insert_one(carrier, Displacement(z)).expect("just spawned");
         }
     }
+
+    // Bodies are filled row of points by row of points; cell order keeps the points that
+    // share nodes together in memory from the first step.
+    sort_points(&world, &grid).expect("set-up spawns only kdmpm components");
 
     // Traced points: the nearest point within one cell.
     let mut traced = Vec::new();
