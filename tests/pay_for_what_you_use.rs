@@ -1,6 +1,6 @@
 //! A scene pays only for what it uses: no gravity system without gravity, no plastic state
 //! on elastic points, no peak watch without kinetic damping, no point-load system without
-//! loads; 2D scenes store 2-vectors.
+//! loads, no sort system when sorting is off; 2D scenes store 2-vectors.
 
 use kdmpm::columns::points_with;
 use kdmpm::components::{PlasticStrain, PointLoad, Position, Stress};
@@ -43,6 +43,18 @@ fn viscous_damping_has_no_peak_watch_and_musl_only_has_a_remap() {
         panic!()
     };
     assert!(!usl.schedule.names().contains(&"remap".to_string()));
+}
+
+#[test]
+fn a_scene_that_never_sorts_has_no_sort_system() {
+    let AnySimulation::Three(sorted) = load("bar.ron", &[]) else {
+        panic!()
+    };
+    assert!(sorted.schedule.names().contains(&"spatial_sort".to_string()));
+    let AnySimulation::Three(never) = load("bar.ron", &["solver.sort_every=0"]) else {
+        panic!()
+    };
+    assert!(!never.schedule.names().contains(&"spatial_sort".to_string()));
 }
 
 #[test]
