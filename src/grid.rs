@@ -211,9 +211,15 @@ impl<D: Dim> Grid<D> {
     pub fn clamped_cell(&self, x: D::Vec) -> [usize; 3] {
         let mut c = [0usize; 3];
         for (a, ca) in c.iter_mut().enumerate().take(D::N) {
-            *ca = (self.grid_coordinate(x, a).max(0.0) as usize).min(self.cells[a] - 1);
+            *ca = self.clamped_cell_along(x, a);
         }
         c
+    }
+
+    /// Index of the cell holding `x` along `axis`, clamped into the grid.
+    #[inline(always)]
+    pub fn clamped_cell_along(&self, x: D::Vec, axis: usize) -> usize {
+        cell_index(self.grid_coordinate(x, axis), self.cells[axis])
     }
 
     /// The nodes a stencil of `support` nodes per axis can reach from cells `lo ..= hi`: it
@@ -259,21 +265,32 @@ impl<D: Dim> Grid<D> {
             if !(xi >= 0.0 && xi <= self.cells[a] as f64) {
                 return None;
             }
-            *ca = (xi as usize).min(self.cells[a] - 1);
+            *ca = cell_index(xi, self.cells[a]);
         }
         Some(c)
     }
 
-    /// Linear cell id of `x` (for sorting points by cell), or `None` outside the grid.
-    pub fn cell_id(&self, x: D::Vec) -> Option<usize> {
-        self.cell_of(x)
-            .map(|c| c[0] + self.cells[0] * (c[1] + self.cells[1].max(1) * c[2]))
+    /// Sort key of the cell holding `x` (clamped into the grid): the id of the cell's lowest
+    /// node, so that cells come in the order nodes are numbered, slab axis slowest.
+    #[inline(always)]
+    pub fn cell_key(&self, x: D::Vec) -> usize {
+        self.node_id(self.clamped_cell(x))
     }
 
     /// True when `x` lies inside the grid's bounding box (faces included).
     pub fn contains(&self, x: D::Vec) -> bool {
         self.cell_of(x).is_some()
     }
+}
+
+/// Index of the cell holding grid coordinate `xi` (cell units from the origin) on an axis of
+/// `cells` cells, clamped into `0 .. cells`: a point on the upper face belongs to the last
+/// cell, one below the lower face to the first.
+#[inline(always)]
+pub fn cell_index(xi: f64, cells: usize) -> usize {
+    // Through a signed integer: f64 → i64 is one instruction on x86-64, f64 → u64 a branchy
+    // sequence, and this runs for every point in every transfer of every step.
+    (xi as i64).max(0).min(cells as i64 - 1) as usize
 }
 
 #[cfg(test)]

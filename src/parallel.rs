@@ -108,7 +108,7 @@ impl Slabs {
             .enumerate()
             .for_each(|(c, first)| {
                 for p in chunk(c) {
-                    let s = grid.clamped_cell(position(p))[axis];
+                    let s = grid.clamped_cell_along(position(p), axis);
                     // SAFETY: `first[s]` walks the range of `order` that belongs to this chunk's
                     // points in slab `s` alone, and stays below `n`.
                     unsafe { order.write(first[s] as usize, p as u32) };

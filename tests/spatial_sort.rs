@@ -87,7 +87,7 @@ fn cell_keys(sim: &Simulation<Dim2>) -> Vec<Vec<usize>> {
         .map(|arch| {
             col::<Position<DVec2>>(arch)
                 .iter()
-                .map(|x| grid.node_id(grid.clamped_cell(x.0)))
+                .map(|x| grid.cell_key(x.0))
                 .collect()
         })
         .collect()

@@ -23,7 +23,7 @@ impl Shape for QuadraticBSpline {
         // xi ≥ 0 inside the grid, so truncation is floor except on [−1/2, 0), which is −1;
         // this avoids a libm call (no SSE4.1 rounding on the baseline x86-64 target).
         let t = xi - 0.5;
-        let b = if t < 0.0 { -1.0 } else { (t as u64) as f64 };
+        let b = if t < 0.0 { -1.0 } else { (t as i64) as f64 };
         let d = xi - (b + 1.0); // in [-1/2, 1/2)
         let w0 = 0.5 * (0.5 - d) * (0.5 - d);
         let w1 = 0.75 - d * d;

@@ -1,6 +1,7 @@
 //! Linear hat functions (bilinear/trilinear by tensor product).
 
 use super::{Shape, Stencil1};
+use crate::grid::cell_index;
 
 /// Linear hat function: w = 1 − |x − x_i|/h on the two nodes of the cell holding the point.
 #[derive(Clone, Copy, Debug, Default)]
@@ -14,7 +15,7 @@ impl Shape for Linear {
     fn eval_1d(xi: f64, cells: usize, inv_h: f64) -> Stencil1 {
         // A point on the upper face belongs to the last cell, so it never reaches a node
         // beyond the grid.
-        let base = (xi.max(0.0) as usize).min(cells.saturating_sub(1));
+        let base = cell_index(xi, cells);
         let f = xi - base as f64;
         Stencil1 {
             base,

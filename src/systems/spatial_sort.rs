@@ -90,9 +90,8 @@ fn cell_order<D: Dim>(
     counts: &mut Vec<u32>,
     order: &mut Vec<u32>,
 ) -> bool {
-    // The id of a cell's lowest node orders cells as nodes are numbered: slab axis slowest,
-    // so a slab's points end up contiguous.
-    let key = |p: &Position<D::Vec>| grid.node_id(grid.clamped_cell(p.0));
+    // Slab axis slowest: a slab's points end up contiguous.
+    let key = |p: &Position<D::Vec>| grid.cell_key(p.0);
     if x.windows(2).all(|w| key(&w[0]) <= key(&w[1])) {
         return true;
     }
