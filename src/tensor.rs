@@ -253,17 +253,36 @@ pub fn jaumann_rotate(stress: &Sym3, w: [f64; 3]) -> Sym3 {
     if w[0] == 0.0 && w[1] == 0.0 {
         return rotate_about_z(stress, w[2]);
     }
-    // Half-spin matrix Â = W/2 with W_xy = w[2], W_yz = w[0], W_zx = w[1] (W skew).
+    // Half-spin Â = W/2 with W_xy = w[2], W_yz = w[0], W_zx = w[1] (W skew), so that
+    // Âv = v × â with â = (a, b, c) and Â² = ââᵀ − |â|² I.
     let (a, b, c) = (0.5 * w[0], 0.5 * w[1], 0.5 * w[2]);
-    let half = DMat3::from_cols(
-        DVec3::new(0.0, -c, b),
-        DVec3::new(c, 0.0, -a),
-        DVec3::new(-b, a, 0.0),
-    );
-    // Cayley: R = I + 2/(1 + |a|²) (Â + Â²).
-    let k = 2.0 / (1.0 + a * a + b * b + c * c);
-    let r = DMat3::IDENTITY + (half + half * half) * k;
-    Sym3::from_mat3(&(r * stress.to_mat3() * r.transpose()))
+    let n2 = a * a + b * b + c * c;
+    // Cayley: R = I + 2/(1 + |â|²) (Â + Â²).
+    let k = 2.0 / (1.0 + n2);
+    let d = 1.0 - k * n2;
+    let r = [
+        [d + k * a * a, k * (a * b + c), k * (a * c - b)],
+        [k * (a * b - c), d + k * b * b, k * (b * c + a)],
+        [k * (a * c + b), k * (b * c - a), d + k * c * c],
+    ];
+    // R σ Rᵀ: T = Rσ in full, then only the six independent entries of T Rᵀ.
+    let s = [
+        [stress.xx, stress.xy, stress.zx],
+        [stress.xy, stress.yy, stress.yz],
+        [stress.zx, stress.yz, stress.zz],
+    ];
+    let t: [[f64; 3]; 3] = std::array::from_fn(|i| {
+        std::array::from_fn(|j| r[i][0] * s[0][j] + r[i][1] * s[1][j] + r[i][2] * s[2][j])
+    });
+    let e = |i: usize, j: usize| t[i][0] * r[j][0] + t[i][1] * r[j][1] + t[i][2] * r[j][2];
+    Sym3 {
+        xx: e(0, 0),
+        yy: e(1, 1),
+        zz: e(2, 2),
+        xy: e(0, 1),
+        yz: e(1, 2),
+        zx: e(2, 0),
+    }
 }
 
 /// The Cayley rotation of [`jaumann_rotate`] for a spin about z only (all of plane strain):
@@ -440,6 +459,26 @@ mod tests {
             assert!(
                 (fast - general).norm() < 1e-12 * s.norm(),
                 "{fast:?} vs {general:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn general_rotation_matches_the_matrix_form_of_the_cayley_transform() {
+        // R = (I − Â)⁻¹(I + Â), Â = W/2, built and applied as full 3×3 matrices.
+        let s = sample();
+        for w in [[0.3, -0.7, 1.1], [-2.0, 0.5, 0.0], [1e-4, 2e-4, -3e-4]] {
+            let half = DMat3::from_cols(
+                DVec3::new(0.0, -w[2], w[1]),
+                DVec3::new(w[2], 0.0, -w[0]),
+                DVec3::new(-w[1], w[0], 0.0),
+            ) * 0.5;
+            let r = (DMat3::IDENTITY - half).inverse() * (DMat3::IDENTITY + half);
+            let matrix = Sym3::from_mat3(&(r * s.to_mat3() * r.transpose()));
+            let fast = jaumann_rotate(&s, w);
+            assert!(
+                (fast - matrix).norm() < 1e-12 * s.norm(),
+                "{w:?}: {fast:?} vs {matrix:?}"
             );
         }
     }
