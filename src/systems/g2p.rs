@@ -48,16 +48,16 @@ impl<D: Dim, S: Shape> System<D> for G2p<D, S> {
                     let mut e = 0.0;
                     for (k, vp) in v.iter_mut().enumerate() {
                         let p = c * CHUNK + k;
-                        let (mut a, mut vg) = (D::Vec::ZERO, D::Vec::ZERO);
-                        for_each_node::<D, S>(grid, x[p].0, |i, w, _| {
-                            a += na[i].0 * w;
-                            if pic {
-                                vg += nv[i].0 * w;
-                            }
-                        });
+                        let mut a = D::Vec::ZERO;
                         vp.0 = if pic {
+                            let mut vg = D::Vec::ZERO;
+                            for_each_node::<D, S>(grid, x[p].0, |i, w, _| {
+                                a += na[i].0 * w;
+                                vg += nv[i].0 * w;
+                            });
                             (vp.0 + a * dt) * flip + vg * (1.0 - flip)
                         } else {
+                            for_each_node::<D, S>(grid, x[p].0, |i, w, _| a += na[i].0 * w);
                             vp.0 + a * dt
                         };
                         e += m[p].0 * vp.0.dot(vp.0);

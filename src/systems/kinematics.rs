@@ -87,15 +87,16 @@ impl<D: Dim, S: Shape> System<D> for Kinematics<D, S> {
                     for k in 0..x.len() {
                         let mut lp = D::MAT_ZERO;
                         let mut vel = D::Vec::ZERO;
-                        for_each_node::<D, S>(grid, x[k].0, |i, w, grad| {
-                            let vi = nv[i].0;
-                            if gradient {
-                                D::add_outer(&mut lp, vi, grad);
-                            }
-                            vel += vi * w;
-                        });
+                        // One loop per case, so that the node loop holds no branch.
                         if gradient {
+                            for_each_node::<D, S>(grid, x[k].0, |i, w, grad| {
+                                let vi = nv[i].0;
+                                D::add_outer(&mut lp, vi, grad);
+                                vel += vi * w;
+                            });
                             l[k].0 = lp;
+                        } else {
+                            for_each_node::<D, S>(grid, x[k].0, |i, w, _| vel += nv[i].0 * w);
                         }
                         if motion {
                             let du = vel * dt;

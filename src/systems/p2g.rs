@@ -97,16 +97,28 @@ impl<D: Dim, S: Shape> System<D> for P2g<D, S> {
                             (Some((s, vol)), true) => Some((&s[p].0, -vol[p].0)),
                             _ => None,
                         };
-                        for_each_node::<D, S>(grid, x[p].0, |i, w, grad| {
-                            let k = i - lo;
-                            if mass_momentum {
+                        // One loop per case, so that the node loop holds no branch.
+                        match (mass_momentum, f) {
+                            (true, Some((s, neg_vol))) => {
+                                for_each_node::<D, S>(grid, x[p].0, |i, w, grad| {
+                                    let k = i - lo;
+                                    nm[k].0 += w * mp;
+                                    np[k].0 += mv * w;
+                                    nf[k].0 += D::stress_dot(s, grad) * neg_vol;
+                                })
+                            }
+                            (true, None) => for_each_node::<D, S>(grid, x[p].0, |i, w, _| {
+                                let k = i - lo;
                                 nm[k].0 += w * mp;
                                 np[k].0 += mv * w;
+                            }),
+                            (false, Some((s, neg_vol))) => {
+                                for_each_node::<D, S>(grid, x[p].0, |i, _, grad| {
+                                    nf[i - lo].0 += D::stress_dot(s, grad) * neg_vol;
+                                })
                             }
-                            if let Some((s, neg_vol)) = f {
-                                nf[k].0 += D::stress_dot(s, grad) * neg_vol;
-                            }
-                        });
+                            (false, None) => {}
+                        }
                     }
                 },
             ));
