@@ -199,11 +199,12 @@ fn run_dim<D: Dim>(
     });
     let wall = start.elapsed().as_secs_f64();
     let error = result.as_ref().err().map(|e| e.to_string());
-    let summary = Summary::collect(&scene.display().to_string(), sim, wall, error);
     if let Err(e) = kdmpm::output::vtk::write_points(sim, &out.join("points.vtu")) {
         eprintln!("error: cannot write points.vtu: {e}");
         return ExitCode::from(BAD_INPUT);
     }
+    // After the output, so that the peak memory covers the whole run.
+    let summary = Summary::collect(&scene.display().to_string(), sim, wall, error);
     let json = serde_json::to_string_pretty(&summary).expect("summary serialises");
     if let Err(e) = std::fs::write(out.join("summary.json"), json) {
         eprintln!("error: cannot write summary.json: {e}");

@@ -56,7 +56,8 @@ pub struct Summary {
     pub wall_seconds: f64,
     /// Points × steps per wall second of the stepping loop.
     pub particle_steps_per_second: f64,
-    /// Peak resident memory of the process (bytes; Linux only).
+    /// Peak resident memory of the process over the whole run, set-up and the writing of
+    /// `points.vtu` included (bytes; Linux only).
     pub peak_memory_bytes: Option<u64>,
     /// Largest displacement magnitude of any point (m), unless the scene keeps none.
     pub max_displacement: Option<f64>,

@@ -4,101 +4,131 @@ use crate::columns::{col, points_with};
 use crate::components::*;
 use crate::dim::Dim;
 use crate::simulation::Simulation;
-use std::fmt::Write as _;
+use hecs::{Archetype, Component};
+use std::fs::File;
+use std::io::{BufWriter, Write};
 use std::path::Path;
 
 /// Writes every material point (load carriers excluded) in [`PointId`] order, whatever
 /// order the spatial sort left them in, with its id, displacement (m, when kept), stress
 /// (Pa, tension positive: xx yy zz xy yz zx), mean stress (Pa), volume (m³) and, when
 /// present, accumulated plastic strain.
+///
+/// The file is streamed field by field straight from the columns: besides the buffered
+/// writer, writing holds 8 bytes a point (where each id is), so output does not raise the
+/// run's peak memory.
 pub fn write_points<D: Dim>(sim: &Simulation<D>, path: &Path) -> std::io::Result<()> {
-    let (mut ids, mut xs, mut us, mut ss, mut vols, mut eps) = (
-        Vec::new(),
-        Vec::new(),
-        Vec::new(),
-        Vec::new(),
-        Vec::new(),
-        Vec::new(),
-    );
-    for arch in points_with::<Stress>(&sim.ctx.world) {
-        let plastic = arch.get::<&PlasticStrain>();
-        let displacement = arch.get::<&Displacement<D::Vec>>();
-        ids.extend(col::<PointId>(arch).iter().map(|id| id.0));
-        for (p, (x, (s, v))) in col::<Position<D::Vec>>(arch)
-            .iter()
-            .zip(col::<Stress>(arch).iter().zip(col::<Volume>(arch).iter()))
-            .enumerate()
-        {
-            xs.push(D::vec_to3(x.0));
-            if let Some(u) = &displacement {
-                us.push(D::vec_to3(u[p].0));
+    let archs: Vec<&Archetype> = points_with::<Stress>(&sim.ctx.world).collect();
+    // Where the point of each id is: archetype in the high half, row in the low half. Ids
+    // are dense (spawn order; the few load carriers leave gaps), so this is a direct map.
+    let points = archs.iter().map(|a| a.len() as usize).sum::<usize>();
+    let mut at = Vec::with_capacity(points);
+    for (a, arch) in archs.iter().enumerate() {
+        for (r, id) in col::<PointId>(arch).iter().enumerate() {
+            let i = id.0 as usize;
+            if at.len() <= i {
+                at.resize(i + 1, NONE);
             }
-            ss.push(s.0);
-            vols.push(v.0);
-            eps.push(plastic.as_ref().map_or(0.0, |e| e[p].0));
+            at[i] = (a as u64) << 32 | r as u64;
         }
     }
-    let n = xs.len();
-    let mut rows: Vec<usize> = (0..n).collect();
-    rows.sort_unstable_by_key(|&r| ids[r]);
-    let mut out = String::with_capacity(n * 200);
-    out.push_str("<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n");
-    let _ = writeln!(
+    let order = Order(at);
+    let n = points;
+    let mut out = BufWriter::with_capacity(1 << 20, File::create(path)?);
+    out.write_all(b"<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n")?;
+    writeln!(
         out,
         "<UnstructuredGrid><Piece NumberOfPoints=\"{n}\" NumberOfCells=\"{n}\">"
-    );
-    out.push_str("<Points><DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n");
-    for x in rows.iter().map(|&r| &xs[r]) {
-        let _ = writeln!(out, "{:e} {:e} {:e}", x[0], x[1], x[2]);
-    }
-    out.push_str(
-        "</DataArray></Points>\n<Cells>\n<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n",
-    );
+    )?;
+    out.write_all(b"<Points><DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n")?;
+    each::<Position<D::Vec>>(&archs, &order, &mut out, |out, x| {
+        let x = D::vec_to3(x.0);
+        writeln!(out, "{:e} {:e} {:e}", x[0], x[1], x[2])
+    })?;
+    out.write_all(b"</DataArray></Points>\n<Cells>\n<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n")?;
     for i in 0..n {
-        let _ = write!(out, "{i} ");
+        write!(out, "{i} ")?;
     }
-    out.push_str("\n</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n");
+    out.write_all(b"\n</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n")?;
     for i in 0..n {
-        let _ = write!(out, "{} ", i + 1);
+        write!(out, "{} ", i + 1)?;
     }
-    out.push_str("\n</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n");
-    out.push_str(&"1 ".repeat(n));
-    out.push_str("\n</DataArray>\n</Cells>\n<PointData>\n");
-    out.push_str("<DataArray type=\"UInt32\" Name=\"id\" format=\"ascii\">\n");
-    for r in &rows {
-        let _ = write!(out, "{} ", ids[*r]);
+    out.write_all(b"\n</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n")?;
+    for _ in 0..n {
+        out.write_all(b"1 ")?;
     }
-    out.push_str("\n</DataArray>\n");
+    out.write_all(b"\n</DataArray>\n</Cells>\n<PointData>\n")?;
+    out.write_all(b"<DataArray type=\"UInt32\" Name=\"id\" format=\"ascii\">\n")?;
+    for (id, _, _) in order.points() {
+        write!(out, "{id} ")?;
+    }
+    out.write_all(b"\n</DataArray>\n")?;
     // Displacements only when the scene keeps them (`output.displacements`).
-    if us.len() == n && n > 0 {
-        out.push_str(
-            "<DataArray type=\"Float64\" Name=\"displacement\" NumberOfComponents=\"3\" format=\"ascii\">\n",
-        );
-        for u in rows.iter().map(|&r| &us[r]) {
-            let _ = writeln!(out, "{:e} {:e} {:e}", u[0], u[1], u[2]);
-        }
-        out.push_str("</DataArray>\n");
+    if n > 0 && archs.iter().all(|a| a.has::<Displacement<D::Vec>>()) {
+        out.write_all(
+            b"<DataArray type=\"Float64\" Name=\"displacement\" NumberOfComponents=\"3\" format=\"ascii\">\n",
+        )?;
+        each::<Displacement<D::Vec>>(&archs, &order, &mut out, |out, u| {
+            let u = D::vec_to3(u.0);
+            writeln!(out, "{:e} {:e} {:e}", u[0], u[1], u[2])
+        })?;
+        out.write_all(b"</DataArray>\n")?;
     }
-    out.push_str("<DataArray type=\"Float64\" Name=\"stress\" NumberOfComponents=\"6\" format=\"ascii\">\n");
-    for s in rows.iter().map(|&r| &ss[r]) {
-        let _ = writeln!(
+    out.write_all(
+        b"<DataArray type=\"Float64\" Name=\"stress\" NumberOfComponents=\"6\" format=\"ascii\">\n",
+    )?;
+    each::<Stress>(&archs, &order, &mut out, |out, s| {
+        let s = &s.0;
+        writeln!(
             out,
             "{:e} {:e} {:e} {:e} {:e} {:e}",
             s.xx, s.yy, s.zz, s.xy, s.yz, s.zx
-        );
+        )
+    })?;
+    out.write_all(b"</DataArray>\n<DataArray type=\"Float64\" Name=\"mean_stress\" format=\"ascii\">\n")?;
+    each::<Stress>(&archs, &order, &mut out, |out, s| {
+        writeln!(out, "{:e}", s.0.trace() / 3.0)
+    })?;
+    out.write_all(b"</DataArray>\n<DataArray type=\"Float64\" Name=\"volume\" format=\"ascii\">\n")?;
+    each::<Volume>(&archs, &order, &mut out, |out, v| writeln!(out, "{:e}", v.0))?;
+    out.write_all(b"</DataArray>\n<DataArray type=\"Float64\" Name=\"plastic_strain\" format=\"ascii\">\n")?;
+    // Bodies without plastic state (elastic) write zero.
+    let plastic: Vec<_> = archs.iter().map(|a| a.get::<&PlasticStrain>()).collect();
+    for (_, a, r) in order.points() {
+        let e = plastic[a].as_ref().map_or(0.0, |e| e[r].0);
+        writeln!(out, "{e:e}")?;
     }
-    out.push_str("</DataArray>\n<DataArray type=\"Float64\" Name=\"mean_stress\" format=\"ascii\">\n");
-    for s in rows.iter().map(|&r| &ss[r]) {
-        let _ = writeln!(out, "{:e}", s.trace() / 3.0);
+    out.write_all(b"</DataArray>\n</PointData>\n</Piece></UnstructuredGrid>\n</VTKFile>\n")?;
+    out.flush()
+}
+
+/// No point has this id.
+const NONE: u64 = u64::MAX;
+
+/// Archetype and row of the point of each id (`NONE` where no point has it).
+struct Order(Vec<u64>);
+
+impl Order {
+    /// (id, archetype, row) of every point, in id order.
+    fn points(&self) -> impl Iterator<Item = (usize, usize, usize)> + '_ {
+        self.0
+            .iter()
+            .enumerate()
+            .filter(|(_, &at)| at != NONE)
+            .map(|(id, &at)| (id, (at >> 32) as usize, (at & 0xFFFF_FFFF) as usize))
     }
-    out.push_str("</DataArray>\n<DataArray type=\"Float64\" Name=\"volume\" format=\"ascii\">\n");
-    for v in rows.iter().map(|&r| &vols[r]) {
-        let _ = writeln!(out, "{v:e}");
+}
+
+/// Writes `field(value)` for the `T` of every point, in id order.
+fn each<T: Component>(
+    archs: &[&Archetype],
+    order: &Order,
+    out: &mut BufWriter<File>,
+    mut field: impl FnMut(&mut BufWriter<File>, &T) -> std::io::Result<()>,
+) -> std::io::Result<()> {
+    let columns: Vec<_> = archs.iter().map(|a| col::<T>(a)).collect();
+    for (_, a, r) in order.points() {
+        field(out, &columns[a][r])?;
     }
-    out.push_str("</DataArray>\n<DataArray type=\"Float64\" Name=\"plastic_strain\" format=\"ascii\">\n");
-    for e in rows.iter().map(|&r| &eps[r]) {
-        let _ = writeln!(out, "{e:e}");
-    }
-    out.push_str("</DataArray>\n</PointData>\n</Piece></UnstructuredGrid>\n</VTKFile>\n");
-    std::fs::write(path, out)
+    Ok(())
 }

@@ -1,0 +1,153 @@
+//! `points.vtu` holds every material point once, in id order, with the values the columns
+//! hold: read back, each number is the column's to the last bit (`{:e}` prints the shortest
+//! decimal that parses back to the same f64).
+
+use glam::DVec2;
+use kdmpm::columns::{col, points_with};
+use kdmpm::components::*;
+use kdmpm::output::vtk::write_points;
+use kdmpm::scene::{build, LoadedScene};
+use kdmpm::{AnySimulation, Dim2, Simulation};
+use std::collections::BTreeMap;
+use std::path::Path;
+
+/// An elastic layer and a cohesionless bank on it (two archetypes, the bank with plastic
+/// strain), a load carrier (not a material point) and a sort every 10 steps, so that
+/// storage order and id order differ.
+const SCENE: &str = r#"Scene(
+    dimension: 2,
+    grid: (origin: [0.0, 0.0], cell_size: 0.5, cells: [40, 16]),
+    shape: QuadraticBSpline,
+    materials: {
+        "sand": MohrCoulomb(density: 1900.0, youngs_modulus: 1.0e7, poisson_ratio: 0.3,
+                            cohesion: 0.0, friction_angle: 25.0, dilatancy_angle: 0.0),
+        "rock": LinearElastic(density: 2400.0, youngs_modulus: 5.0e8, poisson_ratio: 0.25),
+    },
+    bodies: [
+        (material: "sand", region: Polygon(vertices: [[0.0, 3.0], [8.0, 3.0], [4.0, 6.0], [0.0, 6.0]]), points_per_cell: [2, 2]),
+        (material: "rock", region: Box(min: [0.0, 0.0], max: [20.0, 3.0]), points_per_cell: [2, 2]),
+    ],
+    boundaries: [(face: YMin, condition: Fixed), (face: XMin, condition: Roller), (face: XMax, condition: Roller)],
+    gravity: (acceleration: [0.0, -9.81]),
+    point_loads: [(name: "crest", position: [2.1, 5.9], force: [2.0e3, -1.0e4])],
+    solver: (time_step: Courant(0.3), max_steps: 300, sort_every: 10),
+    output: (displacements: KEEP),
+)"#;
+
+fn simulation(displacements: bool) -> Simulation<Dim2> {
+    let text = SCENE.replace("KEEP", &displacements.to_string());
+    let loaded = LoadedScene::from_text(Path::new("vtk.ron"), &text, &[]).expect("scene loads");
+    let AnySimulation::Two(mut sim) = build(&loaded).expect("scene builds").0 else {
+        unreachable!("2D scene")
+    };
+    sim.run(|_| {}).expect("runs");
+    sim
+}
+
+/// The numbers of every `DataArray` of a `.vtu` file, by name (`Points` for the positions).
+fn read_arrays(path: &Path) -> BTreeMap<String, Vec<f64>> {
+    let text = std::fs::read_to_string(path).expect("points.vtu is written");
+    text.split("<DataArray")
+        .skip(1)
+        .map(|array| {
+            let (head, rest) = array.split_once('>').expect("tag closes");
+            let name = head
+                .split_once("Name=\"")
+                .map_or("Points", |(_, n)| n.split('"').next().unwrap());
+            let body = rest.split("</DataArray>").next().unwrap();
+            let values = body
+                .split_whitespace()
+                .map(|v| v.parse().expect("a number"))
+                .collect();
+            (name.to_string(), values)
+        })
+        .collect()
+}
+
+/// What the columns hold for every material point, by id: position, displacement,
+/// stress, volume, plastic strain (0 for bodies without plastic state).
+type Expected = BTreeMap<u32, (DVec2, Option<DVec2>, [f64; 6], f64, f64)>;
+
+fn expected(sim: &Simulation<Dim2>) -> Expected {
+    let mut all = Expected::new();
+    for arch in points_with::<Stress>(&sim.ctx.world) {
+        let (ids, x, s, v) = (
+            col::<PointId>(arch),
+            col::<Position<DVec2>>(arch),
+            col::<Stress>(arch),
+            col::<Volume>(arch),
+        );
+        let u = arch.get::<&Displacement<DVec2>>();
+        let eps = arch.get::<&PlasticStrain>();
+        for p in 0..ids.len() {
+            let s = s[p].0;
+            let row = (
+                x[p].0,
+                u.as_ref().map(|u| u[p].0),
+                [s.xx, s.yy, s.zz, s.xy, s.yz, s.zx],
+                v[p].0,
+                eps.as_ref().map_or(0.0, |e| e[p].0),
+            );
+            assert!(all.insert(ids[p].0, row).is_none());
+        }
+    }
+    all
+}
+
+fn path(name: &str) -> std::path::PathBuf {
+    Path::new(env!("CARGO_TARGET_TMPDIR")).join(name)
+}
+
+#[test]
+fn points_vtu_holds_every_material_point_in_id_order_with_its_column_values() {
+    let sim = simulation(true);
+    let stored: Vec<u32> = points_with::<Stress>(&sim.ctx.world)
+        .flat_map(|a| col::<PointId>(a).iter().map(|id| id.0).collect::<Vec<_>>())
+        .collect();
+    assert!(
+        stored.windows(2).any(|w| w[0] > w[1]),
+        "storage order should differ from id order, or the test shows nothing"
+    );
+    let file = path("points_kept.vtu");
+    write_points(&sim, &file).unwrap();
+    let arrays = read_arrays(&file);
+    let want = expected(&sim);
+    let n = want.len();
+    assert!(std::fs::read_to_string(&file)
+        .unwrap()
+        .contains(&format!("NumberOfPoints=\"{n}\"")));
+
+    let ids: Vec<u32> = arrays["id"].iter().map(|&id| id as u32).collect();
+    assert_eq!(ids, want.keys().copied().collect::<Vec<_>>(), "ids, ascending");
+    assert!(
+        want.values().any(|w| w.4 > 0.0),
+        "the bank should have yielded somewhere"
+    );
+    for (k, (x, u, s, v, e)) in want.values().enumerate() {
+        assert_eq!(
+            arrays["Points"][3 * k..3 * k + 3],
+            [x.x, x.y, 0.0],
+            "position {k}"
+        );
+        let u = u.expect("kept");
+        assert_eq!(arrays["displacement"][3 * k..3 * k + 3], [u.x, u.y, 0.0]);
+        assert_eq!(arrays["stress"][6 * k..6 * k + 6], *s);
+        assert_eq!(arrays["mean_stress"][k], (s[0] + s[1] + s[2]) / 3.0);
+        assert_eq!(arrays["volume"][k], *v);
+        assert_eq!(arrays["plastic_strain"][k], *e);
+    }
+    // One vertex cell per point.
+    assert_eq!(arrays["connectivity"].len(), n);
+    assert_eq!(arrays["offsets"].last().copied(), Some(n as f64));
+    assert!(arrays["types"].iter().all(|&t| t == 1.0));
+}
+
+#[test]
+fn points_vtu_has_no_displacement_field_when_the_scene_keeps_none() {
+    let sim = simulation(false);
+    let file = path("points_not_kept.vtu");
+    write_points(&sim, &file).unwrap();
+    let arrays = read_arrays(&file);
+    assert!(!arrays.contains_key("displacement"));
+    assert_eq!(arrays["volume"].len(), expected(&sim).len());
+}
