@@ -43,6 +43,20 @@ pub struct VelocityGradient<M>(pub M);
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub struct PointId(pub u32);
 
+impl PointId {
+    /// Puts `value` at this id's index of `list`, growing the list with `gap` as needed:
+    /// lists indexed by id hold the points in id order whatever rows they are stored in.
+    /// Ids are dense (spawn order), so such a list is no longer than the point set.
+    #[inline]
+    pub fn place<T: Clone>(self, list: &mut Vec<T>, value: T, gap: T) {
+        let i = self.0 as usize;
+        if list.len() <= i {
+            list.resize(i + 1, gap);
+        }
+        list[i] = value;
+    }
+}
+
 /// Index of the point's material in the simulation's material table.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct MaterialId(pub u16);

@@ -95,11 +95,7 @@ pub fn positions<D: Dim>(world: &hecs::World, out: &mut Vec<[f64; 3]>) {
     for arch in points_with::<Position<D::Vec>>(world) {
         let (x, id) = (col::<Position<D::Vec>>(arch), col::<PointId>(arch));
         for (x, id) in x.iter().zip(id.iter()) {
-            let i = id.0 as usize;
-            if out.len() <= i {
-                out.resize(i + 1, [f64::NAN; 3]);
-            }
-            out[i] = D::vec_to3(x.0);
+            id.place(out, D::vec_to3(x.0), [f64::NAN; 3]);
         }
     }
 }

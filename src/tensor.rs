@@ -126,7 +126,13 @@ impl Sym3 {
     pub fn from_principal(p: [f64; 3], r: &DMat3) -> Sym3 {
         // a_ij = Σ_k p_k r_ik r_jk, component by component (cheaper than two products).
         let (c0, c1, c2) = (r.x_axis, r.y_axis, r.z_axis);
-        let e = |i: usize, j: usize| p[0] * c0[i] * c0[j] + p[1] * c1[i] * c1[j] + p[2] * c2[i] * c2[j];
+        Sym3::from_fn(|i, j| p[0] * c0[i] * c0[j] + p[1] * c1[i] * c1[j] + p[2] * c2[i] * c2[j])
+    }
+
+    /// The symmetric tensor whose six independent entries are `e(i, j)` for (i, j) = (0, 0),
+    /// (1, 1), (2, 2), (0, 1), (1, 2), (2, 0): `e` is asked for those only.
+    #[inline(always)]
+    pub fn from_fn(e: impl Fn(usize, usize) -> f64) -> Sym3 {
         Sym3 {
             xx: e(0, 0),
             yy: e(1, 1),
@@ -274,15 +280,7 @@ pub fn jaumann_rotate(stress: &Sym3, w: [f64; 3]) -> Sym3 {
     let t: [[f64; 3]; 3] = std::array::from_fn(|i| {
         std::array::from_fn(|j| r[i][0] * s[0][j] + r[i][1] * s[1][j] + r[i][2] * s[2][j])
     });
-    let e = |i: usize, j: usize| t[i][0] * r[j][0] + t[i][1] * r[j][1] + t[i][2] * r[j][2];
-    Sym3 {
-        xx: e(0, 0),
-        yy: e(1, 1),
-        zz: e(2, 2),
-        xy: e(0, 1),
-        yz: e(1, 2),
-        zx: e(2, 0),
-    }
+    Sym3::from_fn(|i, j| t[i][0] * r[j][0] + t[i][1] * r[j][1] + t[i][2] * r[j][2])
 }
 
 /// The Cayley rotation of [`jaumann_rotate`] for a spin about z only (all of plane strain):

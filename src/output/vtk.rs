@@ -19,21 +19,16 @@ use std::path::Path;
 /// run's peak memory.
 pub fn write_points<D: Dim>(sim: &Simulation<D>, path: &Path) -> std::io::Result<()> {
     let archs: Vec<&Archetype> = points_with::<Stress>(&sim.ctx.world).collect();
-    // Where the point of each id is: archetype in the high half, row in the low half. Ids
-    // are dense (spawn order; the few load carriers leave gaps), so this is a direct map.
-    let points = archs.iter().map(|a| a.len() as usize).sum::<usize>();
-    let mut at = Vec::with_capacity(points);
+    // Where the point of each id is: archetype in the high half, row in the low half (the
+    // load carriers' ids are gaps).
+    let n = archs.iter().map(|a| a.len() as usize).sum::<usize>();
+    let mut at = Vec::with_capacity(n);
     for (a, arch) in archs.iter().enumerate() {
         for (r, id) in col::<PointId>(arch).iter().enumerate() {
-            let i = id.0 as usize;
-            if at.len() <= i {
-                at.resize(i + 1, NONE);
-            }
-            at[i] = (a as u64) << 32 | r as u64;
+            id.place(&mut at, (a as u64) << 32 | r as u64, NONE);
         }
     }
     let order = Order(at);
-    let n = points;
     let mut out = BufWriter::with_capacity(1 << 20, File::create(path)?);
     out.write_all(b"<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n")?;
     writeln!(
