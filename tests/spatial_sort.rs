@@ -7,42 +7,15 @@ use glam::{DMat2, DVec2};
 use kdmpm::columns::{col, points_with};
 use kdmpm::components::*;
 use kdmpm::measure::{max_movement, positions};
-use kdmpm::scene::{build, LoadedScene};
 use kdmpm::systems::SpatialSort;
-use kdmpm::{AnySimulation, Dim2, Simulation, StepError, System};
+use kdmpm::{Dim2, Simulation, StepError, System};
 use std::collections::BTreeMap;
-use std::path::Path;
 
-/// A cohesionless (plastic) bank on a layer, spawned after it, with a load on its crest.
-/// Set-up sorts the points; as the bank fails, points cross cells and fall out of order.
-const SCENE: &str = r#"Scene(
-    dimension: 2,
-    grid: (origin: [0.0, 0.0], cell_size: 0.5, cells: [40, 16]),
-    shape: QuadraticBSpline,
-    materials: {
-        "sand": MohrCoulomb(density: 1900.0, youngs_modulus: 1.0e7, poisson_ratio: 0.3,
-                            cohesion: 0.0, friction_angle: 25.0, dilatancy_angle: 0.0),
-    },
-    bodies: [
-        (material: "sand", region: Polygon(vertices: [[0.0, 3.0], [8.0, 3.0], [4.0, 6.0], [0.0, 6.0]]), points_per_cell: [2, 2]),
-        (material: "sand", region: Box(min: [0.0, 0.0], max: [20.0, 3.0]), points_per_cell: [2, 2]),
-    ],
-    boundaries: [(face: YMin, condition: Fixed), (face: XMin, condition: Roller), (face: XMax, condition: Roller)],
-    gravity: (acceleration: [0.0, -9.81]),
-    point_loads: [(name: "crest", position: [2.1, 5.9], force: [2.0e3, -1.0e4])],
-    traced: [(name: "edge", position: [3.9, 5.9]), (name: "heap", position: [15.1, 2.9])],
-    solver: (time_step: Courant(0.3), max_steps: STEPS, sort_every: SORT),
-)"#;
+mod common;
 
+/// The failing bank of `common::bank_on_layer`, all of sand (one archetype).
 fn simulation(steps: u64, sort_every: u64) -> Simulation<Dim2> {
-    let text = SCENE
-        .replace("STEPS", &steps.to_string())
-        .replace("SORT", &sort_every.to_string());
-    let loaded = LoadedScene::from_text(Path::new("sort.ron"), &text, &[]).expect("scene loads");
-    let AnySimulation::Two(sim) = build(&loaded).expect("scene builds").0 else {
-        unreachable!("2D scene")
-    };
-    sim
+    common::bank_on_layer(common::SAND, steps, sort_every, true)
 }
 
 /// Everything a point carries, as raw bits, by point id.

@@ -6,40 +6,17 @@ use glam::DVec2;
 use kdmpm::columns::{col, points_with};
 use kdmpm::components::*;
 use kdmpm::output::vtk::write_points;
-use kdmpm::scene::{build, LoadedScene};
-use kdmpm::{AnySimulation, Dim2, Simulation};
+use kdmpm::{Dim2, Simulation};
 use std::collections::BTreeMap;
 use std::path::Path;
 
-/// An elastic layer and a cohesionless bank on it (two archetypes, the bank with plastic
-/// strain), a load carrier (not a material point) and a sort every 10 steps, so that
-/// storage order and id order differ.
-const SCENE: &str = r#"Scene(
-    dimension: 2,
-    grid: (origin: [0.0, 0.0], cell_size: 0.5, cells: [40, 16]),
-    shape: QuadraticBSpline,
-    materials: {
-        "sand": MohrCoulomb(density: 1900.0, youngs_modulus: 1.0e7, poisson_ratio: 0.3,
-                            cohesion: 0.0, friction_angle: 25.0, dilatancy_angle: 0.0),
-        "rock": LinearElastic(density: 2400.0, youngs_modulus: 5.0e8, poisson_ratio: 0.25),
-    },
-    bodies: [
-        (material: "sand", region: Polygon(vertices: [[0.0, 3.0], [8.0, 3.0], [4.0, 6.0], [0.0, 6.0]]), points_per_cell: [2, 2]),
-        (material: "rock", region: Box(min: [0.0, 0.0], max: [20.0, 3.0]), points_per_cell: [2, 2]),
-    ],
-    boundaries: [(face: YMin, condition: Fixed), (face: XMin, condition: Roller), (face: XMax, condition: Roller)],
-    gravity: (acceleration: [0.0, -9.81]),
-    point_loads: [(name: "crest", position: [2.1, 5.9], force: [2.0e3, -1.0e4])],
-    solver: (time_step: Courant(0.3), max_steps: 300, sort_every: 10),
-    output: (displacements: KEEP),
-)"#;
+mod common;
 
+/// The failing bank of `common::bank_on_layer` on an elastic layer (two archetypes, the bank
+/// with plastic strain, and a load carrier, which is not a material point), run 300 steps
+/// with a sort every 10, so that storage order and id order differ.
 fn simulation(displacements: bool) -> Simulation<Dim2> {
-    let text = SCENE.replace("KEEP", &displacements.to_string());
-    let loaded = LoadedScene::from_text(Path::new("vtk.ron"), &text, &[]).expect("scene loads");
-    let AnySimulation::Two(mut sim) = build(&loaded).expect("scene builds").0 else {
-        unreachable!("2D scene")
-    };
+    let mut sim = common::bank_on_layer(common::ROCK, 300, 10, displacements);
     sim.run(|_| {}).expect("runs");
     sim
 }

@@ -3,7 +3,7 @@
 
 use kdmpm::output::Summary;
 use kdmpm::scene::{build, LoadedScene};
-use kdmpm::with_simulation;
+use kdmpm::{with_simulation, AnySimulation, Dim2, Simulation};
 use std::path::Path;
 
 /// Path of a scene shipped in `scenes/`.
@@ -26,4 +26,48 @@ pub fn run(name: &str, overrides: &[&str]) -> Summary {
 /// Relative difference a/b − 1.
 pub fn rel(a: f64, b: f64) -> f64 {
     a / b - 1.0
+}
+
+/// The bank's material: cohesionless Mohr-Coulomb sand.
+pub const SAND: &str = "MohrCoulomb(density: 1900.0, youngs_modulus: 1.0e7, poisson_ratio: 0.3, \
+                        cohesion: 0.0, friction_angle: 25.0, dilatancy_angle: 0.0)";
+
+/// A linear elastic rock.
+pub const ROCK: &str = "LinearElastic(density: 2400.0, youngs_modulus: 5.0e8, poisson_ratio: 0.25)";
+
+/// A cohesionless (plastic) bank of [`SAND`] on a layer of material `LAYER`, spawned after
+/// it, with a load on its crest and two traced points. Set-up sorts the points; as the bank
+/// fails, points cross cells and fall out of order.
+const BANK_ON_LAYER: &str = r#"Scene(
+    dimension: 2,
+    grid: (origin: [0.0, 0.0], cell_size: 0.5, cells: [40, 16]),
+    shape: QuadraticBSpline,
+    materials: { "sand": SAND, "layer": LAYER },
+    bodies: [
+        (material: "sand", region: Polygon(vertices: [[0.0, 3.0], [8.0, 3.0], [4.0, 6.0], [0.0, 6.0]]), points_per_cell: [2, 2]),
+        (material: "layer", region: Box(min: [0.0, 0.0], max: [20.0, 3.0]), points_per_cell: [2, 2]),
+    ],
+    boundaries: [(face: YMin, condition: Fixed), (face: XMin, condition: Roller), (face: XMax, condition: Roller)],
+    gravity: (acceleration: [0.0, -9.81]),
+    point_loads: [(name: "crest", position: [2.1, 5.9], force: [2.0e3, -1.0e4])],
+    traced: [(name: "edge", position: [3.9, 5.9]), (name: "heap", position: [15.1, 2.9])],
+    solver: (time_step: Courant(0.3), max_steps: STEPS, sort_every: SORT),
+    output: (displacements: KEEP),
+)"#;
+
+/// The bank of [`BANK_ON_LAYER`] on a layer of `layer` ([`SAND`] or [`ROCK`]), built, not
+/// run: `steps` steps, a sort every `sort_every` (0: none), per-point displacements kept or
+/// not.
+pub fn bank_on_layer(layer: &str, steps: u64, sort_every: u64, displacements: bool) -> Simulation<Dim2> {
+    let text = BANK_ON_LAYER
+        .replace("SAND", SAND)
+        .replace("LAYER", layer)
+        .replace("STEPS", &steps.to_string())
+        .replace("SORT", &sort_every.to_string())
+        .replace("KEEP", &displacements.to_string());
+    let loaded = LoadedScene::from_text(Path::new("bank.ron"), &text, &[]).expect("scene loads");
+    let AnySimulation::Two(sim) = build(&loaded).expect("scene builds").0 else {
+        unreachable!("2D scene")
+    };
+    sim
 }
