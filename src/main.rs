@@ -131,6 +131,12 @@ fn check(path: &Path, overrides: &[String]) -> ExitCode {
                 d.time_step / d.critical_time_step
             );
             println!("  systems               {}", d.systems.join(" → "));
+            if !d.unused_materials.is_empty() {
+                println!(
+                    "  unused materials      {} (no body uses them; they do not set the time step)",
+                    d.unused_materials.join(", ")
+                );
+            }
             ExitCode::SUCCESS
         }
         Err(e) => {

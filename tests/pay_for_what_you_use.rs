@@ -1,6 +1,7 @@
 //! A scene pays only for what it uses: no gravity system without gravity, no plastic state
 //! on elastic points, no peak watch without kinetic damping, no point-load system without
-//! loads, no sort system when sorting is off; 2D scenes store 2-vectors.
+//! loads, no sort system when sorting is off, no smaller time step for a material no body
+//! uses; 2D scenes store 2-vectors.
 
 use kdmpm::columns::points_with;
 use kdmpm::components::{PlasticStrain, PointLoad, Position, Stress};
@@ -116,4 +117,35 @@ fn displacements_are_kept_only_when_asked_for_and_traced_points_do_without() {
     assert!(with[0] != 0.0 && without == with, "{without:?} vs {with:?}");
     let (max_u, _) = max_displacements(&kept).expect("kept by default");
     assert!(max_u >= with[0].abs());
+}
+
+#[test]
+fn a_material_no_body_uses_does_not_set_the_time_step() {
+    // The bar (E = 1, ρ = 1, ν = 0: c_p = 1 m/s) with a rock 100 times stiffer (c_p = 10 m/s)
+    // defined beside it.
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/bar.ron");
+    let text = std::fs::read_to_string(&path).unwrap().replace(
+        r#""bar": LinearElastic(density: 1.0, youngs_modulus: 1.0, poisson_ratio: 0.0),"#,
+        r#""bar": LinearElastic(density: 1.0, youngs_modulus: 1.0, poisson_ratio: 0.0),
+        "rock": LinearElastic(density: 1.0, youngs_modulus: 100.0, poisson_ratio: 0.0),"#,
+    );
+    assert!(
+        text.contains("\"rock\""),
+        "the bar scene changed: update this test"
+    );
+    let derived = |text: &str| {
+        let courant = ["solver.time_step=Courant(0.5)".to_string()];
+        build(&LoadedScene::from_text(&path, text, &courant).unwrap())
+            .unwrap()
+            .1
+    };
+    let unused = derived(&text);
+    assert_eq!(unused.p_wave_speed, 1.0);
+    assert_eq!(unused.time_step, 0.5);
+    assert_eq!(unused.unused_materials, ["rock"]);
+    // Once a body is made of rock, rock sets the step.
+    let used = derived(&text.replace(r#"(material: "bar""#, r#"(material: "rock""#));
+    assert_eq!(used.p_wave_speed, 10.0);
+    assert_eq!(used.time_step, 0.05);
+    assert_eq!(used.unused_materials, ["bar"]);
 }

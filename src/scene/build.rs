@@ -152,7 +152,13 @@ impl<I: Iterator> Iterator for Counted<I> {
 impl<I: Iterator> ExactSizeIterator for Counted<I> {}
 
 fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulation<D>, Derived), SceneError> {
-    let (table, c_p, dt_crit, dt) = checked;
+    let Checked {
+        materials: table,
+        p_wave_speed: c_p,
+        critical_time_step: dt_crit,
+        time_step: dt,
+        unused_materials,
+    } = checked;
     let s: &Scene = &loaded.scene;
     let n = D::N;
     let mut cells = [0usize; 3];
@@ -400,6 +406,7 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         active_nodes: touched.iter().filter(|&&t| t).count(),
         grid_nodes: grid.node_count(),
         systems: schedule.names(),
+        unused_materials,
     };
     let state = SolverState {
         dt,

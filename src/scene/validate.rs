@@ -10,7 +10,7 @@ use serde::Serialize;
 /// Figures derived from a valid scene (printed by `kdmpm check`).
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct Derived {
-    /// Largest P-wave speed sqrt(M/ρ) over the materials (m/s).
+    /// Largest P-wave speed sqrt(M/ρ) over the materials the bodies use (m/s).
     pub p_wave_speed: f64,
     /// Critical time step h / c_p (s).
     pub critical_time_step: f64,
@@ -24,11 +24,25 @@ pub struct Derived {
     pub grid_nodes: usize,
     /// Systems of one step, in order.
     pub systems: Vec<String>,
+    /// Materials the scene defines but no body uses, in name order. They are validated
+    /// like the others but do not set the time step.
+    pub unused_materials: Vec<String>,
 }
 
-/// What [`check`] establishes: the material table in name order, the largest P-wave speed
-/// (m/s), the critical time step (s) and the time step to use (s).
-pub type Checked = (Vec<(String, MaterialModel)>, f64, f64, f64);
+/// What [`check`] establishes.
+#[derive(Clone, Debug)]
+pub struct Checked {
+    /// Every material the scene defines, in name order.
+    pub materials: Vec<(String, MaterialModel)>,
+    /// Largest P-wave speed sqrt(M/ρ) over the materials the bodies use (m/s).
+    pub p_wave_speed: f64,
+    /// Critical time step h / c_p (s).
+    pub critical_time_step: f64,
+    /// Time step to use (s).
+    pub time_step: f64,
+    /// Materials no body uses, in name order.
+    pub unused_materials: Vec<String>,
+}
 
 /// True for a finite number > 0 (NaN fails).
 fn positive(x: f64) -> bool {
@@ -142,41 +156,6 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
         };
         table.push((name.clone(), model));
     }
-    let c_p = table
-        .iter()
-        .map(|(_, m)| (m.p_wave_modulus() / m.density()).sqrt())
-        .fold(0.0f64, f64::max);
-    let dt_crit = s.grid.cell_size / c_p;
-    let dt = match s.solver.time_step {
-        TimeStep::Fixed(dt) => {
-            if !positive(dt) {
-                return bad(
-                    "solver.time_step",
-                    format!("Fixed(Δt) needs Δt > 0 s, found {dt}"),
-                );
-            }
-            if dt > dt_crit {
-                return bad(
-                    "solver.time_step",
-                    format!(
-                        "Δt = {dt} s is above the critical step h/c_p = {dt_crit:.6} s (c_p = {c_p:.4} m/s) \
-                         by {:.1} %: the explicit scheme would be unstable",
-                        100.0 * (dt / dt_crit - 1.0)
-                    ),
-                );
-            }
-            dt
-        }
-        TimeStep::Courant(a) => {
-            if !(positive(a) && a <= 1.0) {
-                return bad(
-                    "solver.time_step",
-                    format!("Courant(α) needs 0 < α ≤ 1, found {a}"),
-                );
-            }
-            a * dt_crit
-        }
-    };
     if !positive(s.solver.tolerance) {
         return bad(
             "solver.tolerance",
@@ -324,5 +303,55 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
     for (i, t) in s.traced.iter().enumerate() {
         len(&format!("traced[{i}].position"), t.position.len())?;
     }
-    Ok((table, c_p, dt_crit, dt))
+    // Only materials that bodies use set the time step: a stiff material kept in a scene
+    // for later would otherwise make every run take more steps for nothing.
+    let used = |name: &str| s.bodies.iter().any(|b| b.material == name);
+    let c_p = table
+        .iter()
+        .filter(|(name, _)| used(name))
+        .map(|(_, m)| (m.p_wave_modulus() / m.density()).sqrt())
+        .fold(0.0f64, f64::max);
+    let unused_materials = table
+        .iter()
+        .filter(|(name, _)| !used(name))
+        .map(|(name, _)| name.clone())
+        .collect();
+    let dt_crit = s.grid.cell_size / c_p;
+    let dt = match s.solver.time_step {
+        TimeStep::Fixed(dt) => {
+            if !positive(dt) {
+                return bad(
+                    "solver.time_step",
+                    format!("Fixed(Δt) needs Δt > 0 s, found {dt}"),
+                );
+            }
+            if dt > dt_crit {
+                return bad(
+                    "solver.time_step",
+                    format!(
+                        "Δt = {dt} s is above the critical step h/c_p = {dt_crit:.6} s (c_p = {c_p:.4} m/s) \
+                         by {:.1} %: the explicit scheme would be unstable",
+                        100.0 * (dt / dt_crit - 1.0)
+                    ),
+                );
+            }
+            dt
+        }
+        TimeStep::Courant(a) => {
+            if !(positive(a) && a <= 1.0) {
+                return bad(
+                    "solver.time_step",
+                    format!("Courant(α) needs 0 < α ≤ 1, found {a}"),
+                );
+            }
+            a * dt_crit
+        }
+    };
+    Ok(Checked {
+        materials: table,
+        p_wave_speed: c_p,
+        critical_time_step: dt_crit,
+        time_step: dt,
+        unused_materials,
+    })
 }
