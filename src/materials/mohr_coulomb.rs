@@ -193,16 +193,19 @@ impl MohrCoulomb {
             }
             // Solve (λ 11ᵀ + 2G I) Δλ = s_J − σt on the first `active` components:
             // Δλ_j = (e_j − λ Σe/(2G + nλ)) / 2G with e_j = s_j − σt.
-            let excess: Vec<f64> = s[..active].iter().map(|v| v - st).collect();
-            let sum: f64 = excess.iter().sum();
+            // Fixed arrays, zero outside the active set: this runs per point per step.
+            let excess: [f64; 3] = std::array::from_fn(|i| if i < active { s[i] - st } else { 0.0 });
+            let sum: f64 = excess[..active].iter().sum();
             let common = l * sum / (g2 + active as f64 * l);
-            let dl: Vec<f64> = excess.iter().map(|e| (e - common) / g2).collect();
-            let trace: f64 = dl.iter().sum();
-            let mut out = s;
-            for (i, o) in out.iter_mut().enumerate() {
-                let own = if i < active { dl[i] } else { 0.0 };
-                *o = s[i] - l * trace - g2 * own;
-            }
+            let dl: [f64; 3] = std::array::from_fn(|i| {
+                if i < active {
+                    (excess[i] - common) / g2
+                } else {
+                    0.0
+                }
+            });
+            let trace: f64 = dl[..active].iter().sum();
+            let out: [f64; 3] = std::array::from_fn(|i| s[i] - l * trace - g2 * dl[i]);
             if active == 3 || out[active] <= st {
                 return DVec3::from_array(out);
             }
