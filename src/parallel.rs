@@ -1,9 +1,9 @@
 //! Deterministic parallel building blocks.
 //!
 //! Work is split into pieces whose boundaries depend only on the data (fixed-size chunks of
-//! points, slabs of grid rows), never on the number of threads, and partial results are
-//! combined in piece order. So a run gives the same bits on 1 or 2 threads, and from
-//! run to run. No atomics are involved.
+//! points, slabs of grid rows, groups of node layers), never on the number of threads, and
+//! partial results are combined in piece order. So a run gives the same bits on 1 or 2
+//! threads, and from run to run. No atomics are involved.
 
 use crate::dim::Dim;
 use crate::grid::{Grid, NodeBox};
@@ -224,6 +224,53 @@ impl<A: NodeTarget, B: NodeTarget, C: NodeTarget> NodeTarget for (A, B, C) {
     }
 }
 
+/// Nodes a grid-pass task covers at least: whole node layers are grouped up to this many, so
+/// a small grid runs as one task and a big one splits into many.
+pub const NODES_PER_TASK: usize = 8192;
+
+/// Runs `kernel(part_box, part, first_node)` over the node box `b` in parallel and returns
+/// the results in node order.
+///
+/// The box is cut across the slab axis into groups of whole node layers, each a contiguous
+/// range of node ids starting at `first_node`; `part` is that range of `target` and
+/// `part_box` the nodes of `b` inside it. The cut depends on the grid and the box alone,
+/// never on the number of threads, so reductions over the results give the same bits on
+/// any thread count.
+pub fn grid_pass<D: Dim, T: NodeTarget, R: Send>(
+    grid: &Grid<D>,
+    b: NodeBox,
+    target: &T,
+    kernel: impl for<'p> Fn(NodeBox, T::Part<'p>, usize) -> R + Sync,
+) -> Vec<R> {
+    if b.is_empty() {
+        return Vec::new();
+    }
+    let (axis, layer) = (grid.slab_axis, grid.layer());
+    let per_task = NODES_PER_TASK.div_ceil(layer);
+    let groups: Vec<Range<usize>> = (b.lo[axis]..b.hi[axis])
+        .step_by(per_task)
+        .map(|a| a..(a + per_task).min(b.hi[axis]))
+        .collect();
+    groups
+        .into_par_iter()
+        .map(|layers| {
+            let mut part_box = b;
+            (part_box.lo[axis], part_box.hi[axis]) = (layers.start, layers.end);
+            let first = layers.start * layer;
+            // SAFETY: groups cover disjoint layer ranges, hence disjoint node ranges, and the
+            // kernel cannot keep its part past the call.
+            let part = unsafe { target.part(first..layers.end * layer) };
+            kernel(part_box, part, first)
+        })
+        .collect()
+}
+
+impl NodeTarget for () {
+    type Part<'p> = ();
+
+    unsafe fn part<'p>(&self, _: Range<usize>) -> Self::Part<'p> {}
+}
+
 /// A deterministic parallel scatter from points to nodes, straight into the node columns.
 ///
 /// Points are grouped in slabs of one cell row. A slab touches `support + 1` node layers,
@@ -279,5 +326,61 @@ impl SlabScatter {
             });
         }
         slabs.reach(grid, support)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::dim::Dim3;
+    use glam::DVec3;
+
+    /// Runs `f` on a pool of `threads` threads.
+    fn on_threads<R: Send>(threads: usize, f: impl FnOnce() -> R + Send) -> R {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(f)
+    }
+
+    #[test]
+    fn grid_pass_visits_every_box_node_once_and_sums_the_same_bits_on_any_thread_count() {
+        // 41 layers of 41 × 41 nodes: groups of 5 layers, so the box below spans 7 groups.
+        let grid = Grid::<Dim3>::new(DVec3::ZERO, 1.0, [40, 40, 40]);
+        let b = NodeBox {
+            lo: [3, 1, 2],
+            hi: [38, 40, 35],
+        };
+        let values: Vec<f64> = (0..grid.node_count())
+            .map(|i| ((i as f64) * 0.618).sin() * 1e3 + 1e-7 * i as f64)
+            .collect();
+        let pass = |threads| {
+            on_threads(threads, || {
+                let mut visits = vec![0u32; grid.node_count()];
+                let sums = grid_pass(&grid, b, &Disjoint::new(&mut visits), |part_box, part, first| {
+                    let mut sum = 0.0;
+                    for i in part_box.rows(&grid).flatten() {
+                        part[i - first] += 1;
+                        sum += values[i];
+                    }
+                    sum
+                });
+                (sums.len(), sums.iter().sum::<f64>().to_bits(), visits)
+            })
+        };
+        let (groups, one, visits) = pass(1);
+        assert_eq!(groups, 7);
+        let inside = |i: usize| {
+            let ijk = grid.node_ijk(i);
+            (0..3).all(|a| b.lo[a] <= ijk[a] && ijk[a] < b.hi[a])
+        };
+        for (i, &v) in visits.iter().enumerate() {
+            assert_eq!(v, u32::from(inside(i)), "node {i} visited {v} times");
+        }
+        for _ in 0..3 {
+            let (_, two, _) = pass(2);
+            assert_eq!(one, two, "the sum depends on the thread count");
+        }
     }
 }

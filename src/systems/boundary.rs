@@ -4,6 +4,7 @@ use crate::columns::{col, col_mut, nodes};
 use crate::components::*;
 use crate::dim::{Dim, Vector};
 use crate::error::StepError;
+use crate::parallel::{grid_pass, Disjoint};
 use crate::schedule::System;
 use crate::simulation::Context;
 
@@ -19,20 +20,29 @@ impl<D: Dim> System<D> for Boundary {
     fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
         let n = nodes(&ctx.world);
         let fix = col::<NodeFixity>(n);
+        let fix = &*fix; // a plain slice: the column guard cannot be shared with the pool
         let mut np = col_mut::<NodeMomentum<D::Vec>>(n);
         let mut nf = col_mut::<NodeForce<D::Vec>>(n);
-        for i in ctx.state.active_nodes.rows(&ctx.grid).flatten() {
-            let f = fix[i];
-            if f.0 == 0 {
-                continue;
-            }
-            for a in 0..D::N {
-                if f.is_fixed(a) {
-                    np[i].0.set(a, 0.0);
-                    nf[i].0.set(a, 0.0);
+        let target = (Disjoint::new(&mut np), Disjoint::new(&mut nf));
+        grid_pass(
+            &ctx.grid,
+            ctx.state.active_nodes,
+            &target,
+            |b, (np, nf), first| {
+                for i in b.rows(&ctx.grid).flatten() {
+                    let f = fix[i];
+                    if f.0 == 0 {
+                        continue;
+                    }
+                    for a in 0..D::N {
+                        if f.is_fixed(a) {
+                            np[i - first].0.set(a, 0.0);
+                            nf[i - first].0.set(a, 0.0);
+                        }
+                    }
                 }
-            }
-        }
+            },
+        );
         Ok(())
     }
 }

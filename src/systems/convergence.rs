@@ -6,6 +6,7 @@ use crate::components::*;
 use crate::dim::{Dim, Vector};
 use crate::error::StepError;
 use crate::measure::{max_movement, positions};
+use crate::parallel::grid_pass;
 use crate::schedule::System;
 use crate::simulation::Context;
 use crate::state::{StaticCheck, StopReason};
@@ -33,23 +34,34 @@ pub fn force_ratios<D: Dim>(ctx: &Context<D>) -> ForceRatios {
     let nf = col::<NodeForce<D::Vec>>(n);
     let ne = col::<NodeExternalForce<D::Vec>>(n);
     let fix = col::<NodeFixity>(n);
-    let (mut max_u, mut max_e, mut sum_u, mut sum_e) = (0.0f64, 0.0f64, 0.0, 0.0);
-    for i in ctx.state.active_nodes.rows(&ctx.grid).flatten() {
-        if !ctx.grid.carries(i, nm[i].0, min_mass) {
-            continue;
-        }
-        for a in 0..D::N {
-            if fix[i].is_fixed(a) {
+    // Plain slices: the column guards cannot be shared with the pool.
+    let (nm, nf, ne, fix) = (&*nm, &*nf, &*ne, &*fix);
+    let grid = &ctx.grid;
+    // Per group of node layers: max|F_unb|, max|F_ext|, Σ|F_unb|, Σ|F_ext|, combined in node
+    // order below.
+    let parts = grid_pass(grid, ctx.state.active_nodes, &(), |b, (), _| {
+        let (mut max_u, mut max_e, mut sum_u, mut sum_e) = (0.0f64, 0.0f64, 0.0, 0.0);
+        for i in b.rows(grid).flatten() {
+            if !grid.carries(i, nm[i].0, min_mass) {
                 continue;
             }
-            let u = nf[i].0.get(a).abs();
-            let e = ne[i].0.get(a).abs();
-            max_u = max_u.max(u);
-            max_e = max_e.max(e);
-            sum_u += u;
-            sum_e += e;
+            for a in 0..D::N {
+                if fix[i].is_fixed(a) {
+                    continue;
+                }
+                let u = nf[i].0.get(a).abs();
+                let e = ne[i].0.get(a).abs();
+                max_u = max_u.max(u);
+                max_e = max_e.max(e);
+                sum_u += u;
+                sum_e += e;
+            }
         }
-    }
+        [max_u, max_e, sum_u, sum_e]
+    });
+    let [max_u, max_e, sum_u, sum_e] = parts.iter().fold([0.0f64; 4], |t, p| {
+        [t[0].max(p[0]), t[1].max(p[1]), t[2] + p[2], t[3] + p[3]]
+    });
     let ratio = |u: f64, e: f64| {
         if e > 0.0 {
             u / e
@@ -126,12 +138,15 @@ impl<D: Dim> System<D> for Convergence {
             let n = nodes(&ctx.world);
             let ne = col::<NodeExternalForce<D::Vec>>(n);
             let nv = col::<NodeVelocity<D::Vec>>(n);
-            let power: f64 = ctx
-                .state
-                .active_nodes
-                .rows(&ctx.grid)
-                .map(|r| r.map(|i| ne[i].0.dot(nv[i].0)).sum::<f64>())
-                .sum();
+            let (ne, nv) = (&*ne, &*nv);
+            let grid = &ctx.grid;
+            let power: f64 = grid_pass(grid, ctx.state.active_nodes, &(), |b, (), _| {
+                b.rows(grid)
+                    .map(|r| r.map(|i| ne[i].0.dot(nv[i].0)).sum::<f64>())
+                    .sum::<f64>()
+            })
+            .iter()
+            .sum();
             power * ctx.state.dt
         };
         let s = &mut ctx.state;

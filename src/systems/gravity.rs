@@ -4,6 +4,7 @@ use crate::columns::{col, col_mut, nodes};
 use crate::components::*;
 use crate::dim::Dim;
 use crate::error::StepError;
+use crate::parallel::{grid_pass, Disjoint};
 use crate::schedule::System;
 use crate::simulation::Context;
 use crate::state::Gravity as GravitySpec;
@@ -33,17 +34,24 @@ impl<D: Dim> System<D> for Gravity {
         let gv = D::vec_from([a[0] * g, a[1] * g, a[2] * g]);
         let n = nodes(&ctx.world);
         let nm = col::<NodeMass>(n);
+        let nm = &*nm; // a plain slice: the column guard cannot be shared with the pool
         let mut nf = col_mut::<NodeForce<D::Vec>>(n);
         let mut ne = col_mut::<NodeExternalForce<D::Vec>>(n);
-        for r in ctx.state.active_nodes.rows(&ctx.grid) {
-            for i in r {
-                if nm[i].0 > 0.0 {
-                    let w = gv * nm[i].0;
-                    nf[i].0 += w;
-                    ne[i].0 += w;
+        let target = (Disjoint::new(&mut nf), Disjoint::new(&mut ne));
+        grid_pass(
+            &ctx.grid,
+            ctx.state.active_nodes,
+            &target,
+            |b, (nf, ne), first| {
+                for i in b.rows(&ctx.grid).flatten() {
+                    if nm[i].0 > 0.0 {
+                        let w = gv * nm[i].0;
+                        nf[i - first].0 += w;
+                        ne[i - first].0 += w;
+                    }
                 }
-            }
-        }
+            },
+        );
         Ok(())
     }
 }

@@ -4,6 +4,7 @@ use crate::columns::{col, col_mut, nodes};
 use crate::components::*;
 use crate::dim::{Dim, Vector};
 use crate::error::StepError;
+use crate::parallel::{grid_pass, Disjoint};
 use crate::schedule::System;
 use crate::simulation::Context;
 use crate::state::Damping;
@@ -34,21 +35,27 @@ impl<D: Dim> System<D> for Integrate {
         let nm = col::<NodeMass>(n);
         let np = col::<NodeMomentum<D::Vec>>(n);
         let nf = col::<NodeForce<D::Vec>>(n);
+        // Plain slices: the column guards cannot be shared with the pool.
+        let (nm, np, nf) = (&*nm, &*np, &*nf);
         let mut na = col_mut::<NodeAcceleration<D::Vec>>(n);
         let mut nv = col_mut::<NodeVelocity<D::Vec>>(n);
-        for i in ctx.state.active_nodes.rows(&ctx.grid).flatten() {
-            let m = nm[i].0;
-            if ctx.grid.carries(i, m, min_mass) {
-                // Dynamic relaxation's mass matrix is fictitious: a floor on the mass that
-                // accelerates a light node changes the path, never the static answer.
-                let a = (nf[i].0 - np[i].0 * beta2) * (1.0 / ctx.grid.inertia(i, m, floor));
-                na[i].0 = a;
-                nv[i].0 = np[i].0 * (1.0 / m) + a * dt;
-            } else {
-                na[i].0 = D::Vec::ZERO;
-                nv[i].0 = D::Vec::ZERO;
+        let grid = &ctx.grid;
+        let target = (Disjoint::new(&mut na), Disjoint::new(&mut nv));
+        grid_pass(grid, ctx.state.active_nodes, &target, |b, (na, nv), first| {
+            for i in b.rows(grid).flatten() {
+                let (m, k) = (nm[i].0, i - first);
+                if grid.carries(i, m, min_mass) {
+                    // Dynamic relaxation's mass matrix is fictitious: a floor on the mass that
+                    // accelerates a light node changes the path, never the static answer.
+                    let a = (nf[i].0 - np[i].0 * beta2) * (1.0 / grid.inertia(i, m, floor));
+                    na[k].0 = a;
+                    nv[k].0 = np[i].0 * (1.0 / m) + a * dt;
+                } else {
+                    na[k].0 = D::Vec::ZERO;
+                    nv[k].0 = D::Vec::ZERO;
+                }
             }
-        }
+        });
         Ok(())
     }
 }

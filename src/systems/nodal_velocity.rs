@@ -5,6 +5,7 @@ use crate::columns::{col, col_mut, nodes};
 use crate::components::*;
 use crate::dim::{Dim, Vector};
 use crate::error::StepError;
+use crate::parallel::{grid_pass, Disjoint};
 use crate::schedule::System;
 use crate::simulation::Context;
 
@@ -16,16 +17,26 @@ pub fn velocity_from_momentum<D: Dim>(ctx: &Context<D>) {
     let nm = col::<NodeMass>(n);
     let np = col::<NodeMomentum<D::Vec>>(n);
     let fix = col::<NodeFixity>(n);
+    // Plain slices: the column guards cannot be shared with the pool.
+    let (nm, np, fix) = (&*nm, &*np, &*fix);
     let mut nv = col_mut::<NodeVelocity<D::Vec>>(n);
-    for i in ctx.state.active_nodes.rows(&ctx.grid).flatten() {
-        let mut v = if ctx.grid.carries(i, nm[i].0, min_mass) {
-            np[i].0 * (1.0 / nm[i].0)
-        } else {
-            D::Vec::ZERO
-        };
-        constrain(&mut v, fix[i], D::N);
-        nv[i].0 = v;
-    }
+    let grid = &ctx.grid;
+    grid_pass(
+        grid,
+        ctx.state.active_nodes,
+        &Disjoint::new(&mut nv),
+        |b, nv, first| {
+            for i in b.rows(grid).flatten() {
+                let mut v = if grid.carries(i, nm[i].0, min_mass) {
+                    np[i].0 * (1.0 / nm[i].0)
+                } else {
+                    D::Vec::ZERO
+                };
+                constrain(&mut v, fix[i], D::N);
+                nv[i - first].0 = v;
+            }
+        },
+    );
 }
 
 /// USF's nodal velocity at the start of the step.
