@@ -2,7 +2,8 @@
 //!
 //! The 3D elastic block of `scenes/block_*.ron` (as the Taichi peer's presets) at about 10k,
 //! 100k and 1M points on 1 and 2 threads, and the 2D slope. Prints a table and the
-//! per-system split. Each rate is the best of three rounds, the thread counts alternating.
+//! per-system split. Each rate is the best of three rounds, the thread counts (and the
+//! variants of the 100k block) alternating.
 //! `cargo bench --bench throughput` (add `-- 10k` to run one size).
 //!
 //! The 100k block is also run in a grid with ten times as many nodes (50 × 50 × 54 cells
@@ -76,92 +77,143 @@ fn timing_cost() -> f64 {
     start.elapsed().as_secs_f64() / n as f64
 }
 
+/// One scene as timed: its file, its label, overrides and the order of its points.
+struct Variant {
+    file: &'static str,
+    label: &'static str,
+    overrides: &'static [&'static str],
+    order: Order,
+}
+
+/// Builds `variant` for a pool of `threads` threads, shuffled or sorted as asked, and warms
+/// it up with three steps.
+fn prepare(variant: &Variant, threads: usize) -> (rayon::ThreadPool, kdmpm::AnySimulation) {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap();
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("scenes")
+        .join(variant.file);
+    let mut o = vec!["solver.max_steps=1000000000".to_string()];
+    o.extend(variant.overrides.iter().map(|s| s.to_string()));
+    let loaded = LoadedScene::from_file(&path, &o).unwrap();
+    let (mut any, _) = build(&loaded).unwrap();
+    let order = variant.order;
+    pool.install(|| {
+        with_simulation!(&mut any, sim => {
+            if order != Order::AsBuilt {
+                shuffle(sim);
+            }
+            if order == Order::MixedThenSorted {
+                SpatialSort::new(1).run(&mut sim.ctx).expect("sort");
+            }
+            for _ in 0..3 {
+                sim.step().expect("warm-up step");
+            }
+        })
+    });
+    (pool, any)
+}
+
 fn main() {
     let per_call = timing_cost();
     println!("timing one system call costs {:.1} ns", per_call * 1e9);
     let filter: Option<String> = std::env::args().skip(1).find(|a| !a.starts_with('-'));
-    let big_grid: &[&str] = &["grid.cells=[50, 50, 54]"];
+    let variant = |file, label, overrides, order| Variant {
+        file,
+        label,
+        overrides,
+        order,
+    };
     let unsorted: &[&str] = &["solver.sort_every=0"];
-    let cases: [(&str, &str, f64, &[&str], Order); 7] = [
-        ("block_10k.ron", "3D block 10k", 2.0, &[], Order::AsBuilt),
-        ("block_100k.ron", "3D block 100k", 3.0, &[], Order::AsBuilt),
-        ("block_100k.ron", "  in 10× grid", 3.0, big_grid, Order::AsBuilt),
-        ("block_100k.ron", "  mixed", 3.0, unsorted, Order::Mixed),
+    // Variants of one group are timed in the same rounds, so the later ones' cost relative
+    // to the first is measured through the same spells of disturbance.
+    let groups: Vec<(f64, Vec<Variant>)> = vec![
         (
-            "block_100k.ron",
-            "  mixed, sorted",
-            3.0,
-            unsorted,
-            Order::MixedThenSorted,
+            2.0,
+            vec![variant("block_10k.ron", "3D block 10k", &[], Order::AsBuilt)],
         ),
-        ("block_1m.ron", "3D block 1M", 6.0, &[], Order::AsBuilt),
-        ("slope.ron", "2D slope", 3.0, &[], Order::AsBuilt),
+        (
+            3.0,
+            vec![
+                variant("block_100k.ron", "3D block 100k", &[], Order::AsBuilt),
+                variant(
+                    "block_100k.ron",
+                    "  in 10× grid",
+                    &["grid.cells=[50, 50, 54]"],
+                    Order::AsBuilt,
+                ),
+                variant("block_100k.ron", "  mixed", unsorted, Order::Mixed),
+                variant(
+                    "block_100k.ron",
+                    "  mixed, sorted",
+                    unsorted,
+                    Order::MixedThenSorted,
+                ),
+            ],
+        ),
+        (
+            6.0,
+            vec![variant("block_1m.ron", "3D block 1M", &[], Order::AsBuilt)],
+        ),
+        (3.0, vec![variant("slope.ron", "2D slope", &[], Order::AsBuilt)]),
     ];
-    // 2-thread rate of the 100k block in its own grid, to compare the 10× grid with.
-    let mut block_100k = None;
     println!(
         "{:<16} {:>9} {:>8} {:>14} {:>9}",
         "case", "points", "threads", "M pt-steps/s", "speed-up"
     );
-    for (file, label, seconds, overrides, order) in cases {
-        if filter.as_ref().is_some_and(|f| !file.contains(f.as_str())) {
+    for (seconds, variants) in groups {
+        if filter
+            .as_ref()
+            .is_some_and(|f| !variants[0].file.contains(f.as_str()))
+        {
             continue;
         }
-        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes").join(file);
-        let mut runs: Vec<_> = [1, 2]
-            .into_iter()
-            .map(|threads| {
-                let pool = rayon::ThreadPoolBuilder::new()
-                    .num_threads(threads)
-                    .build()
-                    .unwrap();
-                let mut o = vec!["solver.max_steps=1000000000".to_string()];
-                o.extend(overrides.iter().map(|s| s.to_string()));
-                let loaded = LoadedScene::from_file(&path, &o).unwrap();
-                let (mut any, _) = build(&loaded).unwrap();
-                pool.install(|| {
-                    with_simulation!(&mut any, sim => {
-                        if order != Order::AsBuilt {
-                            shuffle(sim);
-                        }
-                        if order == Order::MixedThenSorted {
-                            SpatialSort::new(1).run(&mut sim.ctx).expect("sort");
-                        }
-                        for _ in 0..3 {
-                            sim.step().expect("warm-up step");
-                        }
-                    })
-                });
-                (threads, pool, any, 0.0f64)
+        // (variant, threads, pool, simulation, best rate), 1 and 2 threads side by side.
+        let mut runs: Vec<_> = variants
+            .iter()
+            .enumerate()
+            .flat_map(|(v, variant)| {
+                [1, 2].map(|threads| {
+                    let (pool, any) = prepare(variant, threads);
+                    (v, threads, pool, any, 0.0f64)
+                })
             })
             .collect();
         for _ in 0..ROUNDS {
-            for (_, pool, any, best) in runs.iter_mut() {
+            for (_, _, pool, any, best) in runs.iter_mut() {
                 let rate = pool
                     .install(|| with_simulation!(&mut *any, sim => measure(sim, seconds / ROUNDS as f64)));
                 *best = best.max(rate);
             }
         }
-        let single = runs[0].3;
-        for (threads, _, any, rate) in &runs {
-            let (threads, rate) = (*threads, *rate);
-            let (points, split) = with_simulation!(any, sim => (sim.point_count(), sim.schedule.timings()));
-            println!(
-                "{label:<16} {points:>9} {threads:>8} {:>14.2} {:>8.2}×",
-                rate / 1e6,
-                rate / single
-            );
-            if threads == 2 && file == "block_100k.ron" {
-                match block_100k {
-                    None => block_100k = Some(rate),
-                    Some(own) => println!(
-                        "{:<16} per-step cost: {:.2}× the block's own, as built",
+        // The first variant's rates on 1 and 2 threads, to compare the others with.
+        let reference = [runs[0].4, runs[1].4];
+        for pair in runs.chunks(2) {
+            let single = pair[0].4;
+            for (v, threads, _, any, rate) in pair {
+                let (v, threads, rate) = (*v, *threads, *rate);
+                let label = variants[v].label;
+                let (points, split) =
+                    with_simulation!(any, sim => (sim.point_count(), sim.schedule.timings()));
+                println!(
+                    "{label:<16} {points:>9} {threads:>8} {:>14.2} {:>8.2}×",
+                    rate / 1e6,
+                    rate / single
+                );
+                if v > 0 {
+                    println!(
+                        "{:<16} per-step cost: {:.2}× the {}'s on {threads} thread{}, same rounds",
                         "",
-                        own / rate
-                    ),
+                        reference[threads - 1] / rate,
+                        variants[0].label.trim(),
+                        if threads == 1 { "" } else { "s" }
+                    );
                 }
-            }
-            if threads == 2 {
+                if threads == 1 {
+                    continue;
+                }
                 let total: f64 = split.iter().map(|t| t.seconds).sum();
                 let calls: u64 = split.iter().map(|t| t.calls).sum();
                 println!(
