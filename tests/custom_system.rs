@@ -1,4 +1,5 @@
-//! The example's user system runs inside the schedule, once per step, at its named place.
+//! The example's user system runs inside the schedule, once per step, at its named place;
+//! and every step runs on a thread of the rayon pool.
 
 #[path = "../examples/custom_system.rs"]
 #[allow(dead_code)]
@@ -23,4 +24,22 @@ fn a_user_system_inserted_after_g2p_runs_every_step() {
         .find(|t| t.name == "max_speed_probe")
         .unwrap();
     assert_eq!(probe.calls, sim.ctx.state.step);
+}
+
+#[test]
+fn run_steps_on_a_pool_thread_so_parallel_loops_do_not_wake_the_caller() {
+    let (mut sim, _) = example::bar_with_probe();
+    let on_pool = std::sync::Arc::new(std::sync::Mutex::new(Vec::new()));
+    let seen = on_pool.clone();
+    let probe = kdmpm::FnSystem::new("where_am_i", move |_: &mut kdmpm::Context<kdmpm::Dim3>| {
+        seen.lock().unwrap().push(rayon::current_thread_index().is_some());
+        Ok(())
+    });
+    assert!(sim.schedule.insert_after("g2p", probe));
+    // The test's own thread is not a pool thread.
+    assert!(rayon::current_thread_index().is_none());
+    sim.run(|_| {}).unwrap();
+    let on_pool = on_pool.lock().unwrap();
+    assert_eq!(on_pool.len() as u64, sim.ctx.state.step);
+    assert!(on_pool.iter().all(|&p| p), "a step ran on the caller's thread");
 }
