@@ -291,9 +291,16 @@ impl<D: Dim> Grid<D> {
 /// cell, one below the lower face to the first.
 #[inline(always)]
 pub fn cell_index(xi: f64, cells: usize) -> usize {
-    // Through a signed integer: f64 → i64 is one instruction on x86-64, f64 → u64 a branchy
-    // sequence, and this runs for every point in every transfer of every step.
-    (xi as i64).max(0).min(cells as i64 - 1) as usize
+    // This runs ~20 times a point every step, so it is kept to a compare-and-select per
+    // bound and one truncation: clamped in floating point first, the unchecked conversion
+    // needs none of the saturating cast's fix-ups. The result is the one truncating then
+    // clamping gives for every `xi`, infinities and NaN (cell 0) included.
+    let last = (cells as i64 - 1) as f64;
+    let c = if xi > 0.0 { xi } else { 0.0 };
+    let c = if c < last { c } else { last };
+    // SAFETY: `c` lies in 0 ..= cells − 1 (a NaN fails `xi > 0` and becomes 0), so it is
+    // finite and fits an i64.
+    unsafe { c.to_int_unchecked::<i64>() as usize }
 }
 
 #[cfg(test)]
@@ -301,6 +308,25 @@ mod tests {
     use super::*;
     use crate::dim::{Dim2, Dim3};
     use glam::{DVec2, DVec3};
+
+    #[test]
+    fn cell_index_truncates_then_clamps_into_the_grid_for_any_coordinate() {
+        // The plain definition: truncate toward zero (saturating), then clamp.
+        let reference = |xi: f64, cells: usize| (xi as i64).max(0).min(cells as i64 - 1) as usize;
+        let mut coordinates = vec![f64::NAN, f64::INFINITY, f64::NEG_INFINITY, -0.0, 1e300, -1e300];
+        coordinates.extend((-400..=1600).map(|k| k as f64 * 0.0125));
+        for cells in [1, 2, 7, 13] {
+            let c = cells as f64;
+            coordinates.extend([c, c - 1e-12, c + 1e-12, f64::EPSILON, -f64::EPSILON]);
+            for &xi in &coordinates {
+                assert_eq!(
+                    cell_index(xi, cells),
+                    reference(xi, cells),
+                    "xi = {xi}, {cells} cells"
+                );
+            }
+        }
+    }
 
     #[test]
     fn node_ids_round_trip() {
