@@ -1,6 +1,5 @@
 //! `points.vtu` holds every material point once, in id order, with the values the columns
-//! hold: read back, each number is the column's to the last bit (`{:e}` prints the shortest
-//! decimal that parses back to the same f64).
+//! hold: read back, each number is the column's to the last bit.
 
 use glam::DVec2;
 use kdmpm::columns::{col, points_with};
@@ -21,22 +20,57 @@ fn simulation(displacements: bool) -> Simulation<Dim2> {
     sim
 }
 
-/// The numbers of every `DataArray` of a `.vtu` file, by name (`Points` for the positions).
+/// The numbers of every `DataArray` of a `.vtu` file, by name (`Points` for the positions),
+/// read from the raw appended section as VTK's XML format defines it: each array's `offset`
+/// counts bytes from the `_` that opens the section, where a UInt64 byte count precedes the
+/// little-endian values.
 fn read_arrays(path: &Path) -> BTreeMap<String, Vec<f64>> {
-    let text = std::fs::read_to_string(path).expect("points.vtu is written");
-    text.split("<DataArray")
+    let bytes = std::fs::read(path).expect("points.vtu is written");
+    let marker = b"<AppendedData encoding=\"raw\">";
+    let section = bytes
+        .windows(marker.len())
+        .position(|w| w == marker)
+        .expect("an appended section");
+    let head = std::str::from_utf8(&bytes[..section]).expect("the XML head is text");
+    assert!(head.contains("header_type=\"UInt64\"") && head.contains("byte_order=\"LittleEndian\""));
+    let data = section
+        + marker.len()
+        + bytes[section + marker.len()..]
+            .iter()
+            .position(|&b| b == b'_')
+            .expect("the section opens with _")
+        + 1;
+    let attribute = |tag: &str, key: &str| {
+        tag.split_once(&format!(" {key}=\""))
+            .map(|(_, rest)| rest.split('"').next().unwrap().to_string())
+    };
+    head.split("<DataArray")
         .skip(1)
         .map(|array| {
-            let (head, rest) = array.split_once('>').expect("tag closes");
-            let name = head
-                .split_once("Name=\"")
-                .map_or("Points", |(_, n)| n.split('"').next().unwrap());
-            let body = rest.split("</DataArray>").next().unwrap();
-            let values = body
-                .split_whitespace()
-                .map(|v| v.parse().expect("a number"))
-                .collect();
-            (name.to_string(), values)
+            let tag = array.split_once('>').expect("tag closes").0;
+            assert_eq!(attribute(tag, "format").as_deref(), Some("appended"));
+            let name = attribute(tag, "Name").unwrap_or_else(|| "Points".to_string());
+            let offset: usize = attribute(tag, "offset").expect("an offset").parse().unwrap();
+            let start = data + offset;
+            let len = u64::from_le_bytes(bytes[start..start + 8].try_into().unwrap()) as usize;
+            let block = &bytes[start + 8..start + 8 + len];
+            let values = match attribute(tag, "type").expect("a type").as_str() {
+                "Float64" => block
+                    .chunks_exact(8)
+                    .map(|b| f64::from_le_bytes(b.try_into().unwrap()))
+                    .collect(),
+                "Int64" => block
+                    .chunks_exact(8)
+                    .map(|b| i64::from_le_bytes(b.try_into().unwrap()) as f64)
+                    .collect(),
+                "UInt32" => block
+                    .chunks_exact(4)
+                    .map(|b| u32::from_le_bytes(b.try_into().unwrap()) as f64)
+                    .collect(),
+                "UInt8" => block.iter().map(|&b| b as f64).collect(),
+                other => panic!("unexpected type {other}"),
+            };
+            (name, values)
         })
         .collect()
 }
@@ -90,9 +124,9 @@ fn points_vtu_holds_every_material_point_in_id_order_with_its_column_values() {
     let arrays = read_arrays(&file);
     let want = expected(&sim);
     let n = want.len();
-    assert!(std::fs::read_to_string(&file)
-        .unwrap()
-        .contains(&format!("NumberOfPoints=\"{n}\"")));
+    assert!(
+        String::from_utf8_lossy(&std::fs::read(&file).unwrap()).contains(&format!("NumberOfPoints=\"{n}\""))
+    );
 
     let ids: Vec<u32> = arrays["id"].iter().map(|&id| id as u32).collect();
     assert_eq!(ids, want.keys().copied().collect::<Vec<_>>(), "ids, ascending");
