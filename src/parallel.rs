@@ -224,8 +224,8 @@ impl<A: NodeTarget, B: NodeTarget, C: NodeTarget> NodeTarget for (A, B, C) {
     }
 }
 
-/// Nodes a grid-pass task covers at least: whole node layers are grouped up to this many, so
-/// a small grid runs as one task and a big one splits into many.
+/// Nodes of the box a grid-pass task covers at least: whole node layers are grouped up to
+/// this many, so a small box runs as one task and a big one splits into many.
 pub const NODES_PER_TASK: usize = 8192;
 
 /// Runs `kernel(part_box, part, first_node)` over the node box `b` in parallel and returns
@@ -246,7 +246,10 @@ pub fn grid_pass<D: Dim, T: NodeTarget, R: Send>(
         return Vec::new();
     }
     let (axis, layer) = (grid.slab_axis, grid.layer());
-    let per_task = NODES_PER_TASK.div_ceil(layer);
+    // Sized by the box's nodes in a layer, not the grid's: a body in a big grid then makes
+    // as many tasks as in a grid of its own size, not many small ones.
+    let box_layer = b.len() / (b.hi[axis] - b.lo[axis]);
+    let per_task = NODES_PER_TASK.div_ceil(box_layer);
     let groups: Vec<Range<usize>> = (b.lo[axis]..b.hi[axis])
         .step_by(per_task)
         .map(|a| a..(a + per_task).min(b.hi[axis]))
@@ -346,7 +349,8 @@ mod tests {
 
     #[test]
     fn grid_pass_visits_every_box_node_once_and_sums_the_same_bits_on_any_thread_count() {
-        // 41 layers of 41 × 41 nodes: groups of 5 layers, so the box below spans 7 groups.
+        // 41 layers of 41 × 41 nodes; the box below has 35 × 39 nodes in a layer, so groups
+        // of 7 layers, and its 33 layers make 5 groups.
         let grid = Grid::<Dim3>::new(DVec3::ZERO, 1.0, [40, 40, 40]);
         let b = NodeBox {
             lo: [3, 1, 2],
@@ -370,7 +374,7 @@ mod tests {
             })
         };
         let (groups, one, visits) = pass(1);
-        assert_eq!(groups, 7);
+        assert_eq!(groups, 5);
         let inside = |i: usize| {
             let ijk = grid.node_ijk(i);
             (0..3).all(|a| b.lo[a] <= ijk[a] && ijk[a] < b.hi[a])
