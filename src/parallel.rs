@@ -268,6 +268,23 @@ pub fn grid_pass<D: Dim, T: NodeTarget, R: Send>(
         .collect()
 }
 
+/// Runs `node(i, k, part)` for every node `i` of the box `b`, in parallel over the groups of
+/// [`grid_pass`]: `part` is the group's range of `target` and `k` the node's index in it.
+/// For grid passes that work node by node and return nothing.
+#[inline(always)]
+pub fn for_each_box_node<D: Dim, T: NodeTarget>(
+    grid: &Grid<D>,
+    b: NodeBox,
+    target: &T,
+    node: impl for<'p> Fn(usize, usize, &mut T::Part<'p>) + Sync,
+) {
+    grid_pass(grid, b, target, |part_box, mut part, first| {
+        for i in part_box.rows(grid).flatten() {
+            node(i, i - first, &mut part);
+        }
+    });
+}
+
 impl NodeTarget for () {
     type Part<'p> = ();
 

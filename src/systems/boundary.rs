@@ -4,7 +4,7 @@ use crate::columns::{col, col_mut, nodes};
 use crate::components::*;
 use crate::dim::{Dim, Vector};
 use crate::error::StepError;
-use crate::parallel::{grid_pass, Disjoint};
+use crate::parallel::{for_each_box_node, Disjoint};
 use crate::schedule::System;
 use crate::simulation::Context;
 
@@ -24,25 +24,18 @@ impl<D: Dim> System<D> for Boundary {
         let mut np = col_mut::<NodeMomentum<D::Vec>>(n);
         let mut nf = col_mut::<NodeForce<D::Vec>>(n);
         let target = (Disjoint::new(&mut np), Disjoint::new(&mut nf));
-        grid_pass(
-            &ctx.grid,
-            ctx.state.active_nodes,
-            &target,
-            |b, (np, nf), first| {
-                for i in b.rows(&ctx.grid).flatten() {
-                    let f = fix[i];
-                    if f.0 == 0 {
-                        continue;
-                    }
-                    for a in 0..D::N {
-                        if f.is_fixed(a) {
-                            np[i - first].0.set(a, 0.0);
-                            nf[i - first].0.set(a, 0.0);
-                        }
-                    }
+        for_each_box_node(&ctx.grid, ctx.state.active_nodes, &target, |i, k, (np, nf)| {
+            let f = fix[i];
+            if f.0 == 0 {
+                return;
+            }
+            for a in 0..D::N {
+                if f.is_fixed(a) {
+                    np[k].0.set(a, 0.0);
+                    nf[k].0.set(a, 0.0);
                 }
-            },
-        );
+            }
+        });
         Ok(())
     }
 }

@@ -4,7 +4,7 @@ use crate::columns::{col, col_mut, nodes};
 use crate::components::*;
 use crate::dim::Dim;
 use crate::error::StepError;
-use crate::parallel::{grid_pass, Disjoint};
+use crate::parallel::{for_each_box_node, Disjoint};
 use crate::schedule::System;
 use crate::simulation::Context;
 use crate::state::Gravity as GravitySpec;
@@ -38,20 +38,13 @@ impl<D: Dim> System<D> for Gravity {
         let mut nf = col_mut::<NodeForce<D::Vec>>(n);
         let mut ne = col_mut::<NodeExternalForce<D::Vec>>(n);
         let target = (Disjoint::new(&mut nf), Disjoint::new(&mut ne));
-        grid_pass(
-            &ctx.grid,
-            ctx.state.active_nodes,
-            &target,
-            |b, (nf, ne), first| {
-                for i in b.rows(&ctx.grid).flatten() {
-                    if nm[i].0 > 0.0 {
-                        let w = gv * nm[i].0;
-                        nf[i - first].0 += w;
-                        ne[i - first].0 += w;
-                    }
-                }
-            },
-        );
+        for_each_box_node(&ctx.grid, ctx.state.active_nodes, &target, |i, k, (nf, ne)| {
+            if nm[i].0 > 0.0 {
+                let w = gv * nm[i].0;
+                nf[k].0 += w;
+                ne[k].0 += w;
+            }
+        });
         Ok(())
     }
 }

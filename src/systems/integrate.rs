@@ -4,7 +4,7 @@ use crate::columns::{col, col_mut, nodes};
 use crate::components::*;
 use crate::dim::{Dim, Vector};
 use crate::error::StepError;
-use crate::parallel::{grid_pass, Disjoint};
+use crate::parallel::{for_each_box_node, Disjoint};
 use crate::schedule::System;
 use crate::simulation::Context;
 use crate::state::Damping;
@@ -41,19 +41,17 @@ impl<D: Dim> System<D> for Integrate {
         let mut nv = col_mut::<NodeVelocity<D::Vec>>(n);
         let grid = &ctx.grid;
         let target = (Disjoint::new(&mut na), Disjoint::new(&mut nv));
-        grid_pass(grid, ctx.state.active_nodes, &target, |b, (na, nv), first| {
-            for i in b.rows(grid).flatten() {
-                let (m, k) = (nm[i].0, i - first);
-                if grid.carries(i, m, min_mass) {
-                    // Dynamic relaxation's mass matrix is fictitious: a floor on the mass that
-                    // accelerates a light node changes the path, never the static answer.
-                    let a = (nf[i].0 - np[i].0 * beta2) * (1.0 / grid.inertia(i, m, floor));
-                    na[k].0 = a;
-                    nv[k].0 = np[i].0 * (1.0 / m) + a * dt;
-                } else {
-                    na[k].0 = D::Vec::ZERO;
-                    nv[k].0 = D::Vec::ZERO;
-                }
+        for_each_box_node(grid, ctx.state.active_nodes, &target, |i, k, (na, nv)| {
+            let m = nm[i].0;
+            if grid.carries(i, m, min_mass) {
+                // Dynamic relaxation's mass matrix is fictitious: a floor on the mass that
+                // accelerates a light node changes the path, never the static answer.
+                let a = (nf[i].0 - np[i].0 * beta2) * (1.0 / grid.inertia(i, m, floor));
+                na[k].0 = a;
+                nv[k].0 = np[i].0 * (1.0 / m) + a * dt;
+            } else {
+                na[k].0 = D::Vec::ZERO;
+                nv[k].0 = D::Vec::ZERO;
             }
         });
         Ok(())

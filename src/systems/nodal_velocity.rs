@@ -5,7 +5,7 @@ use crate::columns::{col, col_mut, nodes};
 use crate::components::*;
 use crate::dim::{Dim, Vector};
 use crate::error::StepError;
-use crate::parallel::{grid_pass, Disjoint};
+use crate::parallel::{for_each_box_node, Disjoint};
 use crate::schedule::System;
 use crate::simulation::Context;
 
@@ -21,20 +21,18 @@ pub fn velocity_from_momentum<D: Dim>(ctx: &Context<D>) {
     let (nm, np, fix) = (&*nm, &*np, &*fix);
     let mut nv = col_mut::<NodeVelocity<D::Vec>>(n);
     let grid = &ctx.grid;
-    grid_pass(
+    for_each_box_node(
         grid,
         ctx.state.active_nodes,
         &Disjoint::new(&mut nv),
-        |b, nv, first| {
-            for i in b.rows(grid).flatten() {
-                let mut v = if grid.carries(i, nm[i].0, min_mass) {
-                    np[i].0 * (1.0 / nm[i].0)
-                } else {
-                    D::Vec::ZERO
-                };
-                constrain(&mut v, fix[i], D::N);
-                nv[i - first].0 = v;
-            }
+        |i, k, nv| {
+            let mut v = if grid.carries(i, nm[i].0, min_mass) {
+                np[i].0 * (1.0 / nm[i].0)
+            } else {
+                D::Vec::ZERO
+            };
+            constrain(&mut v, fix[i], D::N);
+            nv[k].0 = v;
         },
     );
 }

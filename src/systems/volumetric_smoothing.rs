@@ -6,7 +6,7 @@ use crate::components::*;
 use crate::dim::Dim;
 use crate::error::StepError;
 use crate::grid::NodeBox;
-use crate::parallel::{grid_pass, Disjoint, SlabScatter, CHUNK};
+use crate::parallel::{for_each_box_node, Disjoint, SlabScatter, CHUNK};
 use crate::schedule::System;
 use crate::shape::{for_each_node, Shape};
 use crate::simulation::Context;
@@ -86,11 +86,9 @@ impl<D: Dim, S: Shape> System<D> for VolumetricSmoothing<D, S> {
                 },
             ));
         }
-        grid_pass(grid, active, &Disjoint::new(sums), |b, sums, first| {
-            for i in b.rows(grid).flatten() {
-                let s = sums[i - first];
-                sums[i - first] = [if s[1] > 0.0 { s[0] / s[1] } else { 0.0 }, 0.0];
-            }
+        for_each_box_node(grid, active, &Disjoint::new(sums), |_, k, sums| {
+            let s = sums[k];
+            sums[k] = [if s[1] > 0.0 { s[0] / s[1] } else { 0.0 }, 0.0];
         });
         let nodal: &[[f64; 2]] = sums;
         let n = D::N as f64;
