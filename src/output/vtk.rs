@@ -42,45 +42,45 @@ pub fn write_points<D: Dim>(sim: &Simulation<D>, path: &Path) -> std::io::Result
     // Every array with the writer of its values. The XML head and the appended section are
     // both made from this one list, so the offsets cannot disagree with the blocks.
     let mut arrays: Vec<Array> = vec![
-        Array::new("Points", "Float64", 3, n, |out| {
+        Array::new("Points", Kind::Float64, 3, n, |out| {
             each::<Position<D::Vec>>(&archs, &order, out, |out, x| f64s(out, &D::vec_to3(x.0)))
         }),
         // One vertex cell per point.
-        Array::new("connectivity", "Int64", 1, n, |out| {
+        Array::new("connectivity", Kind::Int64, 1, n, |out| {
             (0..n as i64).try_for_each(|i| out.write_all(&i.to_le_bytes()))
         }),
-        Array::new("offsets", "Int64", 1, n, |out| {
+        Array::new("offsets", Kind::Int64, 1, n, |out| {
             (1..=n as i64).try_for_each(|i| out.write_all(&i.to_le_bytes()))
         }),
-        Array::new("types", "UInt8", 1, n, |out| {
+        Array::new("types", Kind::UInt8, 1, n, |out| {
             (0..n).try_for_each(|_| out.write_all(&[VTK_VERTEX]))
         }),
-        Array::new("id", "UInt32", 1, n, |out| {
+        Array::new("id", Kind::UInt32, 1, n, |out| {
             order
                 .points()
                 .try_for_each(|(id, _, _)| out.write_all(&(id as u32).to_le_bytes()))
         }),
     ];
     if displacements {
-        arrays.push(Array::new("displacement", "Float64", 3, n, |out| {
+        arrays.push(Array::new("displacement", Kind::Float64, 3, n, |out| {
             each::<Displacement<D::Vec>>(&archs, &order, out, |out, u| f64s(out, &D::vec_to3(u.0)))
         }));
     }
     arrays.extend([
-        Array::new("stress", "Float64", 6, n, |out| {
+        Array::new("stress", Kind::Float64, 6, n, |out| {
             each::<Stress>(&archs, &order, out, |out, s| {
                 let s = &s.0;
                 f64s(out, &[s.xx, s.yy, s.zz, s.xy, s.yz, s.zx])
             })
         }),
-        Array::new("mean_stress", "Float64", 1, n, |out| {
+        Array::new("mean_stress", Kind::Float64, 1, n, |out| {
             each::<Stress>(&archs, &order, out, |out, s| f64s(out, &[s.0.trace() / 3.0]))
         }),
-        Array::new("volume", "Float64", 1, n, |out| {
+        Array::new("volume", Kind::Float64, 1, n, |out| {
             each::<Volume>(&archs, &order, out, |out, v| f64s(out, &[v.0]))
         }),
         // Bodies without plastic state (elastic) write zero.
-        Array::new("plastic_strain", "Float64", 1, n, |out| {
+        Array::new("plastic_strain", Kind::Float64, 1, n, |out| {
             order
                 .points()
                 .try_for_each(|(_, a, r)| f64s(out, &[plastic[a].as_ref().map_or(0.0, |e| e[r].0)]))
@@ -125,11 +125,40 @@ const VTK_VERTEX: u8 = 1;
 /// Writes the values of one array to the file.
 type Values<'a> = Box<dyn Fn(&mut BufWriter<File>) -> std::io::Result<()> + 'a>;
 
+/// The value types the file uses.
+#[derive(Clone, Copy, Debug)]
+enum Kind {
+    Float64,
+    Int64,
+    UInt32,
+    UInt8,
+}
+
+impl Kind {
+    /// VTK's name of the type.
+    fn name(self) -> &'static str {
+        match self {
+            Kind::Float64 => "Float64",
+            Kind::Int64 => "Int64",
+            Kind::UInt32 => "UInt32",
+            Kind::UInt8 => "UInt8",
+        }
+    }
+
+    /// Bytes a value.
+    fn size(self) -> usize {
+        match self {
+            Kind::Float64 | Kind::Int64 => 8,
+            Kind::UInt32 => 4,
+            Kind::UInt8 => 1,
+        }
+    }
+}
+
 /// One array of the appended section and the writer of its values.
 struct Array<'a> {
     name: &'static str,
-    /// VTK's name of the value type.
-    kind: &'static str,
+    kind: Kind,
     components: usize,
     /// Length of the values in bytes (without the block's 8-byte header).
     bytes: usize,
@@ -149,21 +178,16 @@ enum Part {
 impl<'a> Array<'a> {
     fn new(
         name: &'static str,
-        kind: &'static str,
+        kind: Kind,
         components: usize,
         points: usize,
         values: impl Fn(&mut BufWriter<File>) -> std::io::Result<()> + 'a,
     ) -> Self {
-        let size = match kind {
-            "Float64" | "Int64" => 8,
-            "UInt32" => 4,
-            _ => 1,
-        };
         Array {
             name,
             kind,
             components,
-            bytes: points * components * size,
+            bytes: points * components * kind.size(),
             offset: 0,
             values: Box::new(values),
         }
@@ -179,7 +203,7 @@ impl<'a> Array<'a> {
 
     /// The array's `DataArray` element in the XML head.
     fn tag(&self, out: &mut BufWriter<File>) -> std::io::Result<()> {
-        write!(out, "<DataArray type=\"{}\"", self.kind)?;
+        write!(out, "<DataArray type=\"{}\"", self.kind.name())?;
         // The points are the one unnamed array.
         if self.part() != Part::Points {
             write!(out, " Name=\"{}\"", self.name)?;
