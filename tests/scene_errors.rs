@@ -105,12 +105,20 @@ fn malformed_ron_is_reported_where_it_breaks() {
         13,
         &["tolerence"],
     );
+    // A missing field is reported at the end of its struct, named by the field holding it.
     rejects(
         "missing field",
         "time_step: Fixed(0.01), ",
         "",
         13,
-        &["time_step"],
+        &["field `solver`", "time_step"],
+    );
+    rejects(
+        "missing material field",
+        "cohesion: 0.0, ",
+        "",
+        6,
+        &["field `soil`", "cohesion", "MohrCoulomb"],
     );
 }
 

@@ -16,29 +16,99 @@ pub fn line_column(text: &str, at: usize) -> (usize, usize) {
 }
 
 /// The name of the field whose value holds 1-based (line, column): the nearest `name:`
-/// before it.
+/// before it, outside comments and strings.
 pub fn field_before(text: &str, line: usize, column: usize) -> Option<String> {
+    scan_to(text, offset(text, line, column)).last_field
+}
+
+/// The name of the field whose value is the struct, list or map that holds 1-based
+/// (line, column), e.g. `solver` for a position inside `solver: ( .. )`; `None` at the top
+/// level. A missing field is reported at its struct's closing bracket, where the nearest
+/// name before would be the struct's last field rather than the struct.
+pub fn enclosing_field(text: &str, line: usize, column: usize) -> Option<String> {
+    let open = scan_to(text, offset(text, line, column)).open;
+    // A list element or `Some(..)` is named by the field of the container around it.
+    open.iter().rev().find_map(|&o| field_of_value(text, o))
+}
+
+/// Byte offset of 1-based (line, column), columns counted in characters.
+fn offset(text: &str, line: usize, column: usize) -> usize {
     let start_of_line: usize = text
         .split_inclusive('\n')
         .take(line.saturating_sub(1))
         .map(str::len)
         .sum();
-    let at = text[start_of_line..]
+    text[start_of_line.min(text.len())..]
         .char_indices()
         .nth(column.saturating_sub(1))
-        .map_or(text.len(), |(i, _)| start_of_line + i);
-    let before = &text[..at.min(text.len())];
-    let colon = before.rfind(':')?;
-    let head = before[..colon].trim_end();
-    let name: String = head
-        .chars()
-        .rev()
-        .take_while(|c| c.is_alphanumeric() || *c == '_')
-        .collect::<String>()
-        .chars()
-        .rev()
-        .collect();
-    (!name.is_empty()).then_some(name)
+        .map_or(text.len(), |(i, _)| start_of_line + i)
+}
+
+/// What the text before a byte offset leaves open.
+struct Prefix {
+    /// Offsets of the brackets still open, outermost first.
+    open: Vec<usize>,
+    /// The last `name:` or `"key":` at the depth reached (a closed container's own fields
+    /// are forgotten: after `region: Polygon(vertices: ..)` it is `region`).
+    last_field: Option<String>,
+}
+
+/// Reads the text up to byte offset `at`, skipping comments and string contents.
+fn scan_to(text: &str, at: usize) -> Prefix {
+    let b = text.as_bytes();
+    let mut prefix = Prefix {
+        open: Vec::new(),
+        last_field: None,
+    };
+    // The identifier or string just read, as a candidate field name.
+    let mut name: Option<&str> = None;
+    // The last field of each open container's parent, to restore when it closes.
+    let mut outer: Vec<Option<String>> = Vec::new();
+    let mut i = skip_ws(text, 0);
+    while i < at.min(b.len()) {
+        let c = b[i];
+        let next = if c == b'"' {
+            let end = string_end(text, i);
+            name = text.get(i + 1..end.saturating_sub(1).max(i + 1));
+            end
+        } else if c.is_ascii_alphanumeric() || c == b'_' {
+            let end = text[i..]
+                .find(|ch: char| !(ch.is_alphanumeric() || ch == '_'))
+                .map_or(text.len(), |n| i + n);
+            name = Some(&text[i..end]);
+            end
+        } else {
+            match c {
+                b'(' | b'[' | b'{' => {
+                    prefix.open.push(i);
+                    outer.push(prefix.last_field.clone());
+                }
+                b')' | b']' | b'}' => {
+                    prefix.open.pop();
+                    prefix.last_field = outer.pop().flatten();
+                }
+                b':' => prefix.last_field = name.map(str::to_string).or(prefix.last_field),
+                _ => {}
+            }
+            name = None;
+            i + text[i..].chars().next().map_or(1, char::len_utf8)
+        };
+        i = skip_ws(text, next);
+    }
+    prefix
+}
+
+/// The field whose value opens at byte offset `open`: `name: (`, `name: Variant(` or
+/// `"key": Variant(`; `None` when no `name:` stands right before.
+fn field_of_value(text: &str, open: usize) -> Option<String> {
+    let is_ident = |c: char| c.is_alphanumeric() || c == '_';
+    let head = text[..open].trim_end().trim_end_matches(is_ident).trim_end();
+    let head = head.strip_suffix(':')?.trim_end();
+    let name = match head.strip_suffix('"') {
+        Some(quoted) => &quoted[quoted.rfind('"')? + 1..],
+        None => &head[head.trim_end_matches(is_ident).len()..],
+    };
+    (!name.is_empty()).then(|| name.to_string())
 }
 
 /// Position of the field named by `path`: its name if present, else the deepest parent
@@ -356,5 +426,27 @@ Scene(
         assert!(t.contains("friction_angle: 35)"), "{t}");
         assert!(apply_override(TEXT, "solver").is_err());
         assert!(apply_override(TEXT, "nope.field=1").is_err());
+    }
+
+    #[test]
+    fn a_position_is_named_by_its_own_field_and_by_the_field_holding_its_struct() {
+        // Line 12 ends `damping: Viscous(beta: 0.1)),`: column 65 is `Viscous`'s closing
+        // parenthesis, column 66 `solver`'s.
+        assert_eq!(field_before(TEXT, 12, 65).as_deref(), Some("beta"));
+        assert_eq!(enclosing_field(TEXT, 12, 66).as_deref(), Some("solver"));
+        assert_eq!(enclosing_field(TEXT, 12, 65).as_deref(), Some("damping"));
+        // A map entry is named by its key, a list element by the list.
+        assert_eq!(enclosing_field(TEXT, 6, 66).as_deref(), Some("soil"));
+        assert_eq!(enclosing_field(TEXT, 9, 51).as_deref(), Some("bodies"));
+        // The top-level struct has no field.
+        assert_eq!(enclosing_field(TEXT, 13, 1), None);
+        // A colon in a comment names nothing.
+        let commented = "a: (\n  b: 1, // note: here\n  c: x y)";
+        assert_eq!(field_before(commented, 3, 8).as_deref(), Some("c"));
+        assert_eq!(field_before(commented, 3, 3).as_deref(), Some("b"));
+        // After a nested value the field holding it is the nearest, not its inner fields.
+        assert_eq!(field_before(TEXT, 12, 66).as_deref(), Some("damping"));
+        assert_eq!(field_before(TEXT, 12, 67).as_deref(), Some("solver"));
+        assert_eq!(field_before(TEXT, 6, 67).as_deref(), Some("soil"));
     }
 }

@@ -334,9 +334,14 @@ impl LoadedScene {
         let scene: Scene = ron_options().from_str(&text).map_err(|e| {
             let message = e.code.to_string();
             let (line, column) = (e.span.start.line, e.span.start.col);
-            let field = locate::field_before(&text, line, column)
-                .filter(|f| !message.contains(&format!("`{f}`")))
-                .map_or(String::new(), |f| format!("field `{f}`: "));
+            // A missing field is reported at the closing bracket of the struct that lacks
+            // it, so the struct's own field names the place.
+            let field = match e.code {
+                ron::Error::MissingStructField { .. } => locate::enclosing_field(&text, line, column),
+                _ => locate::field_before(&text, line, column),
+            }
+            .filter(|f| !message.contains(&format!("`{f}`")))
+            .map_or(String::new(), |f| format!("field `{f}`: "));
             SceneError::Syntax {
                 path: path.to_path_buf(),
                 line,
