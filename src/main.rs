@@ -39,7 +39,7 @@ enum Command {
         quiet: bool,
         /// Worker threads (default: all cores). Results are identical for any count.
         #[arg(long)]
-        threads: Option<usize>,
+        threads: Option<std::num::NonZeroUsize>,
         /// Write a Chrome trace (chrome://tracing, Perfetto) of every system call to FILE
         /// (needs a build with `--features trace`).
         #[arg(long, value_name = "FILE")]
@@ -81,7 +81,7 @@ fn main() -> ExitCode {
             };
             if let Some(n) = threads {
                 if let Err(e) = rayon::ThreadPoolBuilder::new()
-                    .num_threads(n.max(1))
+                    .num_threads(n.get())
                     .build_global()
                 {
                     eprintln!("error: cannot start {n} threads: {e}");
