@@ -42,45 +42,50 @@ pub fn write_points<D: Dim>(sim: &Simulation<D>, path: &Path) -> std::io::Result
     // Every array with the writer of its values. The XML head and the appended section are
     // both made from this one list, so the offsets cannot disagree with the blocks.
     let mut arrays: Vec<Array> = vec![
-        Array::new("Points", Kind::Float64, 3, n, |out| {
+        Array::new(Part::Points, "Points", Kind::Float64, 3, n, |out| {
             each::<Position<D::Vec>>(&archs, &order, out, |out, x| f64s(out, &D::vec_to3(x.0)))
         }),
         // One vertex cell per point.
-        Array::new("connectivity", Kind::Int64, 1, n, |out| {
+        Array::new(Part::Cells, "connectivity", Kind::Int64, 1, n, |out| {
             (0..n as i64).try_for_each(|i| out.write_all(&i.to_le_bytes()))
         }),
-        Array::new("offsets", Kind::Int64, 1, n, |out| {
+        Array::new(Part::Cells, "offsets", Kind::Int64, 1, n, |out| {
             (1..=n as i64).try_for_each(|i| out.write_all(&i.to_le_bytes()))
         }),
-        Array::new("types", Kind::UInt8, 1, n, |out| {
+        Array::new(Part::Cells, "types", Kind::UInt8, 1, n, |out| {
             (0..n).try_for_each(|_| out.write_all(&[VTK_VERTEX]))
         }),
-        Array::new("id", Kind::UInt32, 1, n, |out| {
+        Array::new(Part::PointData, "id", Kind::UInt32, 1, n, |out| {
             order
                 .points()
                 .try_for_each(|(id, _, _)| out.write_all(&(id as u32).to_le_bytes()))
         }),
     ];
     if displacements {
-        arrays.push(Array::new("displacement", Kind::Float64, 3, n, |out| {
-            each::<Displacement<D::Vec>>(&archs, &order, out, |out, u| f64s(out, &D::vec_to3(u.0)))
-        }));
+        arrays.push(Array::new(
+            Part::PointData,
+            "displacement",
+            Kind::Float64,
+            3,
+            n,
+            |out| each::<Displacement<D::Vec>>(&archs, &order, out, |out, u| f64s(out, &D::vec_to3(u.0))),
+        ));
     }
     arrays.extend([
-        Array::new("stress", Kind::Float64, 6, n, |out| {
+        Array::new(Part::PointData, "stress", Kind::Float64, 6, n, |out| {
             each::<Stress>(&archs, &order, out, |out, s| {
                 let s = &s.0;
                 f64s(out, &[s.xx, s.yy, s.zz, s.xy, s.yz, s.zx])
             })
         }),
-        Array::new("mean_stress", Kind::Float64, 1, n, |out| {
+        Array::new(Part::PointData, "mean_stress", Kind::Float64, 1, n, |out| {
             each::<Stress>(&archs, &order, out, |out, s| f64s(out, &[s.0.trace() / 3.0]))
         }),
-        Array::new("volume", Kind::Float64, 1, n, |out| {
+        Array::new(Part::PointData, "volume", Kind::Float64, 1, n, |out| {
             each::<Volume>(&archs, &order, out, |out, v| f64s(out, &[v.0]))
         }),
         // Bodies without plastic state (elastic) write zero.
-        Array::new("plastic_strain", Kind::Float64, 1, n, |out| {
+        Array::new(Part::PointData, "plastic_strain", Kind::Float64, 1, n, |out| {
             order
                 .points()
                 .try_for_each(|(_, a, r)| f64s(out, &[plastic[a].as_ref().map_or(0.0, |e| e[r].0)]))
@@ -104,7 +109,7 @@ pub fn write_points<D: Dim>(sim: &Simulation<D>, path: &Path) -> std::io::Result
         ("PointData", Part::PointData),
     ] {
         writeln!(out, "<{section}>")?;
-        for array in arrays.iter().filter(|a| a.part() == part) {
+        for array in arrays.iter().filter(|a| a.part == part) {
             array.tag(&mut out)?;
         }
         writeln!(out, "</{section}>")?;
@@ -157,6 +162,7 @@ impl Kind {
 
 /// One array of the appended section and the writer of its values.
 struct Array<'a> {
+    part: Part,
     name: &'static str,
     kind: Kind,
     components: usize,
@@ -177,6 +183,7 @@ enum Part {
 
 impl<'a> Array<'a> {
     fn new(
+        part: Part,
         name: &'static str,
         kind: Kind,
         components: usize,
@@ -184,6 +191,7 @@ impl<'a> Array<'a> {
         values: impl Fn(&mut BufWriter<File>) -> std::io::Result<()> + 'a,
     ) -> Self {
         Array {
+            part,
             name,
             kind,
             components,
@@ -193,19 +201,11 @@ impl<'a> Array<'a> {
         }
     }
 
-    fn part(&self) -> Part {
-        match self.name {
-            "Points" => Part::Points,
-            "connectivity" | "offsets" | "types" => Part::Cells,
-            _ => Part::PointData,
-        }
-    }
-
     /// The array's `DataArray` element in the XML head.
     fn tag(&self, out: &mut BufWriter<File>) -> std::io::Result<()> {
         write!(out, "<DataArray type=\"{}\"", self.kind.name())?;
         // The points are the one unnamed array.
-        if self.part() != Part::Points {
+        if self.part != Part::Points {
             write!(out, " Name=\"{}\"", self.name)?;
         }
         // Scalars leave the component count at VTK's default of one, so that readers give
