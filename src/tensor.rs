@@ -148,30 +148,77 @@ impl Sym3 {
     pub fn eigen(&self) -> ([f64; 3], DMat3) {
         // Plane strain (and any state with z as a principal axis): closed form in the x-y
         // plane, several times cheaper than Jacobi sweeps.
-        let (vals, vecs) = if self.yz == 0.0 && self.zx == 0.0 {
+        let (vals, vecs) = if self.has_principal_z() {
             planar_eigen(self)
         } else {
             jacobi_eigen(self)
         };
-        // Three-element sorting network, descending.
-        let mut order = [0usize, 1, 2];
-        if vals[order[0]] < vals[order[1]] {
-            order.swap(0, 1);
-        }
-        if vals[order[1]] < vals[order[2]] {
-            order.swap(1, 2);
-        }
-        if vals[order[0]] < vals[order[1]] {
-            order.swap(0, 1);
-        }
-        let p = [vals[order[0]], vals[order[1]], vals[order[2]]];
+        let order = descending_order(vals);
+        let p = order.map(|i| vals[i]);
         let r = DMat3::from_cols(vecs.col(order[0]), vecs.col(order[1]), vecs.col(order[2]));
         (p, r)
     }
 
-    /// Principal values in descending order.
+    /// Principal values in descending order, bit for bit those of [`Sym3::eigen`] for a finite
+    /// tensor (up to the sign of a zero); when z is a principal axis they cost one square root, without the eigenvectors.
     pub fn principal_values(&self) -> [f64; 3] {
-        self.eigen().0
+        if self.has_principal_z() {
+            // c + r ≥ c − r: only zz has to find its place, which min/max do without a branch
+            // to mispredict, to the same values as the sorting network.
+            let [hi, lo, zz] = Planar::of(self).values(self);
+            [hi.max(zz), lo.max(hi.min(zz)), lo.min(zz)]
+        } else {
+            self.eigen().0
+        }
+    }
+
+    /// True when z is a principal axis (yz = zx = 0), as in every plane-strain state.
+    #[inline(always)]
+    pub fn has_principal_z(&self) -> bool {
+        self.yz == 0.0 && self.zx == 0.0
+    }
+}
+
+/// Indices of `v` from the largest value to the smallest (a three-element sorting network).
+#[inline(always)]
+fn descending_order(v: [f64; 3]) -> [usize; 3] {
+    let mut order = [0usize, 1, 2];
+    if v[order[0]] < v[order[1]] {
+        order.swap(0, 1);
+    }
+    if v[order[1]] < v[order[2]] {
+        order.swap(1, 2);
+    }
+    if v[order[0]] < v[order[1]] {
+        order.swap(0, 1);
+    }
+    order
+}
+
+/// The x-y block of a tensor whose z axis is principal as centre c, half-difference d and
+/// radius r of its Mohr circle: principal values c ± r and zz.
+struct Planar {
+    c: f64,
+    d: f64,
+    r: f64,
+}
+
+impl Planar {
+    #[inline(always)]
+    fn of(s: &Sym3) -> Planar {
+        let d = 0.5 * (s.xx - s.yy);
+        Planar {
+            c: 0.5 * (s.xx + s.yy),
+            d,
+            // Plain sqrt, not hypot: stresses are far from overflow and hypot is slow in glibc.
+            r: (d * d + s.xy * s.xy).sqrt(),
+        }
+    }
+
+    /// Principal values, unsorted: c + r, c − r, zz.
+    #[inline(always)]
+    fn values(&self, s: &Sym3) -> [f64; 3] {
+        [self.c + self.r, self.c - self.r, s.zz]
     }
 }
 
@@ -179,10 +226,8 @@ impl Sym3 {
 /// (no trigonometry: the eigenvector of the larger value is (d + r, xy) normalised, taking
 /// the better-conditioned of the two equivalent forms).
 fn planar_eigen(s: &Sym3) -> ([f64; 3], DMat3) {
-    let c = 0.5 * (s.xx + s.yy);
-    let d = 0.5 * (s.xx - s.yy);
-    // Plain sqrt, not hypot: stresses are far from overflow and hypot is slow in glibc.
-    let r = (d * d + s.xy * s.xy).sqrt();
+    let planar = Planar::of(s);
+    let (d, r) = (planar.d, planar.r);
     let (ex, ey) = if r == 0.0 {
         (1.0, 0.0)
     } else if d >= 0.0 {
@@ -193,7 +238,7 @@ fn planar_eigen(s: &Sym3) -> ([f64; 3], DMat3) {
         (s.xy / n, (r - d) / n)
     };
     let vecs = DMat3::from_cols(DVec3::new(ex, ey, 0.0), DVec3::new(-ey, ex, 0.0), DVec3::Z);
-    ([c + r, c - r, s.zz], vecs)
+    (planar.values(s), vecs)
 }
 
 /// Cyclic Jacobi eigen-decomposition of a symmetric 3×3 tensor. Robust for repeated
@@ -416,6 +461,33 @@ mod tests {
             }
             assert!((Sym3::from_principal(p, &r) - s).norm() < 1e-12 * s.norm());
         }
+    }
+
+    #[test]
+    fn planar_principal_values_are_those_of_the_eigen_decomposition_bit_for_bit() {
+        // The Mohr-Coulomb update decides elastic or plastic on these values and returns
+        // plastic points with eigen's: the two must agree to the last bit, with zz above,
+        // inside, at the ends of and below the x-y pair, and for repeated values.
+        let mut n = 0;
+        for xy in [0.0, 3.0e4, -7.1e4] {
+            for zz in [-4.0e5, -2.6e5, -2.0e5, -1.2e5, -0.5e5, 0.0, 1.0e5] {
+                for (xx, yy) in [(-3.0e5, -1.2e5), (-1.2e5, -3.0e5), (-2.0e5, -2.0e5)] {
+                    let s = Sym3 {
+                        xx,
+                        yy,
+                        zz,
+                        xy,
+                        ..Sym3::ZERO
+                    };
+                    let p = s.principal_values();
+                    assert_eq!(p.map(f64::to_bits), s.eigen().0.map(f64::to_bits), "{s:?}");
+                    n += 1;
+                }
+            }
+        }
+        assert_eq!(n, 63);
+        // A general state goes through the same Jacobi sweeps either way.
+        assert_eq!(sample().principal_values(), sample().eigen().0);
     }
 
     #[test]

@@ -106,6 +106,13 @@ impl MohrCoulomb {
         self.k * p[0] - p[2] - self.sigma_c
     }
 
+    /// True when principal stresses sorted σ1 ≥ σ2 ≥ σ3 (Pa) are inside the yield surface and
+    /// at or below the tension cut-off.
+    #[inline(always)]
+    pub fn admissible(&self, p: [f64; 3]) -> bool {
+        self.yield_function(p) <= 0.0 && p[0] <= self.tension_cutoff
+    }
+
     /// True when the stress is inside the yield surface and below the tension cut-off by a
     /// bound from its invariants alone, so most elastic points skip the eigen-decomposition.
     ///
@@ -236,12 +243,20 @@ impl Material for MohrCoulomb {
     #[inline]
     fn update(&self, stress: &mut Sym3, de: &Sym3, plastic: Option<&mut f64>) {
         let trial = *stress + self.elasticity.stress_increment(de);
-        if self.surely_elastic(&trial) {
+        // With z principal (all of plane strain) the exact principal values cost one square
+        // root, as much as the invariant bound, and also settle the states the bound cannot
+        // (most of a failing slope); the eigenvectors are then found only for yielding points.
+        let elastic = if trial.has_principal_z() {
+            self.admissible(trial.principal_values())
+        } else {
+            self.surely_elastic(&trial)
+        };
+        if elastic {
             *stress = trial;
             return;
         }
         let (p, r) = trial.eigen();
-        if self.yield_function(p) <= 0.0 && p[0] <= self.tension_cutoff {
+        if self.admissible(p) {
             *stress = trial;
             return;
         }
