@@ -1,7 +1,7 @@
 //! Quadratic B-splines with a boundary modification.
 
 use super::{Shape, Stencil1};
-use crate::grid::cell_index;
+use crate::grid::{cell_index, Axis};
 
 /// Quadratic B-spline centred on each node (support 3h, C¹ continuous).
 ///
@@ -19,14 +19,15 @@ impl Shape for QuadraticBSpline {
     const SUPPORT: usize = 3;
 
     #[inline(always)]
-    fn eval_1d(xi: f64, cells: usize, inv_h: f64) -> Stencil1 {
+    fn eval_1d(xi: f64, axis: &Axis) -> Stencil1 {
+        let (cells, inv_h) = (axis.cells, axis.inv_h);
         // Stencil nodes b, b+1, b+2 with b = floor(xi − 1/2); local coordinate of node b+1.
         // xi ≥ 0 inside the grid, so truncation is floor except on [−1/2, 0), which is −1;
         // this avoids a libm call (no SSE4.1 rounding on the baseline x86-64 target). The
         // truncation is the cell index's, without a saturating cast's fix-ups: it sets the
         // weights of every point in every transfer, so it is on the critical path.
         let t = xi - 0.5;
-        let k = cell_index(t, cells);
+        let k = cell_index(t, axis);
         let b = if t < 0.0 { -1.0 } else { k as i64 as f64 };
         let d = xi - (b + 1.0); // in [-1/2, 1/2)
         let w0 = 0.5 * (0.5 - d) * (0.5 - d);
@@ -76,7 +77,7 @@ mod tests {
             for xi in xs {
                 let b = (xi - 0.5).floor() as i64;
                 let expect = b.clamp(0, cells as i64 - 2) as usize;
-                let s = QuadraticBSpline::eval_1d(xi, cells, 1.0);
+                let s = QuadraticBSpline::eval_1d(xi, &Axis::new(cells, 1.0));
                 assert_eq!(s.base, expect, "xi = {xi}, {cells} cells");
                 let d = xi - (b as f64 + 1.0);
                 let interior = [

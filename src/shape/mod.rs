@@ -11,7 +11,7 @@ pub use bspline::QuadraticBSpline;
 pub use linear::Linear;
 
 use crate::dim::Dim;
-use crate::grid::Grid;
+use crate::grid::{Axis, Grid};
 
 /// The 1D weights of one point along one axis: nodes `base .. base + SUPPORT`.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -30,9 +30,9 @@ pub trait Shape: Copy + Send + Sync + Default + std::fmt::Debug + 'static {
     const NAME: &'static str;
     /// Nodes per axis that a point touches.
     const SUPPORT: usize;
-    /// Weights for a point at grid coordinate `xi` (cell units from the origin) on an axis
-    /// with `cells` cells of inverse size `inv_h`. The caller guarantees `0 ≤ xi ≤ cells`.
-    fn eval_1d(xi: f64, cells: usize, inv_h: f64) -> Stencil1;
+    /// Weights for a point at grid coordinate `xi` (cell units from the origin) on `axis`.
+    /// The caller guarantees `0 ≤ xi ≤ cells`.
+    fn eval_1d(xi: f64, axis: &Axis) -> Stencil1;
 }
 
 /// Calls `f(node_id, w, ∇w)` for every node in the support of a point at `x`.
@@ -40,8 +40,8 @@ pub trait Shape: Copy + Send + Sync + Default + std::fmt::Debug + 'static {
 /// The point must lie inside the grid (the kinematics system guarantees this).
 #[inline(always)]
 pub fn for_each_node<D: Dim, S: Shape>(grid: &Grid<D>, x: D::Vec, mut f: impl FnMut(usize, f64, D::Vec)) {
-    let sx = S::eval_1d(grid.grid_coordinate(x, 0), grid.cells[0], grid.inv_h);
-    let sy = S::eval_1d(grid.grid_coordinate(x, 1), grid.cells[1], grid.inv_h);
+    let sx = S::eval_1d(grid.grid_coordinate(x, 0), &grid.axes[0]);
+    let sy = S::eval_1d(grid.grid_coordinate(x, 1), &grid.axes[1]);
     let [_, stride_y, stride_z] = grid.strides;
     if D::N == 2 {
         for j in 0..S::SUPPORT {
@@ -52,7 +52,7 @@ pub fn for_each_node<D: Dim, S: Shape>(grid: &Grid<D>, x: D::Vec, mut f: impl Fn
             }
         }
     } else {
-        let sz = S::eval_1d(grid.grid_coordinate(x, 2), grid.cells[2], grid.inv_h);
+        let sz = S::eval_1d(grid.grid_coordinate(x, 2), &grid.axes[2]);
         for k in 0..S::SUPPORT {
             for j in 0..S::SUPPORT {
                 let row = (sz.base + k) * stride_z + (sy.base + j) * stride_y + sx.base;
@@ -167,9 +167,10 @@ pub(crate) mod tests {
 
     #[test]
     fn shape_weights_are_never_negative() {
+        let axis = Axis::new(5, 1.0);
         for k in 0..=400 {
             let xi = 5.0 * k as f64 / 400.0;
-            for s in [Linear::eval_1d(xi, 5, 1.0), QuadraticBSpline::eval_1d(xi, 5, 1.0)] {
+            for s in [Linear::eval_1d(xi, &axis), QuadraticBSpline::eval_1d(xi, &axis)] {
                 assert!(s.w.iter().all(|&w| w >= -1e-15), "{xi}: {s:?}");
             }
         }
