@@ -16,7 +16,8 @@ impl Shape for Linear {
         // A point on the upper face belongs to the last cell, so it never reaches a node
         // beyond the grid.
         let base = cell_index(xi, axis);
-        let f = xi - base as f64;
+        // Through i64: one conversion instruction, where usize → f64 needs a fix-up sequence.
+        let f = xi - base as i64 as f64;
         Stencil1 {
             base,
             w: [1.0 - f, f, 0.0],
