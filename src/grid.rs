@@ -315,6 +315,13 @@ impl Axis {
     }
 }
 
+/// A cell or node index as a float. Through i64: one conversion instruction, where usize → f64
+/// needs a fix-up sequence (for values no index reaches), and stencils convert on every call.
+#[inline(always)]
+pub fn index_to_f64(k: usize) -> f64 {
+    k as i64 as f64
+}
+
 /// Index of the cell holding grid coordinate `xi` (cell units from the origin) on `axis`,
 /// clamped into `0 .. cells`: a point on the upper face belongs to the last cell, one below
 /// the lower face to the first.

@@ -1,7 +1,7 @@
 //! Quadratic B-splines with a boundary modification.
 
 use super::{Shape, Stencil1};
-use crate::grid::{cell_index, Axis};
+use crate::grid::{cell_index, index_to_f64, Axis};
 
 /// Quadratic B-spline centred on each node (support 3h, C¹ continuous).
 ///
@@ -28,7 +28,7 @@ impl Shape for QuadraticBSpline {
         // weights of every point in every transfer, so it is on the critical path.
         let t = xi - 0.5;
         let k = cell_index(t, axis);
-        let b = if t < 0.0 { -1.0 } else { k as i64 as f64 };
+        let b = if t < 0.0 { -1.0 } else { index_to_f64(k) };
         let d = xi - (b + 1.0); // in [-1/2, 1/2)
         let w0 = 0.5 * (0.5 - d) * (0.5 - d);
         let w1 = 0.75 - d * d;

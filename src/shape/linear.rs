@@ -1,7 +1,7 @@
 //! Linear hat functions (bilinear/trilinear by tensor product).
 
 use super::{Shape, Stencil1};
-use crate::grid::{cell_index, Axis};
+use crate::grid::{cell_index, index_to_f64, Axis};
 
 /// Linear hat function: w = 1 − |x − x_i|/h on the two nodes of the cell holding the point.
 #[derive(Clone, Copy, Debug, Default)]
@@ -16,8 +16,7 @@ impl Shape for Linear {
         // A point on the upper face belongs to the last cell, so it never reaches a node
         // beyond the grid.
         let base = cell_index(xi, axis);
-        // Through i64: one conversion instruction, where usize → f64 needs a fix-up sequence.
-        let f = xi - base as i64 as f64;
+        let f = xi - index_to_f64(base);
         Stencil1 {
             base,
             w: [1.0 - f, f, 0.0],
