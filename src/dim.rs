@@ -93,6 +93,8 @@ pub trait Dim: Copy + Send + Sync + Debug + Default + 'static {
     fn volume_ratio(l: &Self::Mat, dt: f64) -> f64;
     /// `m += k·I`.
     fn add_identity(m: &mut Self::Mat, k: f64);
+    /// The matrix whose column j is `c[j]`, for the first `N` columns.
+    fn mat_from_cols(c: [Self::Vec; 3]) -> Self::Mat;
 }
 
 /// Plane strain, unit thickness (m).
@@ -146,6 +148,10 @@ impl Dim for Dim2 {
     fn add_identity(m: &mut DMat2, k: f64) {
         m.x_axis.x += k;
         m.y_axis.y += k;
+    }
+    #[inline(always)]
+    fn mat_from_cols(c: [DVec2; 3]) -> DMat2 {
+        DMat2::from_cols(c[0], c[1])
     }
 }
 
@@ -204,5 +210,9 @@ impl Dim for Dim3 {
         m.x_axis.x += k;
         m.y_axis.y += k;
         m.z_axis.z += k;
+    }
+    #[inline(always)]
+    fn mat_from_cols(c: [DVec3; 3]) -> DMat3 {
+        DMat3::from_cols(c[0], c[1], c[2])
     }
 }

@@ -85,16 +85,10 @@ impl<D: Dim, S: Shape> System<D> for Kinematics<D, S> {
                 .enumerate()
                 .map(|(c, ((x, l), mut u))| {
                     for k in 0..x.len() {
-                        let mut lp = D::MAT_ZERO;
                         let mut vel = D::Vec::ZERO;
                         // One loop per case, so that the node loop holds no branch.
                         if gradient {
-                            for_each_node::<D, S>(grid, x[k].0, |i, w, grad| {
-                                let vi = nv[i].0;
-                                D::add_outer(&mut lp, vi, grad);
-                                vel += vi * w;
-                            });
-                            l[k].0 = lp;
+                            (l[k].0, vel) = S::gather_with_gradient(grid, x[k].0, |i| nv[i].0);
                         } else {
                             for_each_node::<D, S>(grid, x[k].0, |i, w, _| vel += nv[i].0 * w);
                         }
