@@ -4,6 +4,7 @@ use super::{Shape, Stencil1};
 use crate::dim::{Dim, Vector};
 use crate::grid::Grid;
 use crate::grid::{cell_index, index_to_f64, Axis};
+use crate::tensor::Sym3;
 
 /// Linear hat function: w = 1 − |x − x_i|/h on the two nodes of the cell holding the point.
 #[derive(Clone, Copy, Debug, Default)]
@@ -37,40 +38,79 @@ impl Shape for Linear {
         x: D::Vec,
         v: impl Fn(usize) -> D::Vec,
     ) -> (D::Mat, D::Vec) {
-        let sx = Self::eval_1d(grid.grid_coordinate(x, 0), &grid.axes[0]);
-        let sy = Self::eval_1d(grid.grid_coordinate(x, 1), &grid.axes[1]);
-        let (f, inv_h) = (sx.w[1], sx.dw[1]);
-        let [_, stride_y, stride_z] = grid.strides;
         let mut cols = [D::Vec::ZERO; 3];
         let mut vel = D::Vec::ZERO;
-        let mut row = |first: usize, w: f64, dw_dy: f64, dw_dz: f64| {
+        rows(grid, x, |sx, first, w, dw_dy, dw_dz| {
             let v0 = v(first);
             let dv = v(first + 1) - v0;
-            let mean = v0 + dv * f;
-            cols[0] += dv * (inv_h * w);
+            let mean = v0 + dv * sx.w[1];
+            cols[0] += dv * (sx.dw[1] * w);
             cols[1] += mean * dw_dy;
             if D::N == 3 {
                 cols[2] += mean * dw_dz;
             }
             vel += mean * w;
-        };
-        if D::N == 2 {
+        });
+        (D::mat_from_cols(cols), vel)
+    }
+
+    /// Row by row along x, as the gather. A row's nodes share w_r, so with P = −Vσ the far
+    /// node gets f w_r m, f w_r q and a + f b, where a = P_x w_r/h and b = P_y ∂w_r/∂y +
+    /// P_z ∂w_r/∂z, and the near node the row's totals w_r m, w_r q and b less those (the
+    /// x-slopes of a row cancel). About 45 flops a row against 66 for two nodes.
+    #[inline(always)]
+    fn scatter_with_gradient<D: Dim>(
+        grid: &Grid<D>,
+        x: D::Vec,
+        m: f64,
+        q: D::Vec,
+        s: &Sym3,
+        neg_vol: f64,
+        mut add: impl FnMut(usize, f64, D::Vec, D::Vec),
+    ) {
+        // Columns of −Vσ (only the first N entries of each are kept in 2D).
+        let p = |a: f64, b: f64, c: f64| D::vec_from([a * neg_vol, b * neg_vol, c * neg_vol]);
+        let (px, py, pz) = (p(s.xx, s.xy, s.zx), p(s.xy, s.yy, s.yz), p(s.zx, s.yz, s.zz));
+        rows(grid, x, |sx, first, w, dw_dy, dw_dz| {
+            let f = sx.w[1];
+            let a = px * (sx.dw[1] * w);
+            let b = if D::N == 3 {
+                py * dw_dy + pz * dw_dz
+            } else {
+                py * dw_dy
+            };
+            let (mr, qr) = (m * w, q * w);
+            let (m1, q1, f1) = (mr * f, qr * f, a + b * f);
+            add(first, mr - m1, qr - q1, b - f1);
+            add(first + 1, m1, q1, f1);
+        });
+    }
+}
+
+/// Calls `row(sx, first_node, w_r, ∂w_r/∂y, ∂w_r/∂z)` for every x-row of the nodes of a
+/// point at `x` (2 rows in 2D, 4 in 3D): the row's nodes are `first_node` and the next one,
+/// with weights (1 − f) w_r and f w_r, where f = `sx.w[1]` and `sx.dw[1]` = 1/h.
+#[inline(always)]
+fn rows<D: Dim>(grid: &Grid<D>, x: D::Vec, mut row: impl FnMut(&Stencil1, usize, f64, f64, f64)) {
+    let sx = Linear::eval_1d(grid.grid_coordinate(x, 0), &grid.axes[0]);
+    let sy = Linear::eval_1d(grid.grid_coordinate(x, 1), &grid.axes[1]);
+    let [_, stride_y, stride_z] = grid.strides;
+    if D::N == 2 {
+        for j in 0..2 {
+            row(&sx, (sy.base + j) * stride_y + sx.base, sy.w[j], sy.dw[j], 0.0);
+        }
+    } else {
+        let sz = Linear::eval_1d(grid.grid_coordinate(x, 2), &grid.axes[2]);
+        for k in 0..2 {
             for j in 0..2 {
-                row((sy.base + j) * stride_y + sx.base, sy.w[j], sy.dw[j], 0.0);
-            }
-        } else {
-            let sz = Self::eval_1d(grid.grid_coordinate(x, 2), &grid.axes[2]);
-            for k in 0..2 {
-                for j in 0..2 {
-                    row(
-                        (sz.base + k) * stride_z + (sy.base + j) * stride_y + sx.base,
-                        sy.w[j] * sz.w[k],
-                        sy.dw[j] * sz.w[k],
-                        sy.w[j] * sz.dw[k],
-                    );
-                }
+                row(
+                    &sx,
+                    (sz.base + k) * stride_z + (sy.base + j) * stride_y + sx.base,
+                    sy.w[j] * sz.w[k],
+                    sy.dw[j] * sz.w[k],
+                    sy.w[j] * sz.dw[k],
+                );
             }
         }
-        (D::mat_from_cols(cols), vel)
     }
 }

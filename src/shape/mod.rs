@@ -12,6 +12,7 @@ pub use linear::Linear;
 
 use crate::dim::{Dim, Vector};
 use crate::grid::{Axis, Grid};
+use crate::tensor::Sym3;
 
 /// The 1D weights of one point along one axis: nodes `base .. base + SUPPORT`.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -53,6 +54,26 @@ pub trait Shape: Copy + Send + Sync + Default + std::fmt::Debug + 'static {
             vel += vi * w;
         });
         (l, vel)
+    }
+
+    /// Calls `add(node_id, w_ip m, w_ip q, −V σ·∇w_ip)` for every node in the support of a
+    /// point at `x` inside the grid: the point's share of nodal mass (kg), momentum (kg·m/s)
+    /// and internal force (N) for mass `m`, momentum `q`, stress `s` (Pa) and `neg_vol` = −V
+    /// (m³, or m² a unit thickness in plane strain). The transpose of
+    /// [`Shape::gather_with_gradient`], and like it node-by-node by default.
+    #[inline(always)]
+    fn scatter_with_gradient<D: Dim>(
+        grid: &Grid<D>,
+        x: D::Vec,
+        m: f64,
+        q: D::Vec,
+        s: &Sym3,
+        neg_vol: f64,
+        mut add: impl FnMut(usize, f64, D::Vec, D::Vec),
+    ) {
+        for_each_node::<D, Self>(grid, x, |i, w, grad| {
+            add(i, w * m, q * w, D::stress_dot(s, grad) * neg_vol)
+        });
     }
 }
 
@@ -243,6 +264,82 @@ pub(crate) mod tests {
         let (l, vel) = Linear::gather_with_gradient(&g3, x, affine);
         assert!((l - a).to_cols_array().iter().all(|d| d.abs() < 1e-12));
         assert!((vel - (a * x + c)).abs().max_element() < 1e-12);
+    }
+
+    /// The row-wise scatter of [`Linear`] against the node-by-node products at `x`, and
+    /// the sums any scatter must give: Σ w_i m = m, Σ w_i q = q, Σ f_i = 0 (the gradients
+    /// sum to zero) and Σ f_i ⊗ x_i = −Vσ (from Σ ∇w_i ⊗ x_i = I).
+    fn check_linear_scatter<D: Dim>(grid: &Grid<D>, x: D::Vec) {
+        let s = Sym3 {
+            xx: -3.1e5,
+            yy: 1.7e5,
+            zz: -0.4e5,
+            xy: 2.2e5,
+            yz: -0.9e5,
+            zx: 1.3e5,
+        };
+        let (m, q, neg_vol) = (2.5, D::vec_from([0.7, -1.9, 0.4]), -0.125);
+        type Share = (f64, [f64; 3], [f64; 3]);
+        let add = |into: &mut [Share], i: usize, dm: f64, dp: D::Vec, df: D::Vec| {
+            let (dp, df) = (D::vec_to3(dp), D::vec_to3(df));
+            into[i].0 += dm;
+            for a in 0..3 {
+                into[i].1[a] += dp[a];
+                into[i].2[a] += df[a];
+            }
+        };
+        let mut rows = vec![(0.0, [0.0; 3], [0.0; 3]); grid.node_count()];
+        Linear::scatter_with_gradient(grid, x, m, q, &s, neg_vol, |i, dm, dp, df| {
+            add(&mut rows, i, dm, dp, df)
+        });
+        let mut nodes = rows.clone();
+        nodes.fill((0.0, [0.0; 3], [0.0; 3]));
+        for_each_node::<D, Linear>(grid, x, |i, w, grad| {
+            add(&mut nodes, i, w * m, q * w, D::stress_dot(&s, grad) * neg_vol)
+        });
+        let force_scale = 3.1e5 * neg_vol.abs() / grid.cell_size;
+        let (mut mass, mut momentum, mut force) = (0.0, [0.0; 3], [0.0; 3]);
+        let mut moment = [[0.0; 3]; 3];
+        for (i, (r, n)) in rows.iter().zip(&nodes).enumerate() {
+            assert!((r.0 - n.0).abs() < 1e-14 * m, "mass at node {i}, {x:?}");
+            let xi = D::vec_to3(grid.node_position(grid.node_ijk(i)));
+            mass += r.0;
+            for a in 0..3 {
+                assert!((r.1[a] - n.1[a]).abs() < 1e-14, "momentum at node {i}, {x:?}");
+                assert!((r.2[a] - n.2[a]).abs() < 1e-12 * force_scale, "force at node {i}");
+                momentum[a] += r.1[a];
+                force[a] += r.2[a];
+                for b in 0..3 {
+                    moment[a][b] += r.2[a] * xi[b];
+                }
+            }
+        }
+        let sigma = [[s.xx, s.xy, s.zx], [s.xy, s.yy, s.yz], [s.zx, s.yz, s.zz]];
+        let q = D::vec_to3(q);
+        assert!((mass - m).abs() < 1e-14 * m);
+        for a in 0..D::N {
+            assert!((momentum[a] - q[a]).abs() < 1e-14);
+            assert!(force[a].abs() < 1e-10 * force_scale, "Σ f = {force:?} at {x:?}");
+            for b in 0..D::N {
+                let p = neg_vol * sigma[a][b];
+                assert!(
+                    (moment[a][b] - p).abs() < 1e-10 * p.abs().max(1.0),
+                    "{a}{b} at {x:?}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn linear_shape_scatters_row_by_row_what_the_node_by_node_products_give() {
+        let g3 = Grid::<Dim3>::new(DVec3::new(0.0, -1.0, 3.0), 0.25, [4, 5, 3]);
+        let g2 = Grid::<Dim2>::new(DVec2::new(-1.0, 2.0), 0.5, [6, 4, 0]);
+        for &a in &sample_points(7, 0.0, 1.0) {
+            for &b in &sample_points(5, 0.0, 1.0) {
+                check_linear_scatter(&g3, DVec3::new(a, -1.0 + 1.25 * b, 3.0 + 0.75 * (1.0 - a * b)));
+                check_linear_scatter(&g2, DVec2::new(-1.0 + 3.0 * a, 2.0 + 2.0 * b));
+            }
+        }
     }
 
     #[test]

@@ -100,11 +100,11 @@ impl<D: Dim, S: Shape> System<D> for P2g<D, S> {
                         // One loop per case, so that the node loop holds no branch.
                         match (mass_momentum, f) {
                             (true, Some((s, neg_vol))) => {
-                                for_each_node::<D, S>(grid, x[p].0, |i, w, grad| {
+                                S::scatter_with_gradient(grid, x[p].0, mp, mv, s, neg_vol, |i, dm, dp, df| {
                                     let k = i - lo;
-                                    nm[k].0 += w * mp;
-                                    np[k].0 += mv * w;
-                                    nf[k].0 += D::stress_dot(s, grad) * neg_vol;
+                                    nm[k].0 += dm;
+                                    np[k].0 += dp;
+                                    nf[k].0 += df;
                                 })
                             }
                             (true, None) => for_each_node::<D, S>(grid, x[p].0, |i, w, _| {
