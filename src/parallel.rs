@@ -5,6 +5,7 @@
 //! partial results are combined in piece order. So a run gives the same bits on 1 or 2
 //! threads, and from run to run. No atomics are involved.
 
+use crate::components::Position;
 use crate::dim::Dim;
 use crate::grid::{Grid, NodeBox};
 use rayon::prelude::*;
@@ -291,62 +292,111 @@ impl NodeTarget for () {
     unsafe fn part<'p>(&self, _: Range<usize>) -> Self::Part<'p> {}
 }
 
-/// A deterministic parallel scatter from points to nodes, straight into the node columns.
+/// The slabs of every point archetype, shared by all the scatters of a step.
 ///
-/// Points are grouped in slabs of one cell row. A slab touches `support + 1` node layers,
-/// so slabs `support + 1` apart never share a node: the scatter runs in `support + 1`
-/// phases, and within a phase every slab writes to its own node range in parallel. A node
-/// therefore receives its contributions slab by slab in phase order, and within a slab in
-/// point order, whatever the number of threads. No per-thread buffers, no reduction pass.
+/// Built by the first scatter after the points moved, reused by the others until they move
+/// again: MUSL's remap scatters from the positions particle-to-grid grouped, and a step's
+/// particle-to-grid from those the last volumetric smoothing grouped. Every system that
+/// moves points or reorders their rows must call [`SlabCache::invalidate`]: stale slabs
+/// give a stale box of active nodes and another order of the sums, or fail the bounds
+/// check of a slab's node range (never a data race).
 #[derive(Debug, Default)]
-pub struct SlabScatter {
+pub struct SlabCache {
+    entries: Vec<CachedSlabs>,
+}
+
+/// One archetype's slabs.
+#[derive(Debug, Default)]
+struct CachedSlabs {
+    /// Address and length of the archetype's position column: its identity while no point
+    /// moves (columns reallocate only when points are added, which moves no existing point
+    /// without the set-up's sort).
+    column: (usize, usize),
+    /// False once points moved since the slabs were built.
+    fresh: bool,
     slabs: Slabs,
 }
 
-impl SlabScatter {
-    /// Groups the `n` points at `position(p)` into slabs, then runs
-    /// `kernel(points, part, first_node)` for every non-empty slab, where `part` is the slab's
-    /// range of `target` starting at node id `first_node` and `points` are point indices.
-    /// Returns the box of nodes the points reach.
-    ///
-    /// The kernel takes each part for the length of one call (it is generic over the part's
-    /// lifetime), so no part can outlive its phase and meet a part of the next one.
-    pub fn scatter<D: Dim, T: NodeTarget>(
-        &mut self,
-        grid: &Grid<D>,
-        n: usize,
-        position: impl Fn(usize) -> D::Vec + Sync,
-        support: usize,
-        target: &T,
-        kernel: impl for<'p> Fn(&[u32], T::Part<'p>, usize) + Sync,
-    ) -> NodeBox {
-        self.slabs.build(grid, n, position);
-        let slabs = &self.slabs;
-        let phases = support + 1;
-        for phase in 0..phases {
-            let members: Vec<usize> = (phase..slabs.len())
-                .step_by(phases)
-                .filter(|&s| !slabs.points(s).is_empty())
-                .collect();
-            for pair in members.windows(2) {
-                let (a, b) = (
-                    Slabs::node_range(grid, pair[0], support),
-                    Slabs::node_range(grid, pair[1], support),
-                );
-                assert!(a.end <= b.start, "slabs of one phase share nodes");
-            }
-            members.par_iter().for_each(|&s| {
-                let nodes = Slabs::node_range(grid, s, support);
-                let first = nodes.start;
-                // SAFETY: the slabs of one phase cover disjoint node ranges (asserted above),
-                // and the kernel cannot keep its part past the call, so none survives into
-                // the next phase.
-                let part = unsafe { target.part(nodes) };
-                kernel(slabs.points(s), part, first);
-            });
+impl SlabCache {
+    /// Marks every archetype's slabs stale (their allocations are kept for the rebuild).
+    pub fn invalidate(&mut self) {
+        for e in &mut self.entries {
+            e.fresh = false;
         }
-        slabs.reach(grid, support)
     }
+
+    /// The slabs of the points whose positions are `x`, built unless still fresh.
+    pub fn slabs<D: Dim>(&mut self, grid: &Grid<D>, x: &[Position<D::Vec>]) -> &Slabs {
+        let column = (x.as_ptr() as usize, x.len());
+        let k = match self.entries.iter().position(|e| e.column == column) {
+            Some(k) => k,
+            None => {
+                // A stale entry gives its allocation to the new archetype.
+                let k = match self.entries.iter().position(|e| !e.fresh) {
+                    Some(k) => k,
+                    None => {
+                        self.entries.push(CachedSlabs::default());
+                        self.entries.len() - 1
+                    }
+                };
+                self.entries[k].column = column;
+                self.entries[k].fresh = false;
+                k
+            }
+        };
+        let e = &mut self.entries[k];
+        if !e.fresh {
+            e.slabs.build(grid, x.len(), |p| x[p].0);
+            e.fresh = true;
+        }
+        &e.slabs
+    }
+}
+
+/// A deterministic parallel scatter from points to nodes, straight into the node columns:
+/// runs `kernel(points, part, first_node)` for every non-empty slab of `slabs`, where `part`
+/// is the slab's range of `target` starting at node id `first_node` and `points` are point
+/// indices. Returns the box of nodes the points reach with `support` nodes per axis.
+///
+/// A slab touches `support + 1` node layers, so slabs `support + 1` apart never share a
+/// node: the scatter runs in `support + 1` phases, and within a phase every slab writes to
+/// its own node range in parallel. A node therefore receives its contributions slab by slab
+/// in phase order, and within a slab in point order, whatever the number of threads. No
+/// per-thread buffers, no reduction pass.
+///
+/// The kernel takes each part for the length of one call (it is generic over the part's
+/// lifetime), so no part can outlive its phase and meet a part of the next one.
+pub fn scatter<D: Dim, T: NodeTarget>(
+    slabs: &Slabs,
+    grid: &Grid<D>,
+    support: usize,
+    target: &T,
+    kernel: impl for<'p> Fn(&[u32], T::Part<'p>, usize) + Sync,
+) -> NodeBox {
+    let phases = support + 1;
+    for phase in 0..phases {
+        let members: Vec<usize> = (phase..slabs.len())
+            .step_by(phases)
+            .filter(|&s| !slabs.points(s).is_empty())
+            .collect();
+        for pair in members.windows(2) {
+            let (a, b) = (
+                Slabs::node_range(grid, pair[0], support),
+                Slabs::node_range(grid, pair[1], support),
+            );
+            assert!(a.end <= b.start, "slabs of one phase share nodes");
+        }
+        members.par_iter().for_each(|&s| {
+            let nodes = Slabs::node_range(grid, s, support);
+            let first = nodes.start;
+            // SAFETY: the slabs of one phase cover disjoint node ranges (asserted above),
+            // and the kernel cannot keep its part past the call, so none survives into
+            // the next phase.
+            let part = unsafe { target.part(nodes) };
+            kernel(slabs.points(s), part, first);
+        });
+    }
+    slabs.reach(grid, support)
 }
 
 #[cfg(test)]

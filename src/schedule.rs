@@ -9,6 +9,9 @@ use crate::simulation::Context;
 use std::time::{Duration, Instant};
 
 /// One stage of the explicit step.
+///
+/// A system that moves points or reorders their rows calls `ctx.slabs.invalidate()`, so
+/// that the next scatter groups them anew (see [`crate::parallel::SlabCache`]).
 pub trait System<D: Dim>: Send {
     /// Stable name, used in schedules, profiles and error messages.
     fn name(&self) -> &str;

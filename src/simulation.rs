@@ -6,6 +6,7 @@ use crate::dim::{Dim, Dim2, Dim3};
 use crate::error::StepError;
 use crate::grid::Grid;
 use crate::materials::MaterialModel;
+use crate::parallel::SlabCache;
 use crate::schedule::Schedule;
 use crate::state::{Settings, SolverState};
 use crate::tensor::Sym3;
@@ -24,6 +25,8 @@ pub struct Context<D: Dim> {
     pub settings: Settings,
     /// Quantities updated every step.
     pub state: SolverState,
+    /// Points grouped by slab of cells for the scatters, kept until points move.
+    pub slabs: SlabCache,
 }
 
 /// A point whose history is recorded.

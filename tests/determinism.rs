@@ -1,28 +1,48 @@
 //! Parallel work is deterministic: the plastic slope gives the same bits on 1 and 2 threads,
-//! spatial sorts included (every 50 steps here, eight in the run).
+//! spatial sorts included (every 50 steps here, eight in the run), and the same bits whether
+//! the scatters share their grouping of points or group them anew.
 
 use kdmpm::columns::{col, points_with};
 use kdmpm::components::{PlasticStrain, Position, Stress, Velocity};
 use kdmpm::scene::{build, LoadedScene};
-use kdmpm::{AnySimulation, Dim2};
+use kdmpm::{AnySimulation, Context, Dim2, FnSystem, StepError};
 use std::path::Path;
 
 /// Every position, velocity, stress and plastic strain as raw bits, plus K_F and K_E.
 fn fingerprint(threads: usize) -> Vec<u64> {
+    run(threads, &["solver.max_steps=400", "solver.sort_every=50"], false)
+}
+
+/// The slope after a run with `overrides`, as raw bits; with `regroup`, every scatter groups
+/// the points anew instead of reusing the slabs of an earlier one.
+fn run(threads: usize, overrides: &[&str], regroup: bool) -> Vec<u64> {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
         .unwrap();
     pool.install(|| {
         let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/slope.ron");
-        let loaded = LoadedScene::from_file(
-            &path,
-            &["solver.max_steps=400".into(), "solver.sort_every=50".into()],
-        )
-        .unwrap();
+        let overrides: Vec<String> = overrides.iter().map(|o| o.to_string()).collect();
+        let loaded = LoadedScene::from_file(&path, &overrides).unwrap();
         let AnySimulation::Two(mut sim) = build(&loaded).unwrap().0 else {
             unreachable!()
         };
+        if regroup {
+            for scatter in [
+                "p2g",
+                "p2g_momentum",
+                "p2g_force",
+                "remap",
+                "volumetric_smoothing",
+            ] {
+                let forget = |ctx: &mut Context<Dim2>| -> Result<(), StepError> {
+                    ctx.slabs.invalidate();
+                    Ok(())
+                };
+                sim.schedule
+                    .insert_before(scatter, FnSystem::new(format!("forget_{scatter}"), forget));
+            }
+        }
         sim.run(|_| {}).unwrap();
         let mut bits = vec![
             sim.ctx.state.force_ratio_max.to_bits(),
@@ -56,4 +76,27 @@ fn plastic_slope_is_bitwise_identical_on_one_and_two_threads() {
     assert_eq!(differing, 0, "{differing} of {} values differ", one.len());
     // And from run to run.
     assert_eq!(fingerprint(2), two);
+}
+
+#[test]
+fn scatters_sharing_their_slabs_give_the_bits_of_slabs_built_for_every_scatter() {
+    // MUSL (remap reuses p2g's slabs) with volumetric smoothing (p2g reuses the smoothing's),
+    // and USF (the force pass reuses the momentum pass's); sorts every 25 steps.
+    for scheme in ["Musl", "Usf"] {
+        let overrides = [
+            "solver.max_steps=300",
+            "solver.sort_every=25",
+            "solver.volumetric_smoothing=true",
+            &format!("solver.scheme={scheme}"),
+        ];
+        let shared = run(2, &overrides, false);
+        let anew = run(2, &overrides, true);
+        let differing = shared.iter().zip(&anew).filter(|(a, b)| a != b).count();
+        assert_eq!(
+            differing,
+            0,
+            "{scheme}: {differing} of {} values differ",
+            shared.len()
+        );
+    }
 }

@@ -9,6 +9,7 @@ use crate::dim::{Dim, Dim2, Dim3, Vector};
 use crate::error::SceneError;
 use crate::grid::Grid;
 use crate::materials::Material;
+use crate::parallel::SlabCache;
 use crate::shape::{for_each_node, Linear, QuadraticBSpline, ShapeKind};
 use crate::simulation::{AnySimulation, Context, Simulation, TracedPoint};
 use crate::state::{Gravity, Settings, SolverState};
@@ -419,6 +420,7 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         materials,
         settings,
         state,
+        slabs: SlabCache::default(),
     };
     Ok((
         Simulation {

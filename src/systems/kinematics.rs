@@ -61,6 +61,9 @@ impl<D: Dim, S: Shape> System<D> for Kinematics<D, S> {
         if ctx.state.reset_this_step {
             return Ok(());
         }
+        if self.motion {
+            ctx.slabs.invalidate();
+        }
         let (grid, dt, step) = (&ctx.grid, ctx.state.dt, ctx.state.step);
         let name = self.name_static();
         let (gradient, motion) = (self.gradient, self.motion);

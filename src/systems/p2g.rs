@@ -4,7 +4,7 @@ use crate::columns::{col, col_mut, nodes, points_with};
 use crate::components::*;
 use crate::dim::Dim;
 use crate::error::StepError;
-use crate::parallel::{Disjoint, SlabScatter};
+use crate::parallel::{scatter, Disjoint};
 use crate::schedule::System;
 use crate::shape::{for_each_node, Shape};
 use crate::simulation::Context;
@@ -24,11 +24,10 @@ pub enum P2gPart {
 /// Maps point mass m_p, momentum m_p v_p and internal force −V_p σ_p·∇w_ip to the grid.
 ///
 /// Points are grouped in slabs of grid rows that scatter in parallel, slabs that share no
-/// node at a time (see [`SlabScatter`]).
+/// node at a time (see [`scatter`]).
 #[derive(Debug)]
 pub struct P2g<D: Dim, S> {
     part: P2gPart,
-    scatter: SlabScatter,
     _marker: PhantomData<fn() -> (D, S)>,
 }
 
@@ -37,7 +36,6 @@ impl<D: Dim, S: Shape> P2g<D, S> {
     pub fn new(part: P2gPart) -> Self {
         P2g {
             part,
-            scatter: SlabScatter::default(),
             _marker: PhantomData,
         }
     }
@@ -83,10 +81,9 @@ impl<D: Dim, S: Shape> System<D> for P2g<D, S> {
                 Disjoint::new(&mut np),
                 Disjoint::new(&mut nf),
             );
-            reached = reached.union(self.scatter.scatter(
+            reached = reached.union(scatter(
+                ctx.slabs.slabs(grid, x),
                 grid,
-                x.len(),
-                |p| x[p].0,
                 S::SUPPORT,
                 &target,
                 |points, (nm, np, nf), lo| {

@@ -5,7 +5,7 @@ use crate::columns::{col, col_mut, nodes, points_with};
 use crate::components::*;
 use crate::dim::{Dim, Vector};
 use crate::error::StepError;
-use crate::parallel::{Disjoint, SlabScatter};
+use crate::parallel::{scatter, Disjoint};
 use crate::schedule::System;
 use crate::shape::{for_each_node, Shape};
 use crate::simulation::Context;
@@ -15,16 +15,12 @@ use std::marker::PhantomData;
 /// After a kinetic-damping reset all v_p are zero, and so is the remapped field.
 #[derive(Debug)]
 pub struct Remap<D: Dim, S> {
-    scatter: SlabScatter,
     _marker: PhantomData<fn() -> (D, S)>,
 }
 
 impl<D: Dim, S> Default for Remap<D, S> {
     fn default() -> Self {
-        Remap {
-            scatter: SlabScatter::default(),
-            _marker: PhantomData,
-        }
+        Remap { _marker: PhantomData }
     }
 }
 
@@ -56,10 +52,9 @@ impl<D: Dim, S: Shape> System<D> for Remap<D, S> {
                 );
                 let (x, m): (&[Position<D::Vec>], &[Mass]) = (&xg, &mg);
                 let v: &[Velocity<D::Vec>] = &vg;
-                reached = reached.union(self.scatter.scatter(
+                reached = reached.union(scatter(
+                    ctx.slabs.slabs(grid, x),
                     grid,
-                    x.len(),
-                    |p| x[p].0,
                     S::SUPPORT,
                     &Disjoint::new(&mut np),
                     |points, np, lo| {

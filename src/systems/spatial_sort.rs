@@ -76,8 +76,12 @@ impl<D: Dim> System<D> for SpatialSort {
         if ctx.state.step % self.every != 0 {
             return Ok(());
         }
-        ctx.state.points_reordered = sort_points(&ctx.world, &ctx.grid)
-            .map_err(|ForeignComponent| StepError::Unsortable { step: ctx.state.step })?;
+        let sorted = sort_points(&ctx.world, &ctx.grid);
+        if sorted != Ok(false) {
+            ctx.slabs.invalidate();
+        }
+        ctx.state.points_reordered =
+            sorted.map_err(|ForeignComponent| StepError::Unsortable { step: ctx.state.step })?;
         Ok(())
     }
 }

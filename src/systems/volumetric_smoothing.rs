@@ -6,7 +6,7 @@ use crate::components::*;
 use crate::dim::Dim;
 use crate::error::StepError;
 use crate::grid::NodeBox;
-use crate::parallel::{for_each_box_node, Disjoint, SlabScatter, CHUNK};
+use crate::parallel::{for_each_box_node, scatter, Disjoint, CHUNK};
 use crate::schedule::System;
 use crate::shape::{for_each_node, Shape};
 use crate::simulation::Context;
@@ -25,7 +25,6 @@ use std::marker::PhantomData;
 /// volume see the same smoothed rate.
 #[derive(Debug)]
 pub struct VolumetricSmoothing<D: Dim, S> {
-    scatter: SlabScatter,
     /// Per node: Σ w V tr(L), Σ w V; then θ_i in the first entry. Zero outside the points'
     /// box between runs.
     sums: Vec<[f64; 2]>,
@@ -35,7 +34,6 @@ pub struct VolumetricSmoothing<D: Dim, S> {
 impl<D: Dim, S> Default for VolumetricSmoothing<D, S> {
     fn default() -> Self {
         VolumetricSmoothing {
-            scatter: SlabScatter::default(),
             sums: Vec::new(),
             _marker: PhantomData,
         }
@@ -68,10 +66,9 @@ impl<D: Dim, S: Shape> System<D> for VolumetricSmoothing<D, S> {
             );
             let (x, vol): (&[Position<D::Vec>], &[Volume]) = (&xg, &vg);
             let l: &[VelocityGradient<D::Mat>] = &lg;
-            active = active.union(self.scatter.scatter(
+            active = active.union(scatter(
+                ctx.slabs.slabs(grid, x),
                 grid,
-                x.len(),
-                |p| x[p].0,
                 S::SUPPORT,
                 &Disjoint::new(sums),
                 |points, sums, lo| {
