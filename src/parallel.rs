@@ -297,7 +297,7 @@ impl NodeTarget for () {
 /// Built by the first scatter after the points moved, reused by the others until they move
 /// again: MUSL's remap scatters from the positions particle-to-grid grouped, and a step's
 /// particle-to-grid from those the last volumetric smoothing grouped. Every system that
-/// moves points or reorders their rows must call [`SlabCache::invalidate`]: stale slabs
+/// moves, adds, removes or reorders points must call [`SlabCache::invalidate`]: stale slabs
 /// give a stale box of active nodes and another order of the sums, or fail the bounds
 /// check of a slab's node range (never a data race).
 #[derive(Debug, Default)]
@@ -308,9 +308,8 @@ pub struct SlabCache {
 /// One archetype's slabs.
 #[derive(Debug, Default)]
 struct CachedSlabs {
-    /// Address and length of the archetype's position column: its identity while no point
-    /// moves (columns reallocate only when points are added, which moves no existing point
-    /// without the set-up's sort).
+    /// Address and length of the archetype's position column, which name the archetype
+    /// between two invalidations.
     column: (usize, usize),
     /// False once points moved since the slabs were built.
     fresh: bool,

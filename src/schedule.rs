@@ -10,7 +10,7 @@ use std::time::{Duration, Instant};
 
 /// One stage of the explicit step.
 ///
-/// A system that moves points or reorders their rows calls `ctx.slabs.invalidate()`, so
+/// A system that moves, adds, removes or reorders points calls `ctx.slabs.invalidate()`, so
 /// that the next scatter groups them anew (see [`crate::parallel::SlabCache`]).
 pub trait System<D: Dim>: Send {
     /// Stable name, used in schedules, profiles and error messages.
