@@ -72,9 +72,7 @@ fn scan_to(text: &str, at: usize) -> Prefix {
             name = text.get(i + 1..end.saturating_sub(1).max(i + 1));
             end
         } else if c.is_ascii_alphanumeric() || c == b'_' {
-            let end = text[i..]
-                .find(|ch: char| !(ch.is_alphanumeric() || ch == '_'))
-                .map_or(text.len(), |n| i + n);
+            let end = ident_end(text, i);
             name = Some(&text[i..end]);
             end
         } else {
@@ -101,12 +99,11 @@ fn scan_to(text: &str, at: usize) -> Prefix {
 /// The field whose value opens at byte offset `open`: `name: (`, `name: Variant(` or
 /// `"key": Variant(`; `None` when no `name:` stands right before.
 fn field_of_value(text: &str, open: usize) -> Option<String> {
-    let is_ident = |c: char| c.is_alphanumeric() || c == '_';
-    let head = text[..open].trim_end().trim_end_matches(is_ident).trim_end();
+    let head = text[..open].trim_end().trim_end_matches(is_ident_char).trim_end();
     let head = head.strip_suffix(':')?.trim_end();
     let name = match head.strip_suffix('"') {
         Some(quoted) => &quoted[quoted.rfind('"')? + 1..],
-        None => &head[head.trim_end_matches(is_ident).len()..],
+        None => &head[head.trim_end_matches(is_ident_char).len()..],
     };
     (!name.is_empty()).then(|| name.to_string())
 }
@@ -207,6 +204,18 @@ fn segments(path: &str) -> Vec<Seg<'_>> {
     out
 }
 
+/// A character of a RON identifier (a field, variant or struct name).
+fn is_ident_char(c: char) -> bool {
+    c.is_alphanumeric() || c == '_'
+}
+
+/// End of the identifier starting at byte offset `at` (`at` itself when none starts there).
+fn ident_end(text: &str, at: usize) -> usize {
+    text[at..]
+        .find(|c| !is_ident_char(c))
+        .map_or(text.len(), |n| at + n)
+}
+
 /// Skips white space and comments from `at`.
 fn skip_ws(text: &str, mut at: usize) -> usize {
     let b = text.as_bytes();
@@ -297,10 +306,7 @@ fn find_field(text: &str, open: usize, name: &str) -> Option<(usize, usize)> {
             let end = string_end(text, at);
             (&text[at + 1..end - 1] == name).then_some(end)
         } else {
-            let end = at
-                + text[at..]
-                    .find(|ch: char| !(ch.is_alphanumeric() || ch == '_'))
-                    .unwrap_or(0);
+            let end = ident_end(text, at);
             (&text[at..end] == name).then_some(end)
         }?;
         let colon = skip_ws(text, key_end);
@@ -335,16 +341,13 @@ fn descend(text: &str, value: usize) -> Option<usize> {
     let mut at = skip_ws(text, value);
     let b = text.as_bytes();
     loop {
-        let ident_end = at
-            + text[at..]
-                .find(|ch: char| !(ch.is_alphanumeric() || ch == '_'))
-                .unwrap_or(0);
-        let next = skip_ws(text, ident_end);
+        let name_end = ident_end(text, at);
+        let next = skip_ws(text, name_end);
         let c = *b.get(next)?;
         if !matches!(c, b'(' | b'[' | b'{') {
             return None;
         }
-        if &text[at..ident_end] == "Some" {
+        if &text[at..name_end] == "Some" {
             at = skip_ws(text, next + 1);
             continue;
         }
