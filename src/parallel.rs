@@ -338,8 +338,8 @@ impl SlabCache {
                         self.entries.len() - 1
                     }
                 };
+                // Stale or new, so built below.
                 self.entries[k].column = column;
-                self.entries[k].fresh = false;
                 k
             }
         };

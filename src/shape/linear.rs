@@ -2,8 +2,7 @@
 
 use super::{Shape, Stencil1};
 use crate::dim::{Dim, Vector};
-use crate::grid::Grid;
-use crate::grid::{cell_index, index_to_f64, Axis};
+use crate::grid::{cell_index, index_to_f64, Axis, Grid};
 use crate::tensor::Sym3;
 
 /// Linear hat function: w = 1 − |x − x_i|/h on the two nodes of the cell holding the point.
