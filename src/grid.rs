@@ -228,6 +228,24 @@ impl<D: Dim> Grid<D> {
         cell_index(self.grid_coordinate(x, axis), &self.axes[axis])
     }
 
+    /// Where a point that moves from `from` to `to` (m) lands: `None` outside the grid (as
+    /// [`Grid::contains`]), otherwise whether it left its cell. Cells are compared in cell
+    /// units rounded down, which agrees with [`Grid::clamped_cell`] except for a point on an
+    /// upper face (or outside), which the clamp puts in the last cell: a move between it and
+    /// the last cell is called a change. A change is never missed.
+    #[inline(always)]
+    pub fn landing(&self, from: D::Vec, to: D::Vec) -> Option<bool> {
+        let mut left = false;
+        for k in 0..D::N {
+            let xi = self.grid_coordinate(to, k);
+            if !(xi >= 0.0 && xi <= self.axes[k].end) {
+                return None;
+            }
+            left |= xi.floor() != self.grid_coordinate(from, k).floor();
+        }
+        Some(left)
+    }
+
     /// The nodes a stencil of `support` nodes per axis can reach from cells `lo ..= hi`: it
     /// starts at the point's cell or the one below and never leaves the grid.
     pub fn reach(&self, lo: [usize; 3], hi: [usize; 3], support: usize) -> NodeBox {
@@ -361,6 +379,56 @@ mod tests {
                 );
             }
         }
+    }
+
+    #[test]
+    fn a_landing_never_misses_a_cell_change_and_calls_one_only_on_an_upper_face() {
+        // A 2 × 3 × 4 grid of 0.5 m cells from (−1, 0, 2) m; points on a lattice of 0.1 m
+        // steps reaching 0.3 m beyond every face, moved by small and cell-sized steps.
+        let grid = Grid::<Dim3>::new(DVec3::new(-1.0, 0.0, 2.0), 0.5, [2, 3, 4]);
+        let (lo, hi) = (grid.origin - 0.3, grid.max_corner() + 0.3);
+        let lattice = |a: usize| {
+            let n = ((hi[a] - lo[a]) / 0.1).round() as usize;
+            (0..=n).map(move |k| lo[a] + k as f64 * 0.1)
+        };
+        let steps = [0.0, 1e-9, -1e-9, 0.04, -0.07, 0.5, -0.5];
+        let (mut called_left, mut kept) = (0, 0);
+        for x in lattice(0) {
+            for y in lattice(1) {
+                for z in lattice(2) {
+                    let from = DVec3::new(x, y, z);
+                    if !grid.contains(from) {
+                        continue;
+                    }
+                    for (i, &d) in steps.iter().enumerate() {
+                        let to = from + DVec3::new(d, steps[(i + 2) % 7], steps[(i + 5) % 7]);
+                        match grid.landing(from, to) {
+                            None => assert!(!grid.contains(to), "{from} → {to} is inside"),
+                            Some(left) => {
+                                assert!(grid.contains(to), "{from} → {to} is outside");
+                                let same = grid.clamped_cell(from) == grid.clamped_cell(to);
+                                let on_upper_face =
+                                    |p: DVec3| (0..3).any(|a| grid.grid_coordinate(p, a) == grid.axes[a].end);
+                                if on_upper_face(from) || on_upper_face(to) {
+                                    assert!(left || same, "{from} → {to}: change missed");
+                                } else {
+                                    assert_eq!(left, !same, "{from} → {to}");
+                                }
+                                if left {
+                                    called_left += 1;
+                                } else {
+                                    kept += 1;
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        assert!(
+            called_left > 1000 && kept > 1000,
+            "{called_left} left, {kept} kept"
+        );
     }
 
     #[test]

@@ -294,10 +294,12 @@ impl NodeTarget for () {
 
 /// The slabs of every point archetype, shared by all the scatters of a step.
 ///
-/// Built by the first scatter after the points moved, reused by the others until they move
-/// again: MUSL's remap scatters from the positions particle-to-grid grouped, and a step's
-/// particle-to-grid from those the last volumetric smoothing grouped. Every system that
-/// moves, adds, removes or reorders points must call [`SlabCache::invalidate`]: stale slabs
+/// A grouping depends on the cell of each point alone. It is built by the first scatter
+/// after a point changed cell and reused by the others until one changes cell again: MUSL's
+/// remap scatters with the slabs particle-to-grid built, a step's particle-to-grid with
+/// those of the last volumetric smoothing, and in a body near rest one step with the last
+/// step's. Every system that moves a point into another cell, or adds, removes or reorders
+/// points, must call [`SlabCache::invalidate`]: stale slabs
 /// give a stale box of active nodes and another order of the sums, or fail the bounds
 /// check of a slab's node range (never a data race).
 #[derive(Debug, Default)]

@@ -10,8 +10,9 @@ use std::time::{Duration, Instant};
 
 /// One stage of the explicit step.
 ///
-/// A system that moves, adds, removes or reorders points calls `ctx.slabs.invalidate()`, so
-/// that the next scatter groups them anew (see [`crate::parallel::SlabCache`]).
+/// A system that moves a point into another cell, or adds, removes or reorders points, calls
+/// `ctx.slabs.invalidate()`, so that the next scatter groups them anew (see
+/// [`crate::parallel::SlabCache`]; [`crate::grid::Grid::landing`] tells a cell change).
 pub trait System<D: Dim>: Send {
     /// Stable name, used in schedules, profiles and error messages.
     fn name(&self) -> &str;
