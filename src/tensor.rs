@@ -3,6 +3,7 @@
 //!
 //! Sign convention: tension positive, as in continuum mechanics.
 
+use crate::dim::madd;
 use glam::{DMat3, DVec3};
 use std::ops::{Add, AddAssign, Mul, Sub, SubAssign};
 
@@ -323,9 +324,9 @@ pub fn jaumann_rotate(stress: &Sym3, w: [f64; 3]) -> Sym3 {
         [stress.zx, stress.yz, stress.zz],
     ];
     let t: [[f64; 3]; 3] = std::array::from_fn(|i| {
-        std::array::from_fn(|j| r[i][0] * s[0][j] + r[i][1] * s[1][j] + r[i][2] * s[2][j])
+        std::array::from_fn(|j| madd(r[i][0], s[0][j], madd(r[i][1], s[1][j], r[i][2] * s[2][j])))
     });
-    Sym3::from_fn(|i, j| t[i][0] * r[j][0] + t[i][1] * r[j][1] + t[i][2] * r[j][2])
+    Sym3::from_fn(|i, j| madd(t[i][0], r[j][0], madd(t[i][1], r[j][1], t[i][2] * r[j][2])))
 }
 
 /// The Cayley rotation of [`jaumann_rotate`] for a spin about z only (all of plane strain):

@@ -42,13 +42,13 @@ impl Shape for Linear {
         rows(grid, x, |sx, first, w, dw_dy, dw_dz| {
             let v0 = v(first);
             let dv = v(first + 1) - v0;
-            let mean = v0 + dv * sx.w[1];
-            cols[0] += dv * (sx.dw[1] * w);
-            cols[1] += mean * dw_dy;
+            let mean = dv.madd(sx.w[1], v0);
+            cols[0] = dv.madd(sx.dw[1] * w, cols[0]);
+            cols[1] = mean.madd(dw_dy, cols[1]);
             if D::N == 3 {
-                cols[2] += mean * dw_dz;
+                cols[2] = mean.madd(dw_dz, cols[2]);
             }
-            vel += mean * w;
+            vel = mean.madd(w, vel);
         });
         (D::mat_from_cols(cols), vel)
     }
@@ -74,12 +74,12 @@ impl Shape for Linear {
             let f = sx.w[1];
             let a = px * (sx.dw[1] * w);
             let b = if D::N == 3 {
-                py * dw_dy + pz * dw_dz
+                py.madd(dw_dy, pz * dw_dz)
             } else {
                 py * dw_dy
             };
             let (mr, qr) = (m * w, q * w);
-            let (m1, q1, f1) = (mr * f, qr * f, a + b * f);
+            let (m1, q1, f1) = (mr * f, qr * f, b.madd(f, a));
             add(first, mr - m1, qr - q1, b - f1);
             add(first + 1, m1, q1, f1);
         });

@@ -51,7 +51,7 @@ pub trait Shape: Copy + Send + Sync + Default + std::fmt::Debug + 'static {
         for_each_node::<D, Self>(grid, x, |i, w, grad| {
             let vi = v(i);
             D::add_outer(&mut l, vi, grad);
-            vel += vi * w;
+            vel = vi.madd(w, vel);
         });
         (l, vel)
     }

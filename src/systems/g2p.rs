@@ -52,12 +52,12 @@ impl<D: Dim, S: Shape> System<D> for G2p<D, S> {
                         vp.0 = if pic {
                             let mut vg = D::Vec::ZERO;
                             for_each_node::<D, S>(grid, x[p].0, |i, w, _| {
-                                a += na[i].0 * w;
-                                vg += nv[i].0 * w;
+                                a = na[i].0.madd(w, a);
+                                vg = nv[i].0.madd(w, vg);
                             });
                             (vp.0 + a * dt) * flip + vg * (1.0 - flip)
                         } else {
-                            for_each_node::<D, S>(grid, x[p].0, |i, w, _| a += na[i].0 * w);
+                            for_each_node::<D, S>(grid, x[p].0, |i, w, _| a = na[i].0.madd(w, a));
                             vp.0 + a * dt
                         };
                         e += m[p].0 * vp.0.dot(vp.0);

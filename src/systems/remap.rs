@@ -61,7 +61,10 @@ impl<D: Dim, S: Shape> System<D> for Remap<D, S> {
                         for &p in points {
                             let p = p as usize;
                             let mv = v[p].0 * m[p].0;
-                            for_each_node::<D, S>(grid, x[p].0, |i, w, _| np[i - lo].0 += mv * w);
+                            for_each_node::<D, S>(grid, x[p].0, |i, w, _| {
+                                let n = &mut np[i - lo].0;
+                                *n = mv.madd(w, *n);
+                            });
                         }
                     },
                 ));
