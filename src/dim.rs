@@ -77,11 +77,8 @@ macro_rules! impl_vector {
             }
             #[inline(always)]
             fn madd(self, k: f64, acc: Self) -> Self {
-                if cfg!(target_feature = "fma") {
-                    self.mul_add(<$t>::splat(k), acc)
-                } else {
-                    self * k + acc
-                }
+                let (v, a) = (self.to_array(), acc.to_array());
+                <$t>::from_array(std::array::from_fn(|i| madd(v[i], k, a[i])))
             }
         }
     };
