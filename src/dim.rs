@@ -41,8 +41,8 @@ pub trait Vector:
 }
 
 /// `a·b + c`: rounded once where the build targets a CPU with fused multiply-add (the
-/// host CPU, `.cargo/config.toml`), so the transfer kernels run about a third fewer
-/// floating-point instructions; rounded twice, as written, where it does not (a software
+/// host CPU, `.cargo/config.toml`), which took the 3D block's stepping loop from 1 385 to
+/// 1 283 instructions a particle-step; rounded twice, as written, where it does not (a software
 /// fused multiply-add would cost more than it saves). Either way the same for every thread
 /// count.
 #[inline(always)]
