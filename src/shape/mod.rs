@@ -38,29 +38,23 @@ pub trait Shape: Copy + Send + Sync + Default + std::fmt::Debug + 'static {
     /// The velocity gradient Σ_i v_i ⊗ ∇w_ip (1/s) and the velocity Σ_i w_ip v_i (m/s) that
     /// the nodal field `v` (node id → m/s) gives a point at `x` inside the grid.
     ///
-    /// The default forms every node's weight and gradient through [`for_each_node`]; a shape
-    /// may use its own structure to do the same sums with less work.
+    /// The default is [`gather_node_by_node`]; a shape may use its own structure to do the
+    /// same sums with less work.
     #[inline(always)]
     fn gather_with_gradient<D: Dim>(
         grid: &Grid<D>,
         x: D::Vec,
         v: impl Fn(usize) -> D::Vec,
     ) -> (D::Mat, D::Vec) {
-        let mut l = D::MAT_ZERO;
-        let mut vel = D::Vec::ZERO;
-        for_each_node::<D, Self>(grid, x, |i, w, grad| {
-            let vi = v(i);
-            D::add_outer(&mut l, vi, grad);
-            vel = vi.madd(w, vel);
-        });
-        (l, vel)
+        gather_node_by_node::<D, Self>(grid, x, v)
     }
 
     /// Calls `add(node_id, w_ip m, w_ip q, −V σ·∇w_ip)` for every node in the support of a
     /// point at `x` inside the grid: the point's share of nodal mass (kg), momentum (kg·m/s)
     /// and internal force (N) for mass `m`, momentum `q`, stress `s` (Pa) and `neg_vol` = −V
     /// (m³, or m² a unit thickness in plane strain). The transpose of
-    /// [`Shape::gather_with_gradient`], and like it node-by-node by default.
+    /// [`Shape::gather_with_gradient`], and like it node by node by default
+    /// ([`scatter_node_by_node`]).
     #[inline(always)]
     fn scatter_with_gradient<D: Dim>(
         grid: &Grid<D>,
@@ -69,12 +63,45 @@ pub trait Shape: Copy + Send + Sync + Default + std::fmt::Debug + 'static {
         q: D::Vec,
         s: &Sym3,
         neg_vol: f64,
-        mut add: impl FnMut(usize, f64, D::Vec, D::Vec),
+        add: impl FnMut(usize, f64, D::Vec, D::Vec),
     ) {
-        for_each_node::<D, Self>(grid, x, |i, w, grad| {
-            add(i, w * m, q * w, D::stress_dot(s, grad) * neg_vol)
-        });
+        scatter_node_by_node::<D, Self>(grid, x, m, q, s, neg_vol, add)
     }
+}
+
+/// [`Shape::gather_with_gradient`] from every node's weight and gradient ([`for_each_node`]):
+/// the default, and the reference a shape's own form is tested against.
+#[inline(always)]
+pub fn gather_node_by_node<D: Dim, S: Shape>(
+    grid: &Grid<D>,
+    x: D::Vec,
+    v: impl Fn(usize) -> D::Vec,
+) -> (D::Mat, D::Vec) {
+    let mut l = D::MAT_ZERO;
+    let mut vel = D::Vec::ZERO;
+    for_each_node::<D, S>(grid, x, |i, w, grad| {
+        let vi = v(i);
+        D::add_outer(&mut l, vi, grad);
+        vel = vi.madd(w, vel);
+    });
+    (l, vel)
+}
+
+/// [`Shape::scatter_with_gradient`] from every node's weight and gradient
+/// ([`for_each_node`]): the default, and the reference a shape's own form is tested against.
+#[inline(always)]
+pub fn scatter_node_by_node<D: Dim, S: Shape>(
+    grid: &Grid<D>,
+    x: D::Vec,
+    m: f64,
+    q: D::Vec,
+    s: &Sym3,
+    neg_vol: f64,
+    mut add: impl FnMut(usize, f64, D::Vec, D::Vec),
+) {
+    for_each_node::<D, S>(grid, x, |i, w, grad| {
+        add(i, w * m, q * w, D::stress_dot(s, grad) * neg_vol)
+    });
 }
 
 /// Calls `f(node_id, w, ∇w)` for every node in the support of a point at `x`.
@@ -207,53 +234,36 @@ pub(crate) mod tests {
         }
     }
 
-    /// The node-by-node sums that [`Shape::gather_with_gradient`] stands for.
-    fn gather_node_by_node<D: Dim, S: Shape>(
-        grid: &Grid<D>,
-        x: D::Vec,
-        v: impl Fn(usize) -> D::Vec,
-    ) -> (D::Mat, D::Vec) {
-        let (mut l, mut vel) = (D::MAT_ZERO, D::Vec::ZERO);
-        for_each_node::<D, S>(grid, x, |i, w, grad| {
-            D::add_outer(&mut l, v(i), grad);
-            vel += v(i) * w;
-        });
-        (l, vel)
+    /// The row-wise gather of [`Linear`] against the node-by-node sums at `x` for an
+    /// arbitrary nodal field; `entries` lists a velocity gradient's entries.
+    fn check_linear_gather<D: Dim>(grid: &Grid<D>, x: D::Vec, entries: impl Fn(D::Mat) -> Vec<f64>) {
+        let v = |i: usize| {
+            let i = i as f64;
+            D::vec_from([(i * 0.37).sin(), (i * 0.11).cos(), (i * 0.53).sin() - 0.2])
+        };
+        let (l, vel) = Linear::gather_with_gradient(grid, x, v);
+        let (l_ref, vel_ref) = gather_node_by_node::<D, Linear>(grid, x, v);
+        for (a, b) in entries(l).iter().zip(entries(l_ref)) {
+            assert!((a - b).abs() < 1e-12, "{x:?}");
+        }
+        let (vel, vel_ref) = (D::vec_to3(vel), D::vec_to3(vel_ref));
+        for a in 0..3 {
+            assert!((vel[a] - vel_ref[a]).abs() < 1e-14, "{x:?}");
+        }
     }
 
     #[test]
     fn linear_shape_gathers_row_by_row_what_the_node_by_node_sums_give() {
-        // An arbitrary nodal field: the row-wise form must agree with every node's outer
-        // product to round-off, in 2D and 3D, on faces and inside.
-        let field = |i: usize| {
-            [
-                (i as f64 * 0.37).sin(),
-                (i as f64 * 0.11).cos(),
-                (i as f64 * 0.53).sin() - 0.2,
-            ]
-        };
+        // The row-wise form must agree with every node's outer product to round-off, in 2D
+        // and 3D, on faces and inside.
         let g3 = Grid::<Dim3>::new(DVec3::new(0.0, -1.0, 3.0), 0.25, [4, 5, 3]);
         let g2 = Grid::<Dim2>::new(DVec2::new(-1.0, 2.0), 0.5, [6, 4, 0]);
         for &a in &sample_points(7, 0.0, 1.0) {
             for &b in &sample_points(5, 0.0, 1.0) {
                 let x3 = DVec3::new(a, -1.0 + 1.25 * b, 3.0 + 0.75 * (1.0 - a * b));
-                let v3 = |i: usize| DVec3::from_array(field(i));
-                let (l, vel) = Linear::gather_with_gradient(&g3, x3, v3);
-                let (l_ref, vel_ref) = gather_node_by_node::<Dim3, Linear>(&g3, x3, v3);
-                assert!(
-                    (l - l_ref).to_cols_array().iter().all(|d| d.abs() < 1e-12),
-                    "{x3:?}"
-                );
-                assert!((vel - vel_ref).abs().max_element() < 1e-14, "{x3:?}");
+                check_linear_gather(&g3, x3, |m: glam::DMat3| m.to_cols_array().to_vec());
                 let x2 = DVec2::new(-1.0 + 3.0 * a, 2.0 + 2.0 * b);
-                let v2 = |i: usize| DVec2::new(field(i)[0], field(i)[1]);
-                let (l, vel) = Linear::gather_with_gradient(&g2, x2, v2);
-                let (l_ref, vel_ref) = gather_node_by_node::<Dim2, Linear>(&g2, x2, v2);
-                assert!(
-                    (l - l_ref).to_cols_array().iter().all(|d| d.abs() < 1e-12),
-                    "{x2:?}"
-                );
-                assert!((vel - vel_ref).abs().max_element() < 1e-14, "{x2:?}");
+                check_linear_gather(&g2, x2, |m: glam::DMat2| m.to_cols_array().to_vec());
             }
         }
         // An affine field v = A x + c is reproduced exactly: L = A and v_p = A x_p + c.
@@ -294,8 +304,8 @@ pub(crate) mod tests {
         });
         let mut nodes = rows.clone();
         nodes.fill((0.0, [0.0; 3], [0.0; 3]));
-        for_each_node::<D, Linear>(grid, x, |i, w, grad| {
-            add(&mut nodes, i, w * m, q * w, D::stress_dot(&s, grad) * neg_vol)
+        scatter_node_by_node::<D, Linear>(grid, x, m, q, &s, neg_vol, |i, dm, dp, df| {
+            add(&mut nodes, i, dm, dp, df)
         });
         let force_scale = 3.1e5 * neg_vol.abs() / grid.cell_size;
         let (mut mass, mut momentum, mut force) = (0.0, [0.0; 3], [0.0; 3]);
