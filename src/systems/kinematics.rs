@@ -97,7 +97,7 @@ impl<D: Dim, S: Shape> System<D> for Kinematics<D, S> {
                         if gradient {
                             (l[k].0, vel) = S::gather_with_gradient(grid, x[k].0, |i| nv[i].0);
                         } else {
-                            for_each_node::<D, S>(grid, x[k].0, |i, w, _| vel += nv[i].0 * w);
+                            for_each_node::<D, S>(grid, x[k].0, |i, w, _| vel = nv[i].0.madd(w, vel));
                         }
                         if motion {
                             let du = vel * dt;
