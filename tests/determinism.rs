@@ -62,7 +62,6 @@ fn run(threads: usize, overrides: &[&str], regroup: bool) -> Vec<u64> {
                 bits.push(e.0.to_bits());
             }
         }
-        let _: &kdmpm::Simulation<Dim2> = &sim;
         bits
     })
 }
