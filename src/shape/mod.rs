@@ -252,19 +252,31 @@ pub(crate) mod tests {
         }
     }
 
+    /// The grids and points on which Linear's row-wise forms are checked against the
+    /// node-by-node sums: a 3D and a 2D grid, points on their faces and inside.
+    fn row_form_cases() -> (Grid<Dim3>, Grid<Dim2>, Vec<(DVec3, DVec2)>) {
+        let g3 = Grid::<Dim3>::new(DVec3::new(0.0, -1.0, 3.0), 0.25, [4, 5, 3]);
+        let g2 = Grid::<Dim2>::new(DVec2::new(-1.0, 2.0), 0.5, [6, 4, 0]);
+        let mut points = Vec::new();
+        for &a in &sample_points(7, 0.0, 1.0) {
+            for &b in &sample_points(5, 0.0, 1.0) {
+                points.push((
+                    DVec3::new(a, -1.0 + 1.25 * b, 3.0 + 0.75 * (1.0 - a * b)),
+                    DVec2::new(-1.0 + 3.0 * a, 2.0 + 2.0 * b),
+                ));
+            }
+        }
+        (g3, g2, points)
+    }
+
     #[test]
     fn linear_shape_gathers_row_by_row_what_the_node_by_node_sums_give() {
         // The row-wise form must agree with every node's outer product to round-off, in 2D
         // and 3D, on faces and inside.
-        let g3 = Grid::<Dim3>::new(DVec3::new(0.0, -1.0, 3.0), 0.25, [4, 5, 3]);
-        let g2 = Grid::<Dim2>::new(DVec2::new(-1.0, 2.0), 0.5, [6, 4, 0]);
-        for &a in &sample_points(7, 0.0, 1.0) {
-            for &b in &sample_points(5, 0.0, 1.0) {
-                let x3 = DVec3::new(a, -1.0 + 1.25 * b, 3.0 + 0.75 * (1.0 - a * b));
-                check_linear_gather(&g3, x3, |m: glam::DMat3| m.to_cols_array().to_vec());
-                let x2 = DVec2::new(-1.0 + 3.0 * a, 2.0 + 2.0 * b);
-                check_linear_gather(&g2, x2, |m: glam::DMat2| m.to_cols_array().to_vec());
-            }
+        let (g3, g2, points) = row_form_cases();
+        for (x3, x2) in points {
+            check_linear_gather(&g3, x3, |m: glam::DMat3| m.to_cols_array().to_vec());
+            check_linear_gather(&g2, x2, |m: glam::DMat2| m.to_cols_array().to_vec());
         }
         // An affine field v = A x + c is reproduced exactly: L = A and v_p = A x_p + c.
         let a = glam::DMat3::from_cols_array(&[0.3, -1.2, 0.5, 2.0, 0.1, -0.7, -0.4, 0.9, 1.5]);
@@ -342,13 +354,10 @@ pub(crate) mod tests {
 
     #[test]
     fn linear_shape_scatters_row_by_row_what_the_node_by_node_products_give() {
-        let g3 = Grid::<Dim3>::new(DVec3::new(0.0, -1.0, 3.0), 0.25, [4, 5, 3]);
-        let g2 = Grid::<Dim2>::new(DVec2::new(-1.0, 2.0), 0.5, [6, 4, 0]);
-        for &a in &sample_points(7, 0.0, 1.0) {
-            for &b in &sample_points(5, 0.0, 1.0) {
-                check_linear_scatter(&g3, DVec3::new(a, -1.0 + 1.25 * b, 3.0 + 0.75 * (1.0 - a * b)));
-                check_linear_scatter(&g2, DVec2::new(-1.0 + 3.0 * a, 2.0 + 2.0 * b));
-            }
+        let (g3, g2, points) = row_form_cases();
+        for (x3, x2) in points {
+            check_linear_scatter(&g3, x3);
+            check_linear_scatter(&g2, x2);
         }
     }
 
