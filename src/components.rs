@@ -7,8 +7,6 @@
 //! that carry a load. Grid nodes all share one archetype, spawned in id order, so a node
 //! column slice is indexed by node id.
 
-use crate::tensor::Sym3;
-
 /// Current position of a material point (m).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Position<V>(pub V);
@@ -29,9 +27,10 @@ pub struct Mass(pub f64);
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Volume(pub f64);
 
-/// Cauchy stress of a material point (Pa, tension positive).
+/// Cauchy stress of a material point (Pa, tension positive), stored as `S` =
+/// [`crate::Dim::Stress`]: four components in plane strain, six in 3D.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Stress(pub Sym3);
+pub struct Stress<S>(pub S);
 
 /// Velocity gradient L = ∂v/∂x of the last step (1/s), input of the stress and volume update.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -5,7 +5,7 @@
 //! nodes per point with linear shape functions and never touches a third axis; the only
 //! 3D quantity it keeps is the out-of-plane normal stress, which plane strain requires.
 
-use crate::tensor::Sym3;
+use crate::tensor::{PlanarSym3, StoredSym, Sym3};
 use glam::{DMat2, DMat3, DVec2, DVec3};
 use std::fmt::Debug;
 use std::ops::{Add, AddAssign, Mul, Neg, Sub, SubAssign};
@@ -96,6 +96,8 @@ pub trait Dim: Copy + Send + Sync + Debug + Default + 'static {
     type Vec: Vector;
     /// Velocity gradient L_ij = ∂v_i/∂x_j (1/s), column-major glam matrix.
     type Mat: Copy + Send + Sync + Debug + PartialEq + 'static;
+    /// A point's stored stress (Pa): [`PlanarSym3`] in plane strain, [`Sym3`] in 3D.
+    type Stress: StoredSym;
 
     /// The zero velocity gradient.
     const MAT_ZERO: Self::Mat;
@@ -131,6 +133,7 @@ impl Dim for Dim2 {
     const N: usize = 2;
     type Vec = DVec2;
     type Mat = DMat2;
+    type Stress = PlanarSym3;
     const MAT_ZERO: DMat2 = DMat2::ZERO;
 
     #[inline(always)]
@@ -181,6 +184,7 @@ impl Dim for Dim3 {
     const N: usize = 3;
     type Vec = DVec3;
     type Mat = DMat3;
+    type Stress = Sym3;
     const MAT_ZERO: DMat3 = DMat3::ZERO;
 
     #[inline(always)]

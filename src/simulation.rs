@@ -9,7 +9,7 @@ use crate::materials::MaterialModel;
 use crate::parallel::SlabCache;
 use crate::schedule::Schedule;
 use crate::state::{Settings, SolverState};
-use crate::tensor::Sym3;
+use crate::tensor::{StoredSym, Sym3};
 use hecs::{Entity, World};
 
 /// Everything the systems read and write: the world (points and nodes), the grid, the
@@ -159,7 +159,10 @@ impl<D: Dim> Simulation<D> {
                     .world
                     .entity(t.current_entity(&self.ctx.world))
                     .expect("traced point exists");
-                let stress = e.get::<&Stress>().map(|s| s.0).unwrap_or_default();
+                let stress = e
+                    .get::<&Stress<D::Stress>>()
+                    .map(|s| s.0.to_sym3())
+                    .unwrap_or_default();
                 TracedResult {
                     name: t.name.clone(),
                     initial_position: t.initial_position,

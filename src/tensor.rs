@@ -24,6 +24,66 @@ pub struct Sym3 {
     pub zx: f64,
 }
 
+/// How a material point stores its stress: the six components of a [`Sym3`] in 3D, the
+/// four of [`PlanarSym3`] in plane strain, where yz and zx are zero by construction.
+/// Materials and the Jaumann rotation work on [`Sym3`]; a point's stress is widened on load
+/// and narrowed on store, which in plane strain the compiler folds into the arithmetic.
+pub trait StoredSym: Copy + Send + Sync + std::fmt::Debug + Default + PartialEq + 'static {
+    /// The full tensor.
+    fn to_sym3(&self) -> Sym3;
+    /// The stored form of `s`. In plane strain `s` must have z principal (yz = zx = 0).
+    fn from_sym3(s: &Sym3) -> Self;
+}
+
+impl StoredSym for Sym3 {
+    #[inline(always)]
+    fn to_sym3(&self) -> Sym3 {
+        *self
+    }
+    #[inline(always)]
+    fn from_sym3(s: &Sym3) -> Self {
+        *s
+    }
+}
+
+/// A symmetric 3×3 tensor with z principal (yz = zx = 0), stored by its four non-zero
+/// components: the stress of plane strain, where σzz ≠ 0 but no shear leaves the plane.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PlanarSym3 {
+    /// Component xx.
+    pub xx: f64,
+    /// Component yy.
+    pub yy: f64,
+    /// Component zz.
+    pub zz: f64,
+    /// Component xy (= yx).
+    pub xy: f64,
+}
+
+impl StoredSym for PlanarSym3 {
+    #[inline(always)]
+    fn to_sym3(&self) -> Sym3 {
+        Sym3 {
+            xx: self.xx,
+            yy: self.yy,
+            zz: self.zz,
+            xy: self.xy,
+            yz: 0.0,
+            zx: 0.0,
+        }
+    }
+    #[inline(always)]
+    fn from_sym3(s: &Sym3) -> Self {
+        debug_assert!(s.has_principal_z(), "out-of-plane shear in plane strain: {s:?}");
+        PlanarSym3 {
+            xx: s.xx,
+            yy: s.yy,
+            zz: s.zz,
+            xy: s.xy,
+        }
+    }
+}
+
 impl Sym3 {
     /// The zero tensor.
     pub const ZERO: Sym3 = Sym3 {
@@ -531,6 +591,30 @@ mod tests {
                 (fast - general).norm() < 1e-12 * s.norm(),
                 "{fast:?} vs {general:?}"
             );
+        }
+    }
+
+    #[test]
+    fn a_plane_strain_stress_stays_planar_through_spin_and_material_and_stores_in_four_components() {
+        // Plane strain keeps yz = zx = 0 (the stored form drops them): the spin of a 2D
+        // velocity gradient is about z only, and an in-plane strain adds no out-of-plane shear.
+        let s = PlanarSym3 {
+            xx: -3.0e5,
+            yy: -1.2e5,
+            zz: -0.7e5,
+            xy: 4.0e4,
+        };
+        let elastic = crate::materials::Elasticity::new(20e6, 0.3);
+        for w in [1e-3, -0.4, 2.5] {
+            let de = Sym3 {
+                xx: 1e-4,
+                yy: -2e-4,
+                xy: 3e-5 * w,
+                ..Sym3::ZERO
+            };
+            let full = jaumann_rotate(&s.to_sym3(), [0.0, 0.0, w]) + elastic.stress_increment(&de);
+            assert!(full.has_principal_z(), "{full:?}");
+            assert_eq!(PlanarSym3::from_sym3(&full).to_sym3(), full);
         }
     }
 

@@ -5,6 +5,7 @@
 use kdmpm::columns::{col, points_with};
 use kdmpm::components::{PlasticStrain, Position, Stress, Velocity};
 use kdmpm::scene::{build, LoadedScene};
+use kdmpm::tensor::{PlanarSym3, StoredSym};
 use kdmpm::{AnySimulation, Context, Dim2, FnSystem, StepError};
 use std::path::Path;
 
@@ -48,15 +49,15 @@ fn run(threads: usize, overrides: &[&str], regroup: bool) -> Vec<u64> {
             sim.ctx.state.force_ratio_max.to_bits(),
             sim.ctx.state.energy_ratio.to_bits(),
         ];
-        for arch in points_with::<Stress>(&sim.ctx.world) {
+        for arch in points_with::<Stress<PlanarSym3>>(&sim.ctx.world) {
             for x in col::<Position<glam::DVec2>>(arch).iter() {
                 bits.extend(x.0.to_array().map(f64::to_bits));
             }
             for v in col::<Velocity<glam::DVec2>>(arch).iter() {
                 bits.extend(v.0.to_array().map(f64::to_bits));
             }
-            for s in col::<Stress>(arch).iter() {
-                bits.extend(s.0.to_array().map(f64::to_bits));
+            for s in col::<Stress<PlanarSym3>>(arch).iter() {
+                bits.extend(s.0.to_sym3().to_array().map(f64::to_bits));
             }
             for e in col::<PlasticStrain>(arch).iter() {
                 bits.push(e.0.to_bits());

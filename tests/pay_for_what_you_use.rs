@@ -1,11 +1,12 @@
 //! A scene pays only for what it uses: no gravity system without gravity, no plastic state
 //! on elastic points, no peak watch without kinetic damping, no point-load system without
 //! loads, no sort system when sorting is off, no smaller time step for a material no body
-//! uses; 2D scenes store 2-vectors.
+//! uses; 2D scenes store 2-vectors and the four stress components of plane strain.
 
 use kdmpm::columns::points_with;
 use kdmpm::components::{PlasticStrain, PointLoad, Position, Stress};
 use kdmpm::scene::{build, LoadedScene};
+use kdmpm::tensor::{PlanarSym3, Sym3};
 use kdmpm::{AnySimulation, Dim2, Dim3};
 use std::path::Path;
 
@@ -29,7 +30,7 @@ fn elastic_bar_without_gravity_has_no_gravity_system_and_no_plastic_state() {
     assert_eq!(loaded.len(), 1);
     assert_eq!(loaded[0].len(), 1);
     assert!(
-        loaded[0].get::<&Stress>().is_none(),
+        loaded[0].get::<&Stress<Sym3>>().is_none(),
         "a load carrier has no stress"
     );
 }
@@ -65,14 +66,20 @@ fn plastic_slope_has_plastic_state_on_every_point_and_gravity_but_no_loads() {
     };
     let names = sim.schedule.names();
     assert!(names.contains(&"gravity".to_string()) && !names.contains(&"point_loads".to_string()));
-    let stressed: u32 = points_with::<Stress>(&sim.ctx.world).map(|a| a.len()).sum();
+    let stressed: u32 = points_with::<Stress<PlanarSym3>>(&sim.ctx.world)
+        .map(|a| a.len())
+        .sum();
     let plastic: u32 = points_with::<PlasticStrain>(&sim.ctx.world)
         .map(|a| a.len())
         .sum();
     assert_eq!(stressed, plastic);
-    // 2D scenes store two components per vector.
+    // 2D scenes store two components per vector, and of the stress only xx, yy, zz and xy
+    // (plane strain has no out-of-plane shear).
+    assert_eq!(points_with::<Stress<Sym3>>(&sim.ctx.world).count(), 0);
     assert_eq!(std::mem::size_of::<Position<<Dim2 as kdmpm::Dim>::Vec>>(), 16);
     assert_eq!(std::mem::size_of::<Position<<Dim3 as kdmpm::Dim>::Vec>>(), 24);
+    assert_eq!(std::mem::size_of::<Stress<<Dim2 as kdmpm::Dim>::Stress>>(), 32);
+    assert_eq!(std::mem::size_of::<Stress<<Dim3 as kdmpm::Dim>::Stress>>(), 48);
 }
 
 #[test]

@@ -8,6 +8,7 @@ use kdmpm::columns::{col, points_with};
 use kdmpm::components::*;
 use kdmpm::measure::{max_movement, positions};
 use kdmpm::systems::SpatialSort;
+use kdmpm::tensor::{PlanarSym3, StoredSym};
 use kdmpm::{Dim2, Simulation, StepError, System};
 use std::collections::BTreeMap;
 
@@ -30,7 +31,7 @@ fn records(sim: &Simulation<Dim2>) -> BTreeMap<u32, Record> {
         let m = col::<Mass>(arch);
         let u = arch.get::<&Displacement<DVec2>>();
         let l = arch.get::<&VelocityGradient<DMat2>>();
-        let s = arch.get::<&Stress>();
+        let s = arch.get::<&Stress<PlanarSym3>>();
         let vol = arch.get::<&Volume>();
         let mat = arch.get::<&MaterialId>();
         let eps = arch.get::<&PlasticStrain>();
@@ -42,7 +43,10 @@ fn records(sim: &Simulation<Dim2>) -> BTreeMap<u32, Record> {
             r.push(m[p].0.to_bits());
             r.extend(u.iter().flat_map(|u| u[p].0.to_array().map(f64::to_bits)));
             r.extend(l.iter().flat_map(|l| l[p].0.to_cols_array().map(f64::to_bits)));
-            r.extend(s.iter().flat_map(|s| s[p].0.to_array().map(f64::to_bits)));
+            r.extend(
+                s.iter()
+                    .flat_map(|s| s[p].0.to_sym3().to_array().map(f64::to_bits)),
+            );
             r.extend(vol.iter().map(|vol| vol[p].0.to_bits()));
             r.extend(mat.iter().map(|mat| mat[p].0 as u64));
             r.extend(eps.iter().map(|e| e[p].0.to_bits()));

@@ -5,6 +5,7 @@ use glam::DVec2;
 use kdmpm::columns::{col, points_with};
 use kdmpm::components::*;
 use kdmpm::output::vtk::write_points;
+use kdmpm::tensor::{PlanarSym3, StoredSym};
 use kdmpm::{Dim2, Simulation};
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -81,17 +82,17 @@ type Expected = BTreeMap<u32, (DVec2, Option<DVec2>, [f64; 6], f64, f64)>;
 
 fn expected(sim: &Simulation<Dim2>) -> Expected {
     let mut all = Expected::new();
-    for arch in points_with::<Stress>(&sim.ctx.world) {
+    for arch in points_with::<Stress<PlanarSym3>>(&sim.ctx.world) {
         let (ids, x, s, v) = (
             col::<PointId>(arch),
             col::<Position<DVec2>>(arch),
-            col::<Stress>(arch),
+            col::<Stress<PlanarSym3>>(arch),
             col::<Volume>(arch),
         );
         let u = arch.get::<&Displacement<DVec2>>();
         let eps = arch.get::<&PlasticStrain>();
         for p in 0..ids.len() {
-            let s = s[p].0;
+            let s = s[p].0.to_sym3();
             let row = (
                 x[p].0,
                 u.as_ref().map(|u| u[p].0),
@@ -112,7 +113,7 @@ fn path(name: &str) -> std::path::PathBuf {
 #[test]
 fn points_vtu_holds_every_material_point_in_id_order_with_its_column_values() {
     let sim = simulation(true);
-    let stored: Vec<u32> = points_with::<Stress>(&sim.ctx.world)
+    let stored: Vec<u32> = points_with::<Stress<PlanarSym3>>(&sim.ctx.world)
         .flat_map(|a| col::<PointId>(a).iter().map(|id| id.0).collect::<Vec<_>>())
         .collect();
     assert!(

@@ -5,6 +5,7 @@ use crate::columns::{col, points_with};
 use crate::components::*;
 use crate::dim::Dim;
 use crate::simulation::Simulation;
+use crate::tensor::StoredSym;
 use hecs::{Archetype, Component};
 use std::fs::File;
 use std::io::{BufWriter, Write};
@@ -24,7 +25,7 @@ use std::path::Path;
 /// writer, writing holds 8 bytes a point (where each id is), so output does not raise the
 /// run's peak memory.
 pub fn write_points<D: Dim>(sim: &Simulation<D>, path: &Path) -> std::io::Result<()> {
-    let archs: Vec<&Archetype> = points_with::<Stress>(&sim.ctx.world).collect();
+    let archs: Vec<&Archetype> = points_with::<Stress<D::Stress>>(&sim.ctx.world).collect();
     // Where the point of each id is: archetype in the high half, row in the low half (the
     // load carriers' ids are gaps).
     let n = archs.iter().map(|a| a.len() as usize).sum::<usize>();
@@ -73,13 +74,15 @@ pub fn write_points<D: Dim>(sim: &Simulation<D>, path: &Path) -> std::io::Result
     }
     arrays.extend([
         Array::new(Part::PointData, "stress", Kind::Float64, 6, n, |out| {
-            each::<Stress>(&archs, &order, out, |out, s| {
-                let s = &s.0;
+            each::<Stress<D::Stress>>(&archs, &order, out, |out, s| {
+                let s = s.0.to_sym3();
                 f64s(out, &[s.xx, s.yy, s.zz, s.xy, s.yz, s.zx])
             })
         }),
         Array::new(Part::PointData, "mean_stress", Kind::Float64, 1, n, |out| {
-            each::<Stress>(&archs, &order, out, |out, s| f64s(out, &[s.0.trace() / 3.0]))
+            each::<Stress<D::Stress>>(&archs, &order, out, |out, s| {
+                f64s(out, &[s.0.to_sym3().trace() / 3.0])
+            })
         }),
         Array::new(Part::PointData, "volume", Kind::Float64, 1, n, |out| {
             each::<Volume>(&archs, &order, out, |out, v| f64s(out, &[v.0]))

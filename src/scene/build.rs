@@ -15,7 +15,6 @@ use crate::simulation::{AnySimulation, Context, Simulation, TracedPoint};
 use crate::state::{Gravity, Settings, SolverState};
 use crate::systems::spatial_sort::sort_points;
 use crate::systems::{check_names, default_names, schedule_from_names, Needs};
-use crate::tensor::Sym3;
 use hecs::{Entity, World};
 
 /// Validates the scene and builds its simulation with its schedule (the default one for its
@@ -251,7 +250,7 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
                 Velocity(z),
                 Mass(mass),
                 Volume(volume),
-                Stress(Sym3::ZERO),
+                Stress(D::Stress::default()),
                 VelocityGradient(D::MAT_ZERO),
                 MaterialId(mat as u16),
             )

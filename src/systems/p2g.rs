@@ -8,6 +8,7 @@ use crate::parallel::{scatter, Disjoint};
 use crate::schedule::System;
 use crate::shape::{for_each_node, Shape};
 use crate::simulation::Context;
+use crate::tensor::StoredSym;
 use std::marker::PhantomData;
 
 /// What a [`P2g`] pass maps.
@@ -67,9 +68,9 @@ impl<D: Dim, S: Shape> System<D> for P2g<D, S> {
             let mg = col::<Mass>(arch);
             let vg = col::<Velocity<D::Vec>>(arch);
             // Load carriers have no volume or stress and add no internal force.
-            let sg = arch.get::<&Stress>();
+            let sg = arch.get::<&Stress<D::Stress>>();
             let volg = arch.get::<&Volume>();
-            let stressed: Option<(&[Stress], &[Volume])> = sg.as_deref().zip(volg.as_deref());
+            let stressed = sg.as_deref().zip(volg.as_deref());
             let force = force && stressed.is_some();
             if !mass_momentum && !force {
                 continue;
@@ -91,19 +92,25 @@ impl<D: Dim, S: Shape> System<D> for P2g<D, S> {
                         let p = p as usize;
                         let (mp, mv) = (m[p].0, v[p].0 * m[p].0);
                         let f = match (stressed, force) {
-                            (Some((s, vol)), true) => Some((&s[p].0, -vol[p].0)),
+                            (Some((s, vol)), true) => Some((s[p].0.to_sym3(), -vol[p].0)),
                             _ => None,
                         };
                         // One loop per case, so that the node loop holds no branch.
                         match (mass_momentum, f) {
-                            (true, Some((s, neg_vol))) => {
-                                S::scatter_with_gradient(grid, x[p].0, mp, mv, s, neg_vol, |i, dm, dp, df| {
+                            (true, Some((s, neg_vol))) => S::scatter_with_gradient(
+                                grid,
+                                x[p].0,
+                                mp,
+                                mv,
+                                &s,
+                                neg_vol,
+                                |i, dm, dp, df| {
                                     let k = i - lo;
                                     nm[k].0 += dm;
                                     np[k].0 += dp;
                                     nf[k].0 += df;
-                                })
-                            }
+                                },
+                            ),
                             (true, None) => for_each_node::<D, S>(grid, x[p].0, |i, w, _| {
                                 let k = i - lo;
                                 nm[k].0 += w * mp;
@@ -111,7 +118,7 @@ impl<D: Dim, S: Shape> System<D> for P2g<D, S> {
                             }),
                             (false, Some((s, neg_vol))) => {
                                 for_each_node::<D, S>(grid, x[p].0, |i, _, grad| {
-                                    nf[i - lo].0 += D::stress_dot(s, grad) * neg_vol;
+                                    nf[i - lo].0 += D::stress_dot(&s, grad) * neg_vol;
                                 })
                             }
                             (false, None) => {}

@@ -158,7 +158,7 @@ macro_rules! point_components {
             VelocityGradient<<$d as Dim>::Mat>,
             Mass,
             Volume,
-            Stress,
+            Stress<<$d as Dim>::Stress>,
             MaterialId,
             PlasticStrain,
             PointId

@@ -8,7 +8,7 @@ use crate::materials::Material;
 use crate::parallel::CHUNK;
 use crate::schedule::System;
 use crate::simulation::Context;
-use crate::tensor::jaumann_rotate;
+use crate::tensor::{jaumann_rotate, StoredSym};
 use rayon::prelude::*;
 
 /// For each point: Δε = sym(L)Δt and ΔW = skew(L)Δt; the stress is first rotated by ΔW
@@ -26,21 +26,21 @@ impl<D: Dim> System<D> for StressUpdate {
         }
         let dt = ctx.state.dt;
         let materials = &ctx.materials;
-        let kernel = |stress: &mut [Stress],
+        let kernel = |stress: &mut [Stress<D::Stress>],
                       l: &[VelocityGradient<D::Mat>],
                       mat: &[MaterialId],
                       mut plastic: Option<&mut [PlasticStrain]>| {
             for p in 0..stress.len() {
                 let (de, w) = D::strain_spin(&l[p].0, dt);
-                let mut s = jaumann_rotate(&stress[p].0, w);
+                let mut s = jaumann_rotate(&stress[p].0.to_sym3(), w);
                 let eps = plastic.as_mut().map(|e| &mut e[p].0);
                 materials[mat[p].0 as usize].update(&mut s, &de, eps);
-                stress[p].0 = s;
+                stress[p].0 = D::Stress::from_sym3(&s);
             }
         };
-        for arch in points_with::<Stress>(&ctx.world) {
+        for arch in points_with::<Stress<D::Stress>>(&ctx.world) {
             let (lg, mg) = (col::<VelocityGradient<D::Mat>>(arch), col::<MaterialId>(arch));
-            let mut sg = col_mut::<Stress>(arch);
+            let mut sg = col_mut::<Stress<D::Stress>>(arch);
             let chunks = sg
                 .par_chunks_mut(CHUNK)
                 .zip(lg.par_chunks(CHUNK))
