@@ -92,7 +92,7 @@ impl<D: Dim, S: Shape> System<D> for P2g<D, S> {
                         let p = p as usize;
                         let (mp, mv) = (m[p].0, v[p].0 * m[p].0);
                         let f = match (stressed, force) {
-                            (Some((s, vol)), true) => Some((s[p].0.to_sym3(), -vol[p].0)),
+                            (Some((s, vol)), true) => Some((&s[p].0, -vol[p].0)),
                             _ => None,
                         };
                         // One loop per case, so that the node loop holds no branch.
@@ -102,7 +102,7 @@ impl<D: Dim, S: Shape> System<D> for P2g<D, S> {
                                 x[p].0,
                                 mp,
                                 mv,
-                                &s,
+                                &s.to_sym3(),
                                 neg_vol,
                                 |i, dm, dp, df| {
                                     let k = i - lo;
@@ -117,6 +117,7 @@ impl<D: Dim, S: Shape> System<D> for P2g<D, S> {
                                 np[k].0 += mv * w;
                             }),
                             (false, Some((s, neg_vol))) => {
+                                let s = s.to_sym3();
                                 for_each_node::<D, S>(grid, x[p].0, |i, _, grad| {
                                     nf[i - lo].0 += D::stress_dot(&s, grad) * neg_vol;
                                 })
