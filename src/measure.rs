@@ -26,7 +26,7 @@ pub struct SurfaceAngle {
 /// atan|b|. `None` when fewer than two columns qualify.
 pub fn surface_angle<D: Dim>(sim: &Simulation<D>) -> Option<SurfaceAngle> {
     let grid = &sim.ctx.grid;
-    let mut top: Vec<Option<(f64, f64)>> = vec![None; grid.cells[0].max(1)];
+    let mut top: Vec<Option<(f64, f64)>> = vec![None; grid.axes[0].cells.max(1)];
     let y0 = grid.origin.get(1);
     for arch in points_with::<Mass>(&sim.ctx.world) {
         for x in col::<Position<D::Vec>>(arch).iter() {

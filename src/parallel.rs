@@ -61,7 +61,7 @@ impl Slabs {
     /// number of threads. The slab of a point is worked out twice rather than stored.
     pub fn build<D: Dim>(&mut self, grid: &Grid<D>, n: usize, position: impl Fn(usize) -> D::Vec + Sync) {
         let axis = grid.slab_axis;
-        let rows = grid.cells[axis];
+        let rows = grid.axes[axis].cells;
         let chunk = |c: usize| c * CHUNK..((c + 1) * CHUNK).min(n);
         self.counts.clear();
         self.counts.resize(n.div_ceil(CHUNK) * rows, 0);

@@ -108,7 +108,7 @@ fn fill_points<'a, D: Dim>(
     for a in 0..n {
         let o = grid.origin.get(a);
         let first = ((lo[a] - o) * grid.inv_h).floor().max(0.0) as usize;
-        let last = (((hi[a] - o) * grid.inv_h).ceil().max(0.0) as usize).min(grid.cells[a]);
+        let last = (((hi[a] - o) * grid.inv_h).ceil().max(0.0) as usize).min(grid.axes[a].cells);
         range[a] = (first, last);
     }
     let sub = [ppc[0], ppc[1], if n == 3 { ppc[2] } else { 1 }];
@@ -174,7 +174,7 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
             Condition::Fixed => (1u8 << n) - 1,
             Condition::Roller => 1u8 << axis,
         };
-        let layer = if upper { grid.cells[axis] } else { 0 };
+        let layer = if upper { grid.axes[axis].cells } else { 0 };
         for (id, f) in fixity.iter_mut().enumerate() {
             if grid.node_ijk(id)[axis] == layer {
                 f.0 |= mask;
