@@ -354,6 +354,24 @@ impl SlabCache {
     }
 }
 
+/// Where each of `threads` contiguous runs of slabs with `sizes` points starts, so that the
+/// runs hold about as many points each: run t starts at the first slab whose middle lies at
+/// or beyond t/threads of all the points. The last entry is `sizes.len()`.
+fn balanced_cuts(sizes: &[usize], threads: usize) -> Vec<usize> {
+    let total: usize = sizes.iter().sum();
+    let mut cuts = Vec::with_capacity(threads + 1);
+    cuts.push(0);
+    let mut before = 0;
+    for (k, &n) in sizes.iter().enumerate() {
+        while cuts.len() < threads && (2 * before + n) * threads >= 2 * cuts.len() * total {
+            cuts.push(k);
+        }
+        before += n;
+    }
+    cuts.resize(threads + 1, sizes.len());
+    cuts
+}
+
 /// A deterministic parallel scatter from points to nodes, straight into the node columns:
 /// runs `kernel(points, part, first_node)` for every non-empty slab of `slabs`, where `part`
 /// is the slab's range of `target` starting at node id `first_node` and `points` are point
@@ -364,6 +382,12 @@ impl SlabCache {
 /// its own node range in parallel. A node therefore receives its contributions slab by slab
 /// in phase order, and within a slab in point order, whatever the number of threads. No
 /// per-thread buffers, no reduction pass.
+///
+/// Which thread runs which slab changes no sum, so each phase is split statically: thread
+/// t takes the t-th of as many contiguous runs of slabs, cut so that each holds about as
+/// many points ([`balanced_cuts`]). Slabs differ in size wherever a body is not a box (the
+/// 2D slope's from 270 points to 891), which rayon's split by slab count left unbalanced;
+/// and a thread keeps the same part of the grid from phase to phase.
 ///
 /// The kernel takes each part for the length of one call (it is generic over the part's
 /// lifetime), so no part can outlive its phase and meet a part of the next one.
@@ -387,7 +411,7 @@ pub fn scatter<D: Dim, T: NodeTarget>(
             );
             assert!(a.end <= b.start, "slabs of one phase share nodes");
         }
-        members.par_iter().for_each(|&s| {
+        let run = |s: usize| {
             let nodes = Slabs::node_range(grid, s, support);
             let first = nodes.start;
             // SAFETY: the slabs of one phase cover disjoint node ranges (asserted above),
@@ -395,6 +419,12 @@ pub fn scatter<D: Dim, T: NodeTarget>(
             // the next phase.
             let part = unsafe { target.part(nodes) };
             kernel(slabs.points(s), part, first);
+        };
+        let sizes: Vec<usize> = members.iter().map(|&s| slabs.points(s).len()).collect();
+        let cuts = balanced_cuts(&sizes, rayon::current_num_threads());
+        rayon::broadcast(|thread| {
+            let i = thread.index();
+            members[cuts[i]..cuts[i + 1]].iter().for_each(|&s| run(s));
         });
     }
     slabs.reach(grid, support)
@@ -413,6 +443,30 @@ mod tests {
             .build()
             .unwrap();
         pool.install(f)
+    }
+
+    #[test]
+    fn phases_split_into_runs_of_about_equal_points_that_cover_every_slab_once() {
+        // The 2D slope's slab sizes shrink from base to crest.
+        let sizes: Vec<usize> = (0..10).map(|k| 891 - 60 * k).collect();
+        let total: usize = sizes.iter().sum();
+        for threads in 1..=5 {
+            let cuts = balanced_cuts(&sizes, threads);
+            assert_eq!(cuts.len(), threads + 1);
+            assert_eq!((cuts[0], cuts[threads]), (0, sizes.len()));
+            assert!(cuts.windows(2).all(|w| w[0] <= w[1]), "{cuts:?}");
+            // Each run is off its share by less than one slab.
+            for t in 0..threads {
+                let run: usize = sizes[cuts[t]..cuts[t + 1]].iter().sum();
+                let share = total as f64 / threads as f64;
+                assert!((run as f64 - share).abs() < 891.0, "{threads} threads: {cuts:?}");
+            }
+        }
+        // A heavy slab first: a split by count would give its thread two more slabs.
+        assert_eq!(balanced_cuts(&[900, 100, 100, 100, 100], 2), vec![0, 1, 5]);
+        // No slab, or fewer slabs than threads: the spare threads get empty runs.
+        assert_eq!(balanced_cuts(&[], 2), vec![0, 0, 0]);
+        assert_eq!(balanced_cuts(&[5], 3), vec![0, 0, 1, 1]);
     }
 
     #[test]
