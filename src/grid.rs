@@ -244,7 +244,7 @@ impl<D: Dim> Grid<D> {
         let mut left = false;
         for k in 0..D::N {
             let xi = self.grid_coordinate(to, k);
-            if !(xi >= 0.0 && xi <= self.axes[k].end) {
+            if !self.axes[k].spans(xi) {
                 return None;
             }
             left |= xi.floor() != self.grid_coordinate(from, k).floor();
@@ -292,7 +292,7 @@ impl<D: Dim> Grid<D> {
         let mut c = [0usize; 3];
         for (a, ca) in c.iter_mut().enumerate().take(D::N) {
             let xi = self.grid_coordinate(x, a);
-            if !(xi >= 0.0 && xi <= self.axes[a].end) {
+            if !self.axes[a].spans(xi) {
                 return None;
             }
             *ca = cell_index(xi, &self.axes[a]);
@@ -336,6 +336,13 @@ impl Axis {
             last_cell: cells as f64 - 1.0,
             inv_h,
         }
+    }
+
+    /// True when grid coordinate `xi` (cell units) lies on the axis, faces included (false
+    /// for NaN).
+    #[inline(always)]
+    pub fn spans(&self, xi: f64) -> bool {
+        xi >= 0.0 && xi <= self.end
     }
 }
 
