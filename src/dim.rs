@@ -113,6 +113,9 @@ pub trait Dim: Copy + Send + Sync + Debug + Default + 'static {
     /// Strain increment sym(L)·dt and spin increment skew(L)·dt embedded in 3D
     /// (plane strain: zero out-of-plane components). Spin is (W_yz, W_zx, W_xy).
     fn strain_spin(l: &Self::Mat, dt: f64) -> (Sym3, [f64; 3]);
+    /// The stress rotated by a spin increment from [`Dim::strain_spin`] (the Jaumann term;
+    /// plane strain's spin is about z alone, and its rotation skips testing the rest).
+    fn jaumann_rotate(s: &Sym3, w: [f64; 3]) -> Sym3;
     /// det(I + L·dt): the volume ratio of one step.
     fn volume_ratio(l: &Self::Mat, dt: f64) -> f64;
     /// `m += k·I`.
@@ -152,6 +155,10 @@ impl Dim for Dim2 {
     #[inline(always)]
     fn stress_dot(s: &Sym3, n: DVec2) -> DVec2 {
         DVec2::new(madd(s.xx, n.x, s.xy * n.y), madd(s.xy, n.x, s.yy * n.y))
+    }
+    #[inline(always)]
+    fn jaumann_rotate(s: &Sym3, w: [f64; 3]) -> Sym3 {
+        crate::tensor::jaumann_rotate_about_z(s, w[2])
     }
     #[inline(always)]
     fn strain_spin(l: &DMat2, dt: f64) -> (Sym3, [f64; 3]) {
@@ -208,6 +215,10 @@ impl Dim for Dim3 {
             madd(s.xy, n.x, madd(s.yy, n.y, s.yz * n.z)),
             madd(s.zx, n.x, madd(s.yz, n.y, s.zz * n.z)),
         )
+    }
+    #[inline(always)]
+    fn jaumann_rotate(s: &Sym3, w: [f64; 3]) -> Sym3 {
+        crate::tensor::jaumann_rotate(s, w)
     }
     #[inline(always)]
     fn strain_spin(l: &DMat3, dt: f64) -> (Sym3, [f64; 3]) {

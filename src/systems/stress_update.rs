@@ -8,7 +8,7 @@ use crate::materials::Material;
 use crate::parallel::CHUNK;
 use crate::schedule::System;
 use crate::simulation::Context;
-use crate::tensor::{jaumann_rotate, jaumann_rotate_about_z, StoredSym};
+use crate::tensor::StoredSym;
 use rayon::prelude::*;
 
 /// For each point: Δε = sym(L)Δt and ΔW = skew(L)Δt; the stress is first rotated by ΔW
@@ -32,11 +32,7 @@ impl<D: Dim> System<D> for StressUpdate {
                       mut plastic: Option<&mut [PlasticStrain]>| {
             for p in 0..stress.len() {
                 let (de, w) = D::strain_spin(&l[p].0, dt);
-                let mut s = if D::N == 2 {
-                    jaumann_rotate_about_z(&stress[p].0.to_sym3(), w[2])
-                } else {
-                    jaumann_rotate(&stress[p].0.to_sym3(), w)
-                };
+                let mut s = D::jaumann_rotate(&stress[p].0.to_sym3(), w);
                 let eps = plastic.as_mut().map(|e| &mut e[p].0);
                 materials[mat[p].0 as usize].update(&mut s, &de, eps);
                 stress[p].0 = D::Stress::from_sym3(&s);
