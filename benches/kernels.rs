@@ -10,6 +10,10 @@ use kdmpm::tensor::Sym3;
 use kdmpm::{AnySimulation, Dim2, Simulation, System};
 use std::path::Path;
 
+/// As the `kdmpm` binary: large blocks coloured (see `kdmpm::alloc`).
+#[global_allocator]
+static ALLOCATOR: kdmpm::alloc::Coloured = kdmpm::alloc::Coloured;
+
 fn slope() -> Simulation<Dim2> {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/slope.ron");
     let loaded = LoadedScene::from_file(&path, &[]).unwrap();

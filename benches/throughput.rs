@@ -21,6 +21,10 @@ use kdmpm::{with_simulation, Dim, Simulation, System};
 use std::path::Path;
 use std::time::Instant;
 
+/// As the `kdmpm` binary: large blocks coloured (see `kdmpm::alloc`).
+#[global_allocator]
+static ALLOCATOR: kdmpm::alloc::Coloured = kdmpm::alloc::Coloured;
+
 /// How the points are stored when the timing starts.
 #[derive(Clone, Copy, PartialEq)]
 enum Order {

@@ -12,6 +12,7 @@
 //! Units are SI throughout; stresses are tension positive.
 #![warn(missing_docs)]
 
+pub mod alloc;
 pub mod columns;
 pub mod components;
 pub mod dim;

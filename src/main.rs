@@ -8,6 +8,11 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
+/// Large blocks coloured, so that the columns a kernel uses together never share their
+/// offset in a page (see `kdmpm::alloc`).
+#[global_allocator]
+static ALLOCATOR: kdmpm::alloc::Coloured = kdmpm::alloc::Coloured;
+
 #[derive(Parser)]
 #[command(
     name = "kdmpm",
