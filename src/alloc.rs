@@ -10,10 +10,10 @@
 //! run (the 1M block on 1 thread: 31, 42 or 53 ms a step by the run; 129 ms with the two
 //! columns 512 MiB apart, 34 ms with the force column moved by one page or by half a page).
 //!
-//! [`Coloured`] gives each large block its own "colour": it takes a block a page longer from
-//! the system and starts the large block in it at a chosen cache line of a page, the next
-//! colour in turn, so columns allocated together never share their offset in a page. This
-//! is jemalloc's cache-oblivious placement, made deterministic: colours go in allocation
+//! [`Coloured`] gives each large block its own "colour": it takes a block a page and a word
+//! longer from the system and starts the large block in it at a chosen cache line of a page,
+//! the next colour in turn, so columns allocated together never share their offset in a page.
+//! This is jemalloc's cache-oblivious placement, made deterministic: colours go in allocation
 //! order, and a block's offset in a page is its colour wherever the system put the block.
 //!
 //! Install it in a binary with
@@ -68,7 +68,7 @@ impl Coloured {
     /// Offset in a page of the next coloured block: a multiple of [`LINE`].
     fn next_colour() -> usize {
         let k = NEXT.fetch_add(1, Ordering::Relaxed);
-        k * STRIDE % COLOURS * LINE
+        (k % COLOURS) * STRIDE % COLOURS * LINE
     }
 
     /// Puts a block of colour `colour` into `outer` (null stays null) and records where
