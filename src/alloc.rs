@@ -97,6 +97,22 @@ impl Coloured {
         }
     }
 
+    /// A block of `layout` from `system` (the system's `alloc` or `alloc_zeroed`): as the
+    /// system gives it when small or over-aligned, else coloured inside an outer block.
+    ///
+    /// # Safety
+    /// `layout` has a non-zero size, and `system` is safe to call with any such layout.
+    unsafe fn take(layout: Layout, system: impl FnOnce(Layout) -> *mut u8) -> *mut u8 {
+        if !Self::colours(layout) {
+            return system(layout);
+        }
+        let Some(outer) = Self::outer(layout) else {
+            return std::ptr::null_mut();
+        };
+        // SAFETY: `system` returns null or a block of `outer`, as `place` asks.
+        unsafe { Self::place(system(outer), Self::next_colour()) }
+    }
+
     /// Start of the outer block of a coloured `block`.
     ///
     /// # Safety
@@ -108,41 +124,27 @@ impl Coloured {
 }
 
 // SAFETY: every block handed out lies inside a block of the system allocator, of the size
-// asked and aligned to a line at least (see `place`), and is given back to it with the outer layout it was taken with: coloured or not is decided by
-// the layout alone, which the caller repeats on `dealloc`.
+// asked and aligned to a line at least (see `place`), and is given back to it with the outer
+// layout it was taken with: coloured or not is decided by the layout alone, which the caller
+// repeats on `dealloc`.
 unsafe impl GlobalAlloc for Coloured {
     unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        if !Self::colours(layout) {
-            // SAFETY: forwarded contract.
-            return unsafe { System.alloc(layout) };
-        }
-        let Some(outer) = Self::outer(layout) else {
-            return std::ptr::null_mut();
-        };
-        // SAFETY: the outer layout has a non-zero size; `place` gets a block of it.
-        unsafe { Self::place(System.alloc(outer), Self::next_colour()) }
+        // SAFETY: forwarded contract.
+        unsafe { Self::take(layout, |l| System.alloc(l)) }
     }
 
     unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
-        if !Self::colours(layout) {
-            // SAFETY: forwarded contract.
-            return unsafe { System.alloc_zeroed(layout) };
-        }
         // The system's zeroed block keeps its untouched pages unmapped (calloc of a fresh
         // mapping); only the header's page is written.
-        let Some(outer) = Self::outer(layout) else {
-            return std::ptr::null_mut();
-        };
-        // SAFETY: as in `alloc`.
-        unsafe { Self::place(System.alloc_zeroed(outer), Self::next_colour()) }
+        // SAFETY: forwarded contract.
+        unsafe { Self::take(layout, |l| System.alloc_zeroed(l)) }
     }
 
     unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        // SAFETY: `ptr` came from `alloc` or `alloc_zeroed` with this layout, which coloured
-        // it exactly when it colours now.
+        // SAFETY: `ptr` came from `take` with this layout, which coloured it exactly when
+        // `colours` and `outer` allow it now.
         unsafe {
             match Self::outer(layout) {
-                // A block that was coloured had an outer layout.
                 Some(outer) if Self::colours(layout) => System.dealloc(Self::outer_of(ptr), outer),
                 _ => System.dealloc(ptr, layout),
             }

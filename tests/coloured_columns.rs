@@ -2,6 +2,7 @@
 //! a page: particle-to-grid's node momentum and force (same stride, same index) never share
 //! address bits 0–11, the layout that made it up to 4× slower in some runs (`kdmpm::alloc`).
 
+use glam::DVec3;
 use kdmpm::alloc::{Coloured, LARGE, PAGE};
 use kdmpm::columns::{col, nodes, points_with};
 use kdmpm::components::{Mass, NodeForce, NodeMass, NodeMomentum, Position, Stress, Velocity, Volume};
@@ -23,6 +24,11 @@ const SCENE: &str = r#"Scene(
     solver: (time_step: Courant(0.3), max_steps: 1),
 )"#;
 
+/// A column's name, start address and length in bytes.
+fn span<'a, T>(name: &'a str, column: &[T]) -> (&'a str, usize, usize) {
+    (name, column.as_ptr() as usize, size_of_val(column))
+}
+
 #[test]
 fn the_large_columns_of_a_scene_start_at_different_offsets_in_a_page() {
     let loaded = LoadedScene::from_text(Path::new("coloured.ron"), SCENE, &[]).unwrap();
@@ -31,36 +37,17 @@ fn the_large_columns_of_a_scene_start_at_different_offsets_in_a_page() {
     };
     let world = &sim.ctx.world;
     let n = nodes(world);
-    let mut columns: Vec<(&str, usize, usize)> = vec![(
-        "node mass",
-        col::<NodeMass>(n).as_ptr() as usize,
-        size_of_val(&*col::<NodeMass>(n)),
-    )];
-    let vec_column = |name, ptr: *const u8, bytes| (name, ptr as usize, bytes);
-    let momentum = col::<NodeMomentum<glam::DVec3>>(n);
-    let force = col::<NodeForce<glam::DVec3>>(n);
-    columns.push(vec_column(
-        "node momentum",
-        momentum.as_ptr().cast(),
-        size_of_val(&*momentum),
-    ));
-    columns.push(vec_column(
-        "node force",
-        force.as_ptr().cast(),
-        size_of_val(&*force),
-    ));
     let arch = points_with::<Stress<Sym3>>(world).next().unwrap();
-    let (x, v, m) = (
-        col::<Position<glam::DVec3>>(arch),
-        col::<Velocity<glam::DVec3>>(arch),
-        col::<Mass>(arch),
-    );
-    let (s, vol) = (col::<Stress<Sym3>>(arch), col::<Volume>(arch));
-    columns.push(vec_column("position", x.as_ptr().cast(), size_of_val(&*x)));
-    columns.push(vec_column("velocity", v.as_ptr().cast(), size_of_val(&*v)));
-    columns.push(vec_column("mass", m.as_ptr().cast(), size_of_val(&*m)));
-    columns.push(vec_column("stress", s.as_ptr().cast(), size_of_val(&*s)));
-    columns.push(vec_column("volume", vol.as_ptr().cast(), size_of_val(&*vol)));
+    let columns = [
+        span("node mass", &col::<NodeMass>(n)),
+        span("node momentum", &col::<NodeMomentum<DVec3>>(n)),
+        span("node force", &col::<NodeForce<DVec3>>(n)),
+        span("position", &col::<Position<DVec3>>(arch)),
+        span("velocity", &col::<Velocity<DVec3>>(arch)),
+        span("mass", &col::<Mass>(arch)),
+        span("stress", &col::<Stress<Sym3>>(arch)),
+        span("volume", &col::<Volume>(arch)),
+    ];
     for &(name, _, bytes) in &columns {
         assert!(bytes >= LARGE, "{name}: {bytes} bytes, too small to be coloured");
     }
