@@ -5,7 +5,8 @@
 //! nodes per point with linear shape functions and never touches a third axis; the only
 //! 3D quantity it keeps is the out-of-plane normal stress, which plane strain requires.
 
-use crate::tensor::{PlanarSym3, StoredSym, Sym3};
+use crate::lanes::Lanes;
+use crate::tensor::{PlanarSym3, StoredSym, Sym, Sym3};
 use glam::{DMat2, DMat3, DVec2, DVec3};
 use std::fmt::Debug;
 use std::ops::{Add, AddAssign, Mul, Neg, Sub, SubAssign};
@@ -111,11 +112,15 @@ pub trait Dim: Copy + Send + Sync + Debug + Default + 'static {
     /// σ·n for the in-plane components of the stress (N/m² · m² = N per unit of n).
     fn stress_dot(s: &Sym3, n: Self::Vec) -> Self::Vec;
     /// Strain increment sym(L)·dt and spin increment skew(L)·dt embedded in 3D
-    /// (plane strain: zero out-of-plane components). Spin is (W_yz, W_zx, W_xy).
-    fn strain_spin(l: &Self::Mat, dt: f64) -> (Sym3, [f64; 3]);
-    /// The stress rotated by a spin increment from [`Dim::strain_spin`] (the Jaumann term;
-    /// plane strain's spin is about z alone, and its rotation skips testing the rest).
-    fn jaumann_rotate(s: &Sym3, w: [f64; 3]) -> Sym3;
+    /// (plane strain: zero out-of-plane components), with `l(i, j)` = L_ij (1/s) of one
+    /// point or four in lanes. Spin is (W_yz, W_zx, W_xy).
+    fn strain_spin<T: Lanes>(l: impl Fn(usize, usize) -> T, dt: T) -> (Sym<T>, [T; 3]);
+    /// Entry (i, j) of a matrix: row i, column j.
+    fn mat_entry(m: &Self::Mat, i: usize, j: usize) -> f64;
+    /// The stress rotated by a spin increment from [`Dim::strain_spin`] (the Jaumann term),
+    /// of one point or four in lanes; plane strain's spin is about z alone, and its rotation
+    /// does only that.
+    fn jaumann_rotate<T: Lanes>(s: &Sym<T>, w: [T; 3]) -> Sym<T>;
     /// det(I + L·dt): the volume ratio of one step.
     fn volume_ratio(l: &Self::Mat, dt: f64) -> f64;
     /// `m += k·I`.
@@ -157,20 +162,26 @@ impl Dim for Dim2 {
         DVec2::new(madd(s.xx, n.x, s.xy * n.y), madd(s.xy, n.x, s.yy * n.y))
     }
     #[inline(always)]
-    fn jaumann_rotate(s: &Sym3, w: [f64; 3]) -> Sym3 {
+    fn jaumann_rotate<T: Lanes>(s: &Sym<T>, w: [T; 3]) -> Sym<T> {
         crate::tensor::jaumann_rotate_about_z(s, w[2])
     }
     #[inline(always)]
-    fn strain_spin(l: &DMat2, dt: f64) -> (Sym3, [f64; 3]) {
-        // glam is column-major: l.col(j)[i] = L_ij.
-        let (l00, l10, l01, l11) = (l.x_axis.x, l.x_axis.y, l.y_axis.x, l.y_axis.y);
-        let strain = Sym3 {
+    fn strain_spin<T: Lanes>(l: impl Fn(usize, usize) -> T, dt: T) -> (Sym<T>, [T; 3]) {
+        let (l00, l10, l01, l11) = (l(0, 0), l(1, 0), l(0, 1), l(1, 1));
+        let (half, zero) = (T::splat(0.5), T::splat(0.0));
+        let strain = Sym {
             xx: l00 * dt,
             yy: l11 * dt,
-            xy: 0.5 * (l01 + l10) * dt,
-            ..Sym3::ZERO
+            xy: half * (l01 + l10) * dt,
+            zz: zero,
+            yz: zero,
+            zx: zero,
         };
-        (strain, [0.0, 0.0, 0.5 * (l01 - l10) * dt])
+        (strain, [zero, zero, half * (l01 - l10) * dt])
+    }
+    #[inline(always)]
+    fn mat_entry(m: &DMat2, i: usize, j: usize) -> f64 {
+        m.col(j)[i]
     }
     #[inline(always)]
     fn volume_ratio(l: &DMat2, dt: f64) -> f64 {
@@ -217,26 +228,30 @@ impl Dim for Dim3 {
         )
     }
     #[inline(always)]
-    fn jaumann_rotate(s: &Sym3, w: [f64; 3]) -> Sym3 {
+    fn jaumann_rotate<T: Lanes>(s: &Sym<T>, w: [T; 3]) -> Sym<T> {
         crate::tensor::jaumann_rotate(s, w)
     }
     #[inline(always)]
-    fn strain_spin(l: &DMat3, dt: f64) -> (Sym3, [f64; 3]) {
-        let c = |i: usize, j: usize| l.col(j)[i];
-        let strain = Sym3 {
+    fn strain_spin<T: Lanes>(c: impl Fn(usize, usize) -> T, dt: T) -> (Sym<T>, [T; 3]) {
+        let half = T::splat(0.5);
+        let strain = Sym {
             xx: c(0, 0) * dt,
             yy: c(1, 1) * dt,
             zz: c(2, 2) * dt,
-            xy: 0.5 * (c(0, 1) + c(1, 0)) * dt,
-            yz: 0.5 * (c(1, 2) + c(2, 1)) * dt,
-            zx: 0.5 * (c(2, 0) + c(0, 2)) * dt,
+            xy: half * (c(0, 1) + c(1, 0)) * dt,
+            yz: half * (c(1, 2) + c(2, 1)) * dt,
+            zx: half * (c(2, 0) + c(0, 2)) * dt,
         };
         let spin = [
-            0.5 * (c(1, 2) - c(2, 1)) * dt,
-            0.5 * (c(2, 0) - c(0, 2)) * dt,
-            0.5 * (c(0, 1) - c(1, 0)) * dt,
+            half * (c(1, 2) - c(2, 1)) * dt,
+            half * (c(2, 0) - c(0, 2)) * dt,
+            half * (c(0, 1) - c(1, 0)) * dt,
         ];
         (strain, spin)
+    }
+    #[inline(always)]
+    fn mat_entry(m: &DMat3, i: usize, j: usize) -> f64 {
+        m.col(j)[i]
     }
     #[inline(always)]
     fn volume_ratio(l: &DMat3, dt: f64) -> f64 {

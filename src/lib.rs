@@ -18,6 +18,7 @@ pub mod components;
 pub mod dim;
 pub mod error;
 pub mod grid;
+pub mod lanes;
 pub mod materials;
 pub mod measure;
 pub mod output;

@@ -3,25 +3,70 @@
 //!
 //! Sign convention: tension positive, as in continuum mechanics.
 
-use crate::dim::madd;
+use crate::lanes::{gather, F64x4, Lanes, LANES};
 use glam::{DMat3, DVec3};
 use std::ops::{Add, AddAssign, Mul, Sub, SubAssign};
 
-/// A symmetric 3×3 tensor stored by its six independent components.
+/// A symmetric 3×3 tensor stored by its six independent components, of one point
+/// ([`Sym3`]) or of four side by side, one per lane ([`Sym3x4`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct Sym3 {
+pub struct Sym<T> {
     /// Component xx.
-    pub xx: f64,
+    pub xx: T,
     /// Component yy.
-    pub yy: f64,
+    pub yy: T,
     /// Component zz.
-    pub zz: f64,
+    pub zz: T,
     /// Component xy (= yx).
-    pub xy: f64,
+    pub xy: T,
     /// Component yz (= zy).
-    pub yz: f64,
+    pub yz: T,
     /// Component zx (= xz).
-    pub zx: f64,
+    pub zx: T,
+}
+
+/// A symmetric 3×3 tensor (stress in Pa, strain increment).
+pub type Sym3 = Sym<f64>;
+
+/// The symmetric tensors of four points, one per lane (see [`crate::lanes`]).
+pub type Sym3x4 = Sym<F64x4>;
+
+impl<T: Lanes> Sym<T> {
+    /// Trace (sum of the diagonal).
+    #[inline(always)]
+    pub fn trace(&self) -> T {
+        self.xx + self.yy + self.zz
+    }
+}
+
+impl Sym3x4 {
+    /// The tensors `f(0), …, f(3)` in lanes 0 to 3.
+    #[inline(always)]
+    pub fn gather(f: impl Fn(usize) -> Sym3) -> Sym3x4 {
+        let s: [Sym3; LANES] = std::array::from_fn(f);
+        Sym {
+            xx: gather(|l| s[l].xx),
+            yy: gather(|l| s[l].yy),
+            zz: gather(|l| s[l].zz),
+            xy: gather(|l| s[l].xy),
+            yz: gather(|l| s[l].yz),
+            zx: gather(|l| s[l].zx),
+        }
+    }
+
+    /// The four tensors, lane by lane.
+    #[inline(always)]
+    pub fn lanes(&self) -> [Sym3; LANES] {
+        let c = [self.xx, self.yy, self.zz, self.xy, self.yz, self.zx].map(|v| v.to_array());
+        std::array::from_fn(|l| Sym {
+            xx: c[0][l],
+            yy: c[1][l],
+            zz: c[2][l],
+            xy: c[3][l],
+            yz: c[4][l],
+            zx: c[5][l],
+        })
+    }
 }
 
 /// How a material point stores its stress: the six components of a [`Sym3`] in 3D, the
@@ -114,12 +159,6 @@ impl Sym3 {
             yz: 0.0,
             zx: 0.0,
         }
-    }
-
-    /// Trace (sum of the diagonal).
-    #[inline(always)]
-    pub fn trace(&self) -> f64 {
-        self.xx + self.yy + self.zz
     }
 
     /// Double contraction a:b.
@@ -352,42 +391,24 @@ fn jacobi_eigen(s: &Sym3) -> ([f64; 3], DMat3) {
 }
 
 /// Rotates `stress` by the spin increment `w = (W_yz, W_zx, W_xy)·dt` (the skew part of the
-/// velocity gradient times the step): the Jaumann-rate term σ̇ = … + Wσ − σW of eq. (8).
+/// velocity gradient times the step): the Jaumann-rate term σ̇ = … + Wσ − σW of eq. (8), for
+/// one point (`T = f64`) or four in lanes (`T = F64x4`), with the same bits either way.
 ///
 /// The rotation is the Cayley transform R = (I − W/2)⁻¹(I + W/2) (Hughes–Winget), which is
 /// exactly orthogonal: a rigid rotation leaves the principal stresses unchanged to round-off,
 /// where the forward-Euler form σ + Wσ − σW would inflate them by (1 + |w|²) every step.
-#[inline(never)]
-pub fn jaumann_rotate(stress: &Sym3, w: [f64; 3]) -> Sym3 {
-    // A call: inlined into the 3D stress update it took 3 more instructions a point.
-    cayley_rotate(stress, w)
-}
-
-/// [`jaumann_rotate`] for a spin `wxy` = W_xy·dt about z only, as in all of plane strain.
-/// The rotation is inlined with the spin's x and y components known to be zero, so that
-/// their tests fold away (20 instructions a point in the 2D slope), while 3D keeps
-/// [`jaumann_rotate`] a call.
+/// No branch on the spin (a zero spin gives R = I exactly), so that lanes need none.
 #[inline(always)]
-pub fn jaumann_rotate_about_z(stress: &Sym3, wxy: f64) -> Sym3 {
-    cayley_rotate(stress, [0.0, 0.0, wxy])
-}
-
-/// The body of [`jaumann_rotate`].
-#[inline(always)]
-fn cayley_rotate(stress: &Sym3, w: [f64; 3]) -> Sym3 {
-    if w == [0.0; 3] {
-        return *stress;
-    }
-    if w[0] == 0.0 && w[1] == 0.0 {
-        return rotate_about_z(stress, w[2]);
-    }
+pub fn jaumann_rotate<T: Lanes>(stress: &Sym<T>, w: [T; 3]) -> Sym<T> {
+    let half = T::splat(0.5);
     // Half-spin Â = W/2 with W_xy = w[2], W_yz = w[0], W_zx = w[1] (W skew), so that
     // Âv = v × â with â = (a, b, c) and Â² = ââᵀ − |â|² I.
-    let (a, b, c) = (0.5 * w[0], 0.5 * w[1], 0.5 * w[2]);
+    let (a, b, c) = (half * w[0], half * w[1], half * w[2]);
     let n2 = a * a + b * b + c * c;
     // Cayley: R = I + 2/(1 + |â|²) (Â + Â²).
-    let k = 2.0 / (1.0 + n2);
-    let d = 1.0 - k * n2;
+    let one = T::splat(1.0);
+    let k = T::splat(2.0) / (one + n2);
+    let d = one - k * n2;
     let r = [
         [d + k * a * a, k * (a * b + c), k * (a * c - b)],
         [k * (a * b - c), d + k * b * b, k * (b * c + a)],
@@ -399,27 +420,38 @@ fn cayley_rotate(stress: &Sym3, w: [f64; 3]) -> Sym3 {
         [stress.xy, stress.yy, stress.yz],
         [stress.zx, stress.yz, stress.zz],
     ];
-    let t: [[f64; 3]; 3] = std::array::from_fn(|i| {
-        std::array::from_fn(|j| madd(r[i][0], s[0][j], madd(r[i][1], s[1][j], r[i][2] * s[2][j])))
+    let t: [[T; 3]; 3] = std::array::from_fn(|i| {
+        std::array::from_fn(|j| T::madd(r[i][0], s[0][j], T::madd(r[i][1], s[1][j], r[i][2] * s[2][j])))
     });
-    Sym3::from_fn(|i, j| madd(t[i][0], r[j][0], madd(t[i][1], r[j][1], t[i][2] * r[j][2])))
+    let e = |i: usize, j: usize| T::madd(t[i][0], r[j][0], T::madd(t[i][1], r[j][1], t[i][2] * r[j][2]));
+    Sym {
+        xx: e(0, 0),
+        yy: e(1, 1),
+        zz: e(2, 2),
+        xy: e(0, 1),
+        yz: e(1, 2),
+        zx: e(2, 0),
+    }
 }
 
-/// The Cayley rotation of [`jaumann_rotate`] for a spin about z:
-/// cos θ = (1 − a²)/(1 + a²), sin θ = 2a/(1 + a²) with a = W_xy/2.
-#[inline]
-fn rotate_about_z(s: &Sym3, wxy: f64) -> Sym3 {
-    let a = 0.5 * wxy;
-    let k = 1.0 / (1.0 + a * a);
-    let (c, sn) = ((1.0 - a * a) * k, 2.0 * a * k);
+/// [`jaumann_rotate`] for a spin `wxy` = W_xy·dt about z only, as in all of plane strain:
+/// the Cayley rotation in the x-y plane, cos θ = (1 − a²)/(1 + a²), sin θ = 2a/(1 + a²) with
+/// a = W_xy/2 (a third of the general rotation's arithmetic).
+#[inline(always)]
+pub fn jaumann_rotate_about_z<T: Lanes>(s: &Sym<T>, wxy: T) -> Sym<T> {
+    let a = T::splat(0.5) * wxy;
+    let one = T::splat(1.0);
+    let k = one / (one + a * a);
+    let (c, sn) = ((one - a * a) * k, T::splat(2.0) * a * k);
     // σ' = R σ Rᵀ with R = [[c, sn], [−sn, c]] in the x-y block.
     let (xx, yy, xy) = (s.xx, s.yy, s.xy);
     let cc = c * c;
     let ss = sn * sn;
     let cs = c * sn;
-    Sym3 {
-        xx: cc * xx + 2.0 * cs * xy + ss * yy,
-        yy: ss * xx - 2.0 * cs * xy + cc * yy,
+    let two = T::splat(2.0);
+    Sym {
+        xx: cc * xx + two * cs * xy + ss * yy,
+        yy: ss * xx - two * cs * xy + cc * yy,
         xy: (cc - ss) * xy + cs * (yy - xx),
         zz: s.zz,
         yz: c * s.yz - sn * s.zx,
@@ -427,11 +459,11 @@ fn rotate_about_z(s: &Sym3, wxy: f64) -> Sym3 {
     }
 }
 
-impl Add for Sym3 {
-    type Output = Sym3;
+impl<T: Lanes> Add for Sym<T> {
+    type Output = Sym<T>;
     #[inline(always)]
-    fn add(self, b: Sym3) -> Sym3 {
-        Sym3 {
+    fn add(self, b: Sym<T>) -> Sym<T> {
+        Sym {
             xx: self.xx + b.xx,
             yy: self.yy + b.yy,
             zz: self.zz + b.zz,
@@ -465,9 +497,9 @@ impl Mul<f64> for Sym3 {
     }
 }
 
-impl AddAssign for Sym3 {
+impl<T: Lanes> AddAssign for Sym<T> {
     #[inline(always)]
-    fn add_assign(&mut self, b: Sym3) {
+    fn add_assign(&mut self, b: Sym<T>) {
         *self = *self + b;
     }
 }
@@ -597,9 +629,14 @@ mod tests {
     fn rotation_about_z_matches_the_general_rotation() {
         let s = sample();
         for w in [1e-3, -0.4, 2.5] {
-            let fast = jaumann_rotate(&s, [0.0, 0.0, w]);
-            assert_eq!(jaumann_rotate_about_z(&s, w), fast);
-            // The general path, forced by a spin component that is zero in effect.
+            let fast = jaumann_rotate_about_z(&s, w);
+            // The general rotation rounds differently: the same to round-off.
+            let general = jaumann_rotate(&s, [0.0, 0.0, w]);
+            assert!(
+                (fast - general).norm() < 1e-12 * s.norm(),
+                "{fast:?} vs {general:?}"
+            );
+            // The matrix form.
             let a = 0.5 * w;
             let half = DMat3::from_cols(DVec3::new(0.0, -a, 0.0), DVec3::new(a, 0.0, 0.0), DVec3::ZERO);
             let r = DMat3::IDENTITY + (half + half * half) * (2.0 / (1.0 + a * a));
@@ -653,6 +690,34 @@ mod tests {
                 "{w:?}: {fast:?} vs {matrix:?}"
             );
         }
+    }
+
+    #[test]
+    fn rotations_in_lanes_give_each_lane_the_bits_of_one_point() {
+        // Four stresses and spins (one of them zero, one about z only) side by side.
+        let base = sample();
+        let stresses: [Sym3; 4] =
+            std::array::from_fn(|l| base * (1.0 + l as f64) + Sym3::diagonal(-7e3 * l as f64, 0.0, 3e3));
+        let spins = [[0.3, -0.7, 1.1], [0.0; 3], [0.0, 0.0, -0.4], [1e-4, 2e-4, -3e-4]];
+        let lanes = Sym3x4::gather(|l| stresses[l]);
+        let w = [0, 1, 2].map(|axis| gather(|l| spins[l][axis]));
+        let general = jaumann_rotate(&lanes, w).lanes();
+        let about_z = jaumann_rotate_about_z(&lanes, w[2]).lanes();
+        let bits = |s: &Sym3| s.to_array().map(f64::to_bits);
+        for l in 0..4 {
+            assert_eq!(
+                bits(&general[l]),
+                bits(&jaumann_rotate(&stresses[l], spins[l])),
+                "lane {l}"
+            );
+            assert_eq!(
+                bits(&about_z[l]),
+                bits(&jaumann_rotate_about_z(&stresses[l], spins[l][2])),
+                "lane {l}"
+            );
+        }
+        // A zero spin leaves the stress as it was.
+        assert_eq!(general[1], stresses[1]);
     }
 
     #[test]

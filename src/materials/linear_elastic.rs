@@ -1,7 +1,8 @@
 //! Linear isotropic elasticity (Hooke's law in rate form).
 
 use super::{Elasticity, Material};
-use crate::tensor::Sym3;
+use crate::lanes::LANES;
+use crate::tensor::{Sym3, Sym3x4};
 
 /// Linear elastic material: Δσ = λ tr(Δε) I + 2G Δε.
 #[derive(Clone, Debug, PartialEq)]
@@ -34,6 +35,10 @@ impl Material for LinearElastic {
     }
     #[inline(always)]
     fn update(&self, stress: &mut Sym3, de: &Sym3, _plastic: Option<&mut f64>) {
+        *stress += self.elasticity.stress_increment(de);
+    }
+    #[inline(always)]
+    fn update4(&self, stress: &mut Sym3x4, de: &Sym3x4, _plastic: Option<[&mut f64; LANES]>) {
         *stress += self.elasticity.stress_increment(de);
     }
 }

@@ -4,15 +4,21 @@ use crate::columns::{col, col_mut, points_with};
 use crate::components::*;
 use crate::dim::Dim;
 use crate::error::StepError;
-use crate::materials::Material;
+use crate::lanes::{gather, F64x4, LANES};
+use crate::materials::{Material, MaterialModel};
 use crate::parallel::CHUNK;
 use crate::schedule::System;
 use crate::simulation::Context;
-use crate::tensor::StoredSym;
+use crate::tensor::{StoredSym, Sym3x4};
 use rayon::prelude::*;
 
 /// For each point: Δε = sym(L)Δt and ΔW = skew(L)Δt; the stress is first rotated by ΔW
 /// (objective Jaumann term) and then integrated by the point's material over Δε.
+///
+/// Points go four at a time, one per SIMD lane ([`crate::lanes`]): the rotation always, and
+/// the material's update when the four share a material (each gets the bits it would get
+/// alone). In the 3D elastic block (1M points, 1 thread) this took the stress update from
+/// 28.8 to 12.0 ns a point; the 2D slope's Mohr-Coulomb points gain less (790 → 775 µs a step).
 #[derive(Debug, Default)]
 pub struct StressUpdate;
 
@@ -30,12 +36,35 @@ impl<D: Dim> System<D> for StressUpdate {
                       l: &[VelocityGradient<D::Mat>],
                       mat: &[MaterialId],
                       mut plastic: Option<&mut [PlasticStrain]>| {
-            for p in 0..stress.len() {
-                let (de, w) = D::strain_spin(&l[p].0, dt);
-                let mut s = D::jaumann_rotate(&stress[p].0.to_sym3(), w);
-                let eps = plastic.as_mut().map(|e| &mut e[p].0);
-                materials[mat[p].0 as usize].update(&mut s, &de, eps);
-                stress[p].0 = D::Stress::from_sym3(&s);
+            let full = stress.len() / LANES * LANES;
+            for g in (0..full).step_by(LANES) {
+                let at = g..g + LANES;
+                update_group::<D>(
+                    materials,
+                    dt,
+                    (&mut stress[at.clone()]).try_into().expect("four points"),
+                    l[at.clone()].try_into().expect("four points"),
+                    mat[at.clone()].try_into().expect("four points"),
+                    plastic
+                        .as_mut()
+                        .map(|e| (&mut e[at]).try_into().expect("four points")),
+                );
+            }
+            let n = stress.len() - full;
+            if n > 0 {
+                // The last few points; the spare lanes repeat the last one, and their results
+                // are dropped.
+                let at = |q: usize| full + q.min(n - 1);
+                let mut s4: [Stress<D::Stress>; LANES] = std::array::from_fn(|q| stress[at(q)]);
+                let l4 = std::array::from_fn(|q| l[at(q)]);
+                let m4 = std::array::from_fn(|q| mat[at(q)]);
+                let mut e4: Option<[PlasticStrain; LANES]> =
+                    plastic.as_ref().map(|e| std::array::from_fn(|q| e[at(q)]));
+                update_group::<D>(materials, dt, &mut s4, &l4, &m4, e4.as_mut());
+                stress[full..].copy_from_slice(&s4[..n]);
+                if let (Some(e), Some(e4)) = (plastic, e4) {
+                    e[full..].copy_from_slice(&e4[..n]);
+                }
             }
         };
         for arch in points_with::<Stress<D::Stress>>(&ctx.world) {
@@ -54,5 +83,44 @@ impl<D: Dim> System<D> for StressUpdate {
             }
         }
         Ok(())
+    }
+}
+
+/// Four points: strain and spin increments, the Jaumann rotation in lanes, and the material
+/// update, in lanes when the four share a material and point by point otherwise.
+#[inline(always)]
+fn update_group<D: Dim>(
+    materials: &[MaterialModel],
+    dt: f64,
+    stress: &mut [Stress<D::Stress>; LANES],
+    l: &[VelocityGradient<D::Mat>; LANES],
+    mat: &[MaterialId; LANES],
+    plastic: Option<&mut [PlasticStrain; LANES]>,
+) {
+    let (de, w) = D::strain_spin(|i, j| gather(|q| D::mat_entry(&l[q].0, i, j)), F64x4::splat(dt));
+    let mut s = D::jaumann_rotate(&Sym3x4::gather(|q| stress[q].0.to_sym3()), w);
+    let id = mat[0].0;
+    let eps = plastic.map(|e| e.each_mut().map(|e| &mut e.0));
+    let out = if mat.iter().all(|m| m.0 == id) {
+        materials[id as usize].update4(&mut s, &de, eps);
+        s.lanes()
+    } else {
+        let (mut s, de) = (s.lanes(), de.lanes());
+        match eps {
+            Some(eps) => {
+                for ((s, de), (m, eps)) in s.iter_mut().zip(&de).zip(mat.iter().zip(eps)) {
+                    materials[m.0 as usize].update(s, de, Some(eps));
+                }
+            }
+            None => {
+                for ((s, de), m) in s.iter_mut().zip(&de).zip(mat) {
+                    materials[m.0 as usize].update(s, de, None);
+                }
+            }
+        }
+        s
+    };
+    for (stress, s) in stress.iter_mut().zip(&out) {
+        stress.0 = D::Stress::from_sym3(s);
     }
 }

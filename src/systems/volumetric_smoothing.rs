@@ -43,7 +43,7 @@ impl<D: Dim, S> Default for VolumetricSmoothing<D, S> {
 /// Trace of a velocity gradient through the volume ratio's first-order term.
 #[inline(always)]
 fn trace<D: Dim>(l: &D::Mat) -> f64 {
-    D::strain_spin(l, 1.0).0.trace()
+    D::strain_spin(|i, j| D::mat_entry(l, i, j), 1.0).0.trace()
 }
 
 impl<D: Dim, S: Shape> System<D> for VolumetricSmoothing<D, S> {

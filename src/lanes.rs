@@ -1,0 +1,80 @@
+//! One point or four side by side: the arithmetic the stress update's formulas are written
+//! in, so that each formula exists once and runs on a scalar `f64` (one point) or on
+//! [`F64x4`] (four points, one per SIMD lane).
+//!
+//! The stress update treats four points at a time: its Jaumann rotation and the elastic
+//! increment are a chain of ~80 dependent multiply-adds and a division per point, which one
+//! point at a time keeps the core waiting on latencies; four in the lanes of one AVX register
+//! take about the time of one. Every operation is done lane by lane with the same rounding as
+//! the scalar one, so a point's result does not depend on which lane, or which path, it took.
+
+use crate::dim::madd;
+use std::ops::{Add, Div, Mul, Sub};
+
+/// Four f64 lanes (one 256-bit AVX register where the build targets AVX).
+pub type F64x4 = wide::f64x4;
+
+/// Points per group in the stress update.
+pub const LANES: usize = 4;
+
+/// The operations a formula over [`Lanes`] may use: `+ − × ÷` lane by lane, constants, and
+/// [`Lanes::madd`], which rounds exactly like [`madd`].
+pub trait Lanes:
+    Copy + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self> + Div<Output = Self>
+{
+    /// `v` in every lane.
+    fn splat(v: f64) -> Self;
+    /// `a·b + c` lane by lane, rounded once where the build has fused multiply-add and
+    /// twice (as written) where it does not: the same choice as [`madd`].
+    fn madd(a: Self, b: Self, c: Self) -> Self;
+}
+
+impl Lanes for f64 {
+    #[inline(always)]
+    fn splat(v: f64) -> f64 {
+        v
+    }
+    #[inline(always)]
+    fn madd(a: f64, b: f64, c: f64) -> f64 {
+        madd(a, b, c)
+    }
+}
+
+impl Lanes for F64x4 {
+    #[inline(always)]
+    fn splat(v: f64) -> F64x4 {
+        F64x4::splat(v)
+    }
+    #[inline(always)]
+    fn madd(a: F64x4, b: F64x4, c: F64x4) -> F64x4 {
+        if cfg!(target_feature = "fma") {
+            a.mul_add(b, c)
+        } else {
+            a * b + c
+        }
+    }
+}
+
+/// The lanes `f(0), …, f(3)`.
+#[inline(always)]
+pub fn gather(f: impl Fn(usize) -> f64) -> F64x4 {
+    F64x4::new([f(0), f(1), f(2), f(3)])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_lane_multiply_add_rounds_like_the_scalar_one() {
+        // 1 + 2⁻⁵² squared: the exact product 1 + 2⁻⁵¹ + 2⁻¹⁰⁴ loses its last term when
+        // rounded before the add, so fused and unfused differ in the last bit; the lanes must
+        // take the same choice as `dim::madd`.
+        let a = 1.0 + f64::EPSILON;
+        let c = -(1.0 + 2.0 * f64::EPSILON);
+        let lane = <F64x4 as Lanes>::madd(F64x4::splat(a), F64x4::splat(a), F64x4::splat(c));
+        for v in lane.to_array() {
+            assert_eq!(v.to_bits(), madd(a, a, c).to_bits());
+        }
+    }
+}
