@@ -32,6 +32,20 @@ pub type Sym3 = Sym<f64>;
 pub type Sym3x4 = Sym<F64x4>;
 
 impl<T: Lanes> Sym<T> {
+    /// The symmetric tensor whose six independent entries are `e(i, j)` for (i, j) = (0, 0),
+    /// (1, 1), (2, 2), (0, 1), (1, 2), (2, 0): `e` is asked for those only.
+    #[inline(always)]
+    pub fn from_fn(e: impl Fn(usize, usize) -> T) -> Sym<T> {
+        Sym {
+            xx: e(0, 0),
+            yy: e(1, 1),
+            zz: e(2, 2),
+            xy: e(0, 1),
+            yz: e(1, 2),
+            zx: e(2, 0),
+        }
+    }
+
     /// Trace (sum of the diagonal).
     #[inline(always)]
     pub fn trace(&self) -> T {
@@ -229,20 +243,6 @@ impl Sym3 {
         Sym3::from_fn(|i, j| p[0] * c0[i] * c0[j] + p[1] * c1[i] * c1[j] + p[2] * c2[i] * c2[j])
     }
 
-    /// The symmetric tensor whose six independent entries are `e(i, j)` for (i, j) = (0, 0),
-    /// (1, 1), (2, 2), (0, 1), (1, 2), (2, 0): `e` is asked for those only.
-    #[inline(always)]
-    pub fn from_fn(e: impl Fn(usize, usize) -> f64) -> Sym3 {
-        Sym3 {
-            xx: e(0, 0),
-            yy: e(1, 1),
-            zz: e(2, 2),
-            xy: e(0, 1),
-            yz: e(1, 2),
-            zx: e(2, 0),
-        }
-    }
-
     /// Principal values in descending order (σ1 ≥ σ2 ≥ σ3) and the matching unit
     /// eigenvectors as the columns of a rotation matrix.
     pub fn eigen(&self) -> ([f64; 3], DMat3) {
@@ -423,15 +423,7 @@ pub fn jaumann_rotate<T: Lanes>(stress: &Sym<T>, w: [T; 3]) -> Sym<T> {
     let t: [[T; 3]; 3] = std::array::from_fn(|i| {
         std::array::from_fn(|j| T::madd(r[i][0], s[0][j], T::madd(r[i][1], s[1][j], r[i][2] * s[2][j])))
     });
-    let e = |i: usize, j: usize| T::madd(t[i][0], r[j][0], T::madd(t[i][1], r[j][1], t[i][2] * r[j][2]));
-    Sym {
-        xx: e(0, 0),
-        yy: e(1, 1),
-        zz: e(2, 2),
-        xy: e(0, 1),
-        yz: e(1, 2),
-        zx: e(2, 0),
-    }
+    Sym::from_fn(|i, j| T::madd(t[i][0], r[j][0], T::madd(t[i][1], r[j][1], t[i][2] * r[j][2])))
 }
 
 /// [`jaumann_rotate`] for a spin `wxy` = W_xy·dt about z only, as in all of plane strain:

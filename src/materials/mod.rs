@@ -30,21 +30,34 @@ pub trait Material: Send + Sync {
     /// model whose update has no branch does all four at once.
     #[inline(always)]
     fn update4(&self, stress: &mut Sym3x4, de: &Sym3x4, plastic: Option<[&mut f64; LANES]>) {
-        let (mut s, de) = (stress.lanes(), de.lanes());
-        match plastic {
-            Some(eps) => {
-                for ((s, de), eps) in s.iter_mut().zip(&de).zip(eps) {
-                    self.update(s, de, Some(eps));
-                }
-            }
-            None => {
-                for (s, de) in s.iter_mut().zip(&de) {
-                    self.update(s, de, None);
-                }
+        update_lane_by_lane(stress, de, plastic, |_, s, de, eps| self.update(s, de, eps));
+    }
+}
+
+/// Calls `update(lane, stress, de, plastic)` with each lane's stress, strain increment and
+/// plastic strain in turn, and puts the stresses back into their lanes.
+#[inline(always)]
+pub fn update_lane_by_lane(
+    stress: &mut Sym3x4,
+    de: &Sym3x4,
+    plastic: Option<[&mut f64; LANES]>,
+    mut update: impl FnMut(usize, &mut Sym3, &Sym3, Option<&mut f64>),
+) {
+    let (mut s, de) = (stress.lanes(), de.lanes());
+    // One loop each, so that an elastic material's loop carries no plastic strain.
+    match plastic {
+        Some(eps) => {
+            for (lane, ((s, de), eps)) in s.iter_mut().zip(&de).zip(eps).enumerate() {
+                update(lane, s, de, Some(eps));
             }
         }
-        *stress = Sym3x4::gather(|l| s[l]);
+        None => {
+            for (lane, (s, de)) in s.iter_mut().zip(&de).enumerate() {
+                update(lane, s, de, None);
+            }
+        }
     }
+    *stress = Sym3x4::gather(|l| s[l]);
 }
 
 /// Isotropic elastic stiffness from Young's modulus and Poisson's ratio.
@@ -128,7 +141,7 @@ impl Material for MaterialModel {
             MaterialModel::MohrCoulomb(m) => m.update(stress, de, plastic),
         }
     }
-    #[inline]
+    #[inline(always)]
     fn update4(&self, stress: &mut Sym3x4, de: &Sym3x4, plastic: Option<[&mut f64; LANES]>) {
         match self {
             MaterialModel::LinearElastic(m) => m.update4(stress, de, plastic),

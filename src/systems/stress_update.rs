@@ -5,7 +5,7 @@ use crate::components::*;
 use crate::dim::Dim;
 use crate::error::StepError;
 use crate::lanes::{gather, F64x4, LANES};
-use crate::materials::{Material, MaterialModel};
+use crate::materials::{update_lane_by_lane, Material, MaterialModel};
 use crate::parallel::CHUNK;
 use crate::schedule::System;
 use crate::simulation::Context;
@@ -101,26 +101,14 @@ fn update_group<D: Dim>(
     let mut s = D::jaumann_rotate(&Sym3x4::gather(|q| stress[q].0.to_sym3()), w);
     let id = mat[0].0;
     let eps = plastic.map(|e| e.each_mut().map(|e| &mut e.0));
-    let out = if mat.iter().all(|m| m.0 == id) {
+    if mat.iter().all(|m| m.0 == id) {
         materials[id as usize].update4(&mut s, &de, eps);
-        s.lanes()
     } else {
-        let (mut s, de) = (s.lanes(), de.lanes());
-        match eps {
-            Some(eps) => {
-                for ((s, de), (m, eps)) in s.iter_mut().zip(&de).zip(mat.iter().zip(eps)) {
-                    materials[m.0 as usize].update(s, de, Some(eps));
-                }
-            }
-            None => {
-                for ((s, de), m) in s.iter_mut().zip(&de).zip(mat) {
-                    materials[m.0 as usize].update(s, de, None);
-                }
-            }
-        }
-        s
-    };
-    for (stress, s) in stress.iter_mut().zip(&out) {
+        update_lane_by_lane(&mut s, &de, eps, |q, s, de, eps| {
+            materials[mat[q].0 as usize].update(s, de, eps)
+        });
+    }
+    for (stress, s) in stress.iter_mut().zip(&s.lanes()) {
         stress.0 = D::Stress::from_sym3(s);
     }
 }
