@@ -6,7 +6,8 @@ use kdmpm::materials::{Material, MohrCoulomb};
 use kdmpm::scene::{build, LoadedScene};
 use kdmpm::shape::QuadraticBSpline;
 use kdmpm::systems::{Convergence, G2p, GridReset, P2g, P2gPart};
-use kdmpm::tensor::Sym3;
+use kdmpm::lanes::LANES;
+use kdmpm::tensor::{Sym3, Sym3x4};
 use kdmpm::{AnySimulation, Dim2, Simulation, System};
 use std::path::Path;
 
@@ -62,6 +63,32 @@ fn kernels(c: &mut Criterion) {
             let mut s = std::hint::black_box(start);
             let mut eps = 0.0;
             mc.update(&mut s, &de, Some(&mut eps));
+            s
+        })
+    });
+    // Four points at rest (K0 = ν/(1 − ν) = 0.667) under a small increment: the state of
+    // most of a slope once it has failed. One by one, and in lanes as the stress update
+    // calls it.
+    let at_rest: [Sym3; LANES] = std::array::from_fn(|q| {
+        let v = -1.0e5 * (1.0 + 0.1 * q as f64);
+        Sym3::diagonal(0.667 * v, v, 0.667 * v)
+    });
+    c.bench_function("Mohr-Coulomb update (4 elastic points, one by one)", |b| {
+        b.iter(|| {
+            let mut s = std::hint::black_box(at_rest);
+            let mut eps = [0.0; LANES];
+            for (s, eps) in s.iter_mut().zip(&mut eps) {
+                mc.update(s, &de, Some(eps));
+            }
+            s
+        })
+    });
+    let (at_rest4, de4) = (Sym3x4::gather(|q| at_rest[q]), Sym3x4::gather(|_| de));
+    c.bench_function("Mohr-Coulomb update (4 elastic points, in lanes)", |b| {
+        b.iter(|| {
+            let mut s = std::hint::black_box(at_rest4);
+            let mut eps = [0.0; LANES];
+            mc.update4(&mut s, &de4, Some(eps.each_mut()));
             s
         })
     });

@@ -17,8 +17,9 @@ pub type F64x4 = wide::f64x4;
 /// Points per group in the stress update.
 pub const LANES: usize = 4;
 
-/// The operations a formula over [`Lanes`] may use: `+ − × ÷` lane by lane, constants, and
-/// [`Lanes::madd`], which rounds exactly like [`madd`].
+/// The operations a formula over [`Lanes`] may use: `+ − × ÷` lane by lane, constants,
+/// [`Lanes::madd`], which rounds exactly like [`madd`], square root, and the larger or smaller
+/// of two values (as `f64::max` and `f64::min`: a NaN loses to a number).
 pub trait Lanes:
     Copy + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self> + Div<Output = Self>
 {
@@ -27,6 +28,12 @@ pub trait Lanes:
     /// `a·b + c` lane by lane, rounded once where the build has fused multiply-add and
     /// twice (as written) where it does not: the same choice as [`madd`].
     fn madd(a: Self, b: Self, c: Self) -> Self;
+    /// Square root, correctly rounded.
+    fn sqrt(self) -> Self;
+    /// The larger value, as `f64::max`.
+    fn max(self, b: Self) -> Self;
+    /// The smaller value, as `f64::min`.
+    fn min(self, b: Self) -> Self;
 }
 
 impl Lanes for f64 {
@@ -37,6 +44,18 @@ impl Lanes for f64 {
     #[inline(always)]
     fn madd(a: f64, b: f64, c: f64) -> f64 {
         madd(a, b, c)
+    }
+    #[inline(always)]
+    fn sqrt(self) -> f64 {
+        f64::sqrt(self)
+    }
+    #[inline(always)]
+    fn max(self, b: f64) -> f64 {
+        f64::max(self, b)
+    }
+    #[inline(always)]
+    fn min(self, b: f64) -> f64 {
+        f64::min(self, b)
     }
 }
 
@@ -52,6 +71,18 @@ impl Lanes for F64x4 {
         } else {
             a * b + c
         }
+    }
+    #[inline(always)]
+    fn sqrt(self) -> F64x4 {
+        F64x4::sqrt(self)
+    }
+    #[inline(always)]
+    fn max(self, b: F64x4) -> F64x4 {
+        F64x4::max(self, b)
+    }
+    #[inline(always)]
+    fn min(self, b: F64x4) -> F64x4 {
+        F64x4::min(self, b)
     }
 }
 

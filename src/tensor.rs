@@ -51,6 +51,25 @@ impl<T: Lanes> Sym<T> {
     pub fn trace(&self) -> T {
         self.xx + self.yy + self.zz
     }
+
+    /// Mean stress p = tr/3 and the norm of the deviatoric part |s| = sqrt(s:s).
+    #[inline(always)]
+    pub fn mean_and_deviatoric_norm(&self) -> (T, T) {
+        let p = self.trace() / T::splat(3.0);
+        let (a, b, c) = (self.xx - p, self.yy - p, self.zz - p);
+        let off = self.xy * self.xy + self.yz * self.yz + self.zx * self.zx;
+        (p, (a * a + b * b + c * c + T::splat(2.0) * off).sqrt())
+    }
+
+    /// Principal values in descending order of a tensor whose z axis is principal
+    /// (yz = zx = 0, see [`Sym3::has_principal_z`]); meaningless otherwise. One square root.
+    #[inline(always)]
+    pub fn planar_principal_values(&self) -> [T; 3] {
+        // c + r ≥ c − r: only zz has to find its place, which min/max do without a branch
+        // to mispredict, to the same values as the sorting network.
+        let [hi, lo, zz] = Planar::of(self).values(self);
+        [hi.max(zz), lo.max(hi.min(zz)), lo.min(zz)]
+    }
 }
 
 impl Sym3x4 {
@@ -66,6 +85,13 @@ impl Sym3x4 {
             yz: gather(|l| s[l].yz),
             zx: gather(|l| s[l].zx),
         }
+    }
+
+    /// Which lanes hold a tensor with z as a principal axis (yz = zx = 0): bit l for lane l.
+    #[inline(always)]
+    pub fn principal_z_lanes(&self) -> u32 {
+        let zero = F64x4::splat(0.0);
+        (self.yz.simd_eq(zero) & self.zx.simd_eq(zero)).to_bitmask()
     }
 
     /// The four tensors, lane by lane.
@@ -184,15 +210,6 @@ impl Sym3 {
             + 2.0 * (self.xy * b.xy + self.yz * b.yz + self.zx * b.zx)
     }
 
-    /// Mean stress p = tr/3 and the norm of the deviatoric part |s| = sqrt(s:s).
-    #[inline(always)]
-    pub fn mean_and_deviatoric_norm(&self) -> (f64, f64) {
-        let p = self.trace() / 3.0;
-        let (a, b, c) = (self.xx - p, self.yy - p, self.zz - p);
-        let off = self.xy * self.xy + self.yz * self.yz + self.zx * self.zx;
-        (p, (a * a + b * b + c * c + 2.0 * off).sqrt())
-    }
-
     /// Frobenius norm sqrt(a:a).
     #[inline(always)]
     pub fn norm(&self) -> f64 {
@@ -263,10 +280,7 @@ impl Sym3 {
     /// tensor (up to the sign of a zero); when z is a principal axis they cost one square root, without the eigenvectors.
     pub fn principal_values(&self) -> [f64; 3] {
         if self.has_principal_z() {
-            // c + r ≥ c − r: only zz has to find its place, which min/max do without a branch
-            // to mispredict, to the same values as the sorting network.
-            let [hi, lo, zz] = Planar::of(self).values(self);
-            [hi.max(zz), lo.max(hi.min(zz)), lo.min(zz)]
+            self.planar_principal_values()
         } else {
             self.eigen().0
         }
@@ -297,18 +311,19 @@ fn descending_order(v: [f64; 3]) -> [usize; 3] {
 
 /// The x-y block of a tensor whose z axis is principal as centre c, half-difference d and
 /// radius r of its Mohr circle: principal values c ± r and zz.
-struct Planar {
-    c: f64,
-    d: f64,
-    r: f64,
+struct Planar<T> {
+    c: T,
+    d: T,
+    r: T,
 }
 
-impl Planar {
+impl<T: Lanes> Planar<T> {
     #[inline(always)]
-    fn of(s: &Sym3) -> Planar {
-        let d = 0.5 * (s.xx - s.yy);
+    fn of(s: &Sym<T>) -> Planar<T> {
+        let half = T::splat(0.5);
+        let d = half * (s.xx - s.yy);
         Planar {
-            c: 0.5 * (s.xx + s.yy),
+            c: half * (s.xx + s.yy),
             d,
             // Plain sqrt, not hypot: stresses are far from overflow and hypot is slow in glibc.
             r: (d * d + s.xy * s.xy).sqrt(),
@@ -317,7 +332,7 @@ impl Planar {
 
     /// Principal values, unsorted: c + r, c − r, zz.
     #[inline(always)]
-    fn values(&self, s: &Sym3) -> [f64; 3] {
+    fn values(&self, s: &Sym<T>) -> [T; 3] {
         [self.c + self.r, self.c - self.r, s.zz]
     }
 }

@@ -15,9 +15,13 @@
 //! In compression-positive terms the plane f = 0 is the classical
 //! σ1' = σ3' (1 + sin φ)/(1 − sin φ) + 2c cos φ/(1 − sin φ).
 
-use super::{Elasticity, Material};
-use crate::tensor::Sym3;
+use super::{update_lane_by_lane, Elasticity, Material};
+use crate::lanes::{F64x4, Lanes, LANES};
+use crate::tensor::{Sym, Sym3, Sym3x4};
 use glam::DVec3;
+
+/// Every lane's bit of a four-lane mask.
+const ALL_LANES: u32 = (1 << LANES) - 1;
 
 /// Mohr-Coulomb perfectly plastic material.
 #[derive(Clone, Debug, PartialEq)]
@@ -101,9 +105,11 @@ impl MohrCoulomb {
         }
     }
 
-    /// Yield function f for principal stresses sorted σ1 ≥ σ2 ≥ σ3 (Pa; ≤ 0 is admissible).
-    pub fn yield_function(&self, p: [f64; 3]) -> f64 {
-        self.k * p[0] - p[2] - self.sigma_c
+    /// Yield function f for principal stresses sorted σ1 ≥ σ2 ≥ σ3 (Pa; ≤ 0 is admissible),
+    /// of one point or four in lanes.
+    #[inline(always)]
+    pub fn yield_function<T: Lanes>(&self, p: [T; 3]) -> T {
+        T::splat(self.k) * p[0] - p[2] - T::splat(self.sigma_c)
     }
 
     /// True when principal stresses sorted σ1 ≥ σ2 ≥ σ3 (Pa) are inside the yield surface and
@@ -122,9 +128,63 @@ impl MohrCoulomb {
     /// runs anyway.
     #[inline(always)]
     pub fn surely_elastic(&self, stress: &Sym3) -> bool {
+        let (f, sigma_1) = self.invariant_bound(stress);
+        f <= 0.0 && sigma_1 <= self.tension_cutoff
+    }
+
+    /// The bounds of [`MohrCoulomb::surely_elastic`] on f and σ1 (Pa), of one point or four
+    /// in lanes.
+    #[inline(always)]
+    fn invariant_bound<T: Lanes>(&self, stress: &Sym<T>) -> (T, T) {
         let (p, s) = stress.mean_and_deviatoric_norm();
-        let r = (2.0f64 / 3.0).sqrt() * s;
-        (self.k - 1.0) * p + (self.k + 1.0) * r - self.sigma_c <= 0.0 && p + r <= self.tension_cutoff
+        let r = T::splat((2.0f64 / 3.0).sqrt()) * s;
+        let f = T::splat(self.k - 1.0) * p + T::splat(self.k + 1.0) * r - T::splat(self.sigma_c);
+        (f, p + r)
+    }
+
+    /// The test of [`Material::update`] that lets a trial stress stand, for four points in
+    /// lanes: bit l is set when lane l passes it. When the lanes disagree on whether z is a
+    /// principal axis (which selects the test) none is set, and each point is tested alone.
+    #[inline(always)]
+    fn elastic_lanes(&self, trial: &Sym3x4) -> u32 {
+        let (f, sigma_1) = match trial.principal_z_lanes() {
+            ALL_LANES => {
+                let p = trial.planar_principal_values();
+                (self.yield_function(p), p[0])
+            }
+            0 => self.invariant_bound(trial),
+            _ => return 0,
+        };
+        let (zero, cutoff) = (F64x4::splat(0.0), F64x4::splat(self.tension_cutoff));
+        (f.simd_le(zero) & sigma_1.simd_le(cutoff)).to_bitmask()
+    }
+
+    /// Where a trial stress (Pa) ends: itself when admissible, else returned to the yield
+    /// surface, adding the plastic strain of the return to `plastic`.
+    #[inline(always)]
+    fn settle(&self, trial: Sym3, plastic: Option<&mut f64>) -> Sym3 {
+        // With z principal (all of plane strain) the exact principal values cost one square
+        // root, as much as the invariant bound, and also settle the states the bound cannot
+        // (most of a failing slope); the eigenvectors are then found only for yielding points.
+        let planar = trial.has_principal_z();
+        let elastic = if planar {
+            self.admissible(trial.principal_values())
+        } else {
+            self.surely_elastic(&trial)
+        };
+        if elastic {
+            return trial;
+        }
+        let (p, r) = trial.eigen();
+        // The bound is loose near the surface: a general state it did not pass may be inside.
+        if !planar && self.admissible(p) {
+            return trial;
+        }
+        let (ret, _) = self.return_principal(p);
+        if let Some(eps) = plastic {
+            *eps += self.plastic_strain_increment(DVec3::from_array(p) - DVec3::from_array(ret));
+        }
+        Sym3::from_principal(ret, &r)
     }
 
     /// Returns sorted principal trial stresses to the yield surface.
@@ -242,30 +302,16 @@ impl Material for MohrCoulomb {
     }
     #[inline]
     fn update(&self, stress: &mut Sym3, de: &Sym3, plastic: Option<&mut f64>) {
-        let trial = *stress + self.elasticity.stress_increment(de);
-        // With z principal (all of plane strain) the exact principal values cost one square
-        // root, as much as the invariant bound, and also settle the states the bound cannot
-        // (most of a failing slope); the eigenvectors are then found only for yielding points.
-        let planar = trial.has_principal_z();
-        let elastic = if planar {
-            self.admissible(trial.principal_values())
-        } else {
-            self.surely_elastic(&trial)
-        };
-        if elastic {
-            *stress = trial;
-            return;
-        }
-        let (p, r) = trial.eigen();
-        // The bound is loose near the surface: a general state it did not pass may be inside.
-        if !planar && self.admissible(p) {
-            *stress = trial;
-            return;
-        }
-        let (ret, _) = self.return_principal(p);
-        *stress = Sym3::from_principal(ret, &r);
-        if let Some(eps) = plastic {
-            *eps += self.plastic_strain_increment(DVec3::from_array(p) - DVec3::from_array(ret));
+        *stress = self.settle(*stress + self.elasticity.stress_increment(de), plastic);
+    }
+
+    /// The elastic trial and its test in lanes; when all four pass (most points of a slope
+    /// at rest) that is all, else each point settles alone, with the bits `update` gives it.
+    #[inline(always)]
+    fn update4(&self, stress: &mut Sym3x4, de: &Sym3x4, plastic: Option<[&mut f64; LANES]>) {
+        *stress += self.elasticity.stress_increment(de);
+        if self.elastic_lanes(stress) != ALL_LANES {
+            update_lane_by_lane(stress, de, plastic, |_, s, _, eps| *s = self.settle(*s, eps));
         }
     }
 }
@@ -456,5 +502,83 @@ mod tests {
         let (s, _) = mc.return_principal([40e3, -20e3, -50e3]);
         assert!(s[0] <= 10e3 + 1e-6, "{s:?}");
         assert!(mc.yield_function(sorted(s)) <= 1e-6);
+    }
+
+    /// A reproducible value in [−1, 1) (a 64-bit linear congruential generator).
+    fn next(seed: &mut u64) -> f64 {
+        *seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (*seed >> 11) as f64 / (1u64 << 52) as f64 - 1.0
+    }
+
+    #[test]
+    fn four_points_in_lanes_get_the_bits_each_gets_alone_elastic_or_yielding_planar_or_not() {
+        // Soil stresses about an at-rest state (σv = −200 kPa, K0 = 0.6) with shear noise, and
+        // strain increments of 0.2 % or 1 %: groups all elastic (the lanes' fast path), groups
+        // where some lanes yield, and groups mixing planar and general states.
+        let mc = MohrCoulomb::new(2000.0, 20e6, 0.3, 5e3, 30.0, 5.0, Some(2e3));
+        let mut seed = 11;
+        let (mut all_elastic, mut some_yield, mut mixed_planes) = (0, 0, 0);
+        for group in 0..4000 {
+            let planar: [bool; LANES] = std::array::from_fn(|q| match group % 3 {
+                0 => true,
+                1 => false,
+                _ => q % 2 == 0,
+            });
+            let strain = if group % 2 == 0 { 2e-3 } else { 1e-2 };
+            let mut tensor = |scale: f64, base: [f64; 3], planar: bool| {
+                let mut t = Sym3 {
+                    xx: base[0] + scale * next(&mut seed),
+                    yy: base[1] + scale * next(&mut seed),
+                    zz: base[2] + scale * next(&mut seed),
+                    xy: scale * next(&mut seed),
+                    yz: scale * next(&mut seed),
+                    zx: scale * next(&mut seed),
+                };
+                if planar {
+                    (t.yz, t.zx) = (0.0, 0.0);
+                }
+                t
+            };
+            let stress: [Sym3; LANES] =
+                std::array::from_fn(|q| tensor(30e3, [-120e3, -200e3, -120e3], planar[q]));
+            let de: [Sym3; LANES] = std::array::from_fn(|q| tensor(strain, [0.0; 3], planar[q]));
+            let eps0: [f64; LANES] = std::array::from_fn(|q| q as f64 * 1e-3);
+            let mut alone = stress;
+            let mut eps_alone = eps0;
+            for q in 0..LANES {
+                mc.update(&mut alone[q], &de[q], Some(&mut eps_alone[q]));
+            }
+            let mut lanes = Sym3x4::gather(|q| stress[q]);
+            let mut eps_lanes = eps0;
+            let trial = lanes + mc.elasticity.stress_increment(&Sym3x4::gather(|q| de[q]));
+            match mc.elastic_lanes(&trial) {
+                ALL_LANES => all_elastic += 1,
+                0 if group % 3 == 2 => mixed_planes += 1,
+                _ => some_yield += 1,
+            }
+            mc.update4(&mut lanes, &Sym3x4::gather(|q| de[q]), Some(eps_lanes.each_mut()));
+            let bits = |s: &[Sym3], e: &[f64]| -> Vec<u64> {
+                s.iter()
+                    .flat_map(|s| s.to_array())
+                    .chain(e.iter().copied())
+                    .map(f64::to_bits)
+                    .collect()
+            };
+            assert_eq!(
+                bits(&lanes.lanes(), &eps_lanes),
+                bits(&alone, &eps_alone),
+                "group {group}: {stress:?} + {de:?}"
+            );
+        }
+        // Each path ran often enough to count: the test is void if the mix drifts.
+        for (what, n) in [
+            ("all elastic", all_elastic),
+            ("some yield", some_yield),
+            ("mixed planes", mixed_planes),
+        ] {
+            assert!(n >= 300, "{what}: {n} groups of 4000");
+        }
     }
 }
