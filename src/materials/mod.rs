@@ -27,8 +27,8 @@ pub trait Material: Send + Sync {
     fn update(&self, stress: &mut Sym3, de: &Sym3, plastic: Option<&mut f64>);
     /// [`Material::update`] for four points of this material side by side, one per lane,
     /// with the same bits for each as `update` would give it. By default lane by lane; linear
-    /// elasticity does all four at once, Mohr-Coulomb tests all four in lanes and settles
-    /// point by point only groups where one yields.
+    /// elasticity does all four at once; Mohr-Coulomb tests all four for yield in lanes and
+    /// returns one by one only the points that fail the test.
     #[inline(always)]
     fn update4(&self, stress: &mut Sym3x4, de: &Sym3x4, plastic: Option<[&mut f64; LANES]>) {
         update_lane_by_lane(stress, de, plastic, |_, s, de, eps| self.update(s, de, eps));
