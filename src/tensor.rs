@@ -52,6 +52,21 @@ impl<T: Lanes> Sym<T> {
         self.xx + self.yy + self.zz
     }
 
+    /// Double contraction a:b.
+    #[inline(always)]
+    pub fn ddot(&self, b: &Sym<T>) -> T {
+        self.xx * b.xx
+            + self.yy * b.yy
+            + self.zz * b.zz
+            + T::splat(2.0) * (self.xy * b.xy + self.yz * b.yz + self.zx * b.zx)
+    }
+
+    /// Frobenius norm sqrt(a:a).
+    #[inline(always)]
+    pub fn norm(&self) -> T {
+        self.ddot(self).sqrt()
+    }
+
     /// Mean stress p = tr/3 and the norm of the deviatoric part |s| = sqrt(s:s).
     #[inline(always)]
     pub fn mean_and_deviatoric_norm(&self) -> (T, T) {
@@ -199,21 +214,6 @@ impl Sym3 {
             yz: 0.0,
             zx: 0.0,
         }
-    }
-
-    /// Double contraction a:b.
-    #[inline(always)]
-    pub fn ddot(&self, b: &Sym3) -> f64 {
-        self.xx * b.xx
-            + self.yy * b.yy
-            + self.zz * b.zz
-            + 2.0 * (self.xy * b.xy + self.yz * b.yz + self.zx * b.zx)
-    }
-
-    /// Frobenius norm sqrt(a:a).
-    #[inline(always)]
-    pub fn norm(&self) -> f64 {
-        self.ddot(self).sqrt()
     }
 
     /// True when every component is finite.

@@ -120,20 +120,21 @@ impl MohrCoulomb {
     }
 
     /// True when the stress is inside the yield surface and below the tension cut-off by a
-    /// bound from its invariants alone, so most elastic points skip the eigen-decomposition.
+    /// bound, so most elastic points skip the eigen-decomposition: the bound from the
+    /// invariants ([`MohrCoulomb::invariant_bound`]) or, for nearly planar states, the one
+    /// from the x-y block ([`MohrCoulomb::near_planar_bound`]). A stress it passes is one the
+    /// exact test on the eigen-decomposition's values passes too.
+    #[inline(always)]
+    pub fn surely_elastic(&self, stress: &Sym3) -> bool {
+        let passes = |(f, sigma_1): (f64, f64)| f <= 0.0 && sigma_1 <= self.tension_cutoff;
+        passes(self.invariant_bound(stress)) || passes(self.near_planar_bound(stress))
+    }
+
+    /// Upper bounds on f and σ1 (Pa) from the invariants, of one point or four in lanes.
     ///
     /// The deviatoric principal values lie within ±sqrt(2/3)|s|, so
     /// f = (k − 1) p + k s1 − s3 − σc ≤ (k − 1) p + (k + 1) sqrt(2/3) |s| − σc and
-    /// σ1 ≤ p + sqrt(2/3) |s|. The bound is loose only near the surface, where the exact test
-    /// runs anyway.
-    #[inline(always)]
-    pub fn surely_elastic(&self, stress: &Sym3) -> bool {
-        let (f, sigma_1) = self.invariant_bound(stress);
-        f <= 0.0 && sigma_1 <= self.tension_cutoff
-    }
-
-    /// The bounds of [`MohrCoulomb::surely_elastic`] on f and σ1 (Pa), of one point or four
-    /// in lanes.
+    /// σ1 ≤ p + sqrt(2/3) |s|. Loose only near the surface, where the exact test runs anyway.
     #[inline(always)]
     fn invariant_bound<T: Lanes>(&self, stress: &Sym<T>) -> (T, T) {
         let (p, s) = stress.mean_and_deviatoric_norm();
@@ -142,21 +143,40 @@ impl MohrCoulomb {
         (f, p + r)
     }
 
+    /// Upper bounds on f and σ1 (Pa) from the principal values of the stress without its yz
+    /// and zx, of one point or four in lanes. Leaving out a symmetric part E moves each sorted
+    /// principal value by at most E's spectral norm, here sqrt(yz² + zx²) (Weyl's
+    /// inequality), so f by at most (k + 1) times that; a margin of 1e-10 |σ| and 1e-10 σc
+    /// covers the rounding of this test and of the eigen-decomposition's values (a few
+    /// ε |σ| each, ε = 2.2e-16). Tight where the invariant bound is loose: near the surface in
+    /// a nearly planar state, such as a 3D body in plane strain, whose yz and zx are round-off.
+    #[inline(always)]
+    fn near_planar_bound<T: Lanes>(&self, stress: &Sym<T>) -> (T, T) {
+        const MARGIN: f64 = 1e-10;
+        let p = stress.planar_principal_values();
+        let out_of_plane = (stress.yz * stress.yz + stress.zx * stress.zx).sqrt();
+        let shift = T::madd(T::splat(MARGIN), stress.norm(), out_of_plane);
+        let f =
+            T::madd(T::splat(self.k + 1.0), shift, self.yield_function(p)) + T::splat(MARGIN * self.sigma_c);
+        (f, p[0] + shift)
+    }
+
     /// The test of [`Material::update`] that lets a trial stress stand, for four points in
-    /// lanes: bit l is set when lane l passes it. When the lanes disagree on whether z is a
+    /// lanes: bit l is set when lane l passes it (or, for a general state, a bound that
+    /// passes only stresses the exact test passes). When the lanes disagree on whether z is a
     /// principal axis (which selects the test) none is set, and each point is tested alone.
     #[inline(always)]
     fn elastic_lanes(&self, trial: &Sym3x4) -> u32 {
-        let (f, sigma_1) = match trial.principal_z_lanes() {
+        let (zero, cutoff) = (F64x4::splat(0.0), F64x4::splat(self.tension_cutoff));
+        let passes = |(f, sigma_1): (F64x4, F64x4)| (f.simd_le(zero) & sigma_1.simd_le(cutoff)).to_bitmask();
+        match trial.principal_z_lanes() {
             ALL_LANES => {
                 let p = trial.planar_principal_values();
-                (self.yield_function(p), p[0])
+                passes((self.yield_function(p), p[0]))
             }
-            0 => self.invariant_bound(trial),
-            _ => return 0,
-        };
-        let (zero, cutoff) = (F64x4::splat(0.0), F64x4::splat(self.tension_cutoff));
-        (f.simd_le(zero) & sigma_1.simd_le(cutoff)).to_bitmask()
+            0 => passes(self.invariant_bound(trial)) | passes(self.near_planar_bound(trial)),
+            _ => 0,
+        }
     }
 
     /// Where a trial stress (Pa) ends: itself when admissible, else returned to the yield
@@ -417,6 +437,35 @@ mod tests {
         }
 
         #[test]
+        fn the_near_planar_bound_passes_no_stress_the_exact_test_fails(
+            s3 in -1e6f64..-1e3, mid in 0.0f64..1.0, rel in -1e-8f64..1e-8,
+            angle in 0.0f64..3.2, magnitude in -12.0f64..3.0, a in -1.0f64..1.0, b in -1.0f64..1.0,
+            coh in 0.0f64..5e4, phi in 5.0f64..45.0,
+        ) {
+            // Principal values σ1 within 1e-8 (relative) of the surface and σ3 in the x-y plane,
+            // turned by `angle`, σ2 along z, and out-of-plane shear of about 10^magnitude Pa:
+            // where the bound's margin is all that stands between a pass and a wrong pass.
+            let mc = soil(coh, phi, 0.0);
+            let s1 = (s3 + mc.sigma_c) / mc.k * (1.0 + rel);
+            let (c, d) = (0.5 * (s1 + s3), 0.5 * (s1 - s3));
+            let out = 10f64.powf(magnitude);
+            let s = Sym3 {
+                xx: c + d * (2.0 * angle).cos(),
+                yy: c - d * (2.0 * angle).cos(),
+                zz: s3 + mid * (s1 - s3),
+                xy: d * (2.0 * angle).sin(),
+                yz: a * out,
+                zx: b * out,
+            };
+            let (f, sigma_1) = mc.near_planar_bound(&s);
+            if f <= 0.0 && sigma_1 <= mc.tension_cutoff {
+                // Exactly the test `update` makes after the eigen-decomposition: the bound
+                // standing in for it must not change a single decision.
+                prop_assert!(mc.admissible(s.eigen().0), "{s:?}");
+            }
+        }
+
+        #[test]
         fn stresses_inside_the_surface_return_unchanged(
             s3 in -1e6f64..-1e3, f1 in 0.0f64..1.0, f2 in 0.0f64..1.0,
         ) {
@@ -427,6 +476,32 @@ mod tests {
             let (s, kind) = mc.return_principal([s1, s2, s3]);
             prop_assert_eq!(kind, Return::Elastic);
             prop_assert_eq!(s, [s1, s2, s3]);
+        }
+    }
+
+    #[test]
+    fn a_nearly_planar_stress_just_inside_the_surface_skips_the_eigen_decomposition() {
+        // A 3D body in plane strain: yz and zx of round-off size. 1e-6 inside the surface the
+        // invariant bound cannot tell, the near-planar bound can; 1e-6 outside, neither passes.
+        let mc = soil(2e3, 20.0, 0.0);
+        let s3 = -2e5;
+        for (rel, inside) in [(-1e-6, true), (1e-6, false)] {
+            let s1 = (s3 + mc.sigma_c) / mc.k * (1.0 - rel);
+            let s = Sym3 {
+                xx: s1,
+                yy: s3,
+                zz: 0.5 * (s1 + s3),
+                xy: 0.0,
+                yz: 2e-9,
+                zx: -1e-9,
+            };
+            assert_eq!(mc.admissible(s.eigen().0), inside, "{s:?}");
+            let (f, sigma_1) = mc.invariant_bound(&s);
+            assert!(
+                f > 0.0 || sigma_1 > mc.tension_cutoff,
+                "invariant bound passed {s:?}"
+            );
+            assert_eq!(mc.surely_elastic(&s), inside, "{s:?}");
         }
     }
 
