@@ -1,6 +1,6 @@
 //! Linear hat functions (bilinear/trilinear by tensor product).
 
-use super::{Shape, Stencil1};
+use super::{for_each_row, Shape, Stencil1};
 use crate::dim::{Dim, Vector};
 use crate::grid::{cell_index, index_to_f64, Axis, Grid};
 use crate::tensor::Sym3;
@@ -39,7 +39,7 @@ impl Shape for Linear {
     ) -> (D::Mat, D::Vec) {
         let mut cols = [D::Vec::ZERO; 3];
         let mut vel = D::Vec::ZERO;
-        rows(grid, x, |sx, first, w, dw_dy, dw_dz| {
+        for_each_row::<D, Self>(grid, x, |sx, first, w, dw_dy, dw_dz| {
             let v0 = v(first);
             let dv = v(first + 1) - v0;
             let mean = dv.madd(sx.w[1], v0);
@@ -70,7 +70,7 @@ impl Shape for Linear {
         // Columns of −Vσ (only the first N entries of each are kept in 2D).
         let p = |a: f64, b: f64, c: f64| D::vec_from([a * neg_vol, b * neg_vol, c * neg_vol]);
         let (px, py, pz) = (p(s.xx, s.xy, s.zx), p(s.xy, s.yy, s.yz), p(s.zx, s.yz, s.zz));
-        rows(grid, x, |sx, first, w, dw_dy, dw_dz| {
+        for_each_row::<D, Self>(grid, x, |sx, first, w, dw_dy, dw_dz| {
             let f = sx.w[1];
             let a = px * (sx.dw[1] * w);
             let b = if D::N == 3 {
@@ -83,33 +83,5 @@ impl Shape for Linear {
             add(first, mr - m1, qr - q1, b - f1);
             add(first + 1, m1, q1, f1);
         });
-    }
-}
-
-/// Calls `row(sx, first_node, w_r, ∂w_r/∂y, ∂w_r/∂z)` for every x-row of the nodes of a
-/// point at `x` (2 rows in 2D, 4 in 3D): the row's nodes are `first_node` and the next one,
-/// with weights (1 − f) w_r and f w_r, where f = `sx.w[1]` and `sx.dw[1]` = 1/h.
-#[inline(always)]
-fn rows<D: Dim>(grid: &Grid<D>, x: D::Vec, mut row: impl FnMut(&Stencil1, usize, f64, f64, f64)) {
-    let sx = Linear::eval_1d(grid.grid_coordinate(x, 0), &grid.axes[0]);
-    let sy = Linear::eval_1d(grid.grid_coordinate(x, 1), &grid.axes[1]);
-    let [_, stride_y, stride_z] = grid.strides;
-    if D::N == 2 {
-        for j in 0..2 {
-            row(&sx, (sy.base + j) * stride_y + sx.base, sy.w[j], sy.dw[j], 0.0);
-        }
-    } else {
-        let sz = Linear::eval_1d(grid.grid_coordinate(x, 2), &grid.axes[2]);
-        for k in 0..2 {
-            for j in 0..2 {
-                row(
-                    &sx,
-                    (sz.base + k) * stride_z + (sy.base + j) * stride_y + sx.base,
-                    sy.w[j] * sz.w[k],
-                    sy.dw[j] * sz.w[k],
-                    sy.w[j] * sz.dw[k],
-                );
-            }
-        }
     }
 }

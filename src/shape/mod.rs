@@ -109,29 +109,46 @@ pub fn scatter_node_by_node<D: Dim, S: Shape>(
 /// The point must lie inside the grid (the kinematics system guarantees this).
 #[inline(always)]
 pub fn for_each_node<D: Dim, S: Shape>(grid: &Grid<D>, x: D::Vec, mut f: impl FnMut(usize, f64, D::Vec)) {
+    for_each_row::<D, S>(grid, x, |sx, first, w, dw_dy, dw_dz| {
+        for i in 0..S::SUPPORT {
+            let grad = D::vec_from([sx.dw[i] * w, sx.w[i] * dw_dy, sx.w[i] * dw_dz]);
+            f(first + i, sx.w[i] * w, grad);
+        }
+    });
+}
+
+/// Calls `row(sx, first_node, w_r, ∂w_r/∂y, ∂w_r/∂z)` for every x-row of the nodes in the
+/// support of a point at `x` inside the grid (`SUPPORT` rows in 2D, `SUPPORT²` in 3D). A row's
+/// nodes are `first_node` and the next `SUPPORT − 1`; node i of the row has weight
+/// `sx.w[i]`·w_r and gradient (`sx.dw[i]`·w_r, `sx.w[i]`·∂w_r/∂y, `sx.w[i]`·∂w_r/∂z), where
+/// w_r is the product of the y and z weights (∂w_r/∂z = 0 in 2D).
+///
+/// The nodes of a row share w_r and its derivatives, so the transfers work a row at a time
+/// and leave the x-weights to the last, cheapest factor.
+#[inline(always)]
+pub fn for_each_row<D: Dim, S: Shape>(
+    grid: &Grid<D>,
+    x: D::Vec,
+    mut row: impl FnMut(&Stencil1, usize, f64, f64, f64),
+) {
     let sx = S::eval_1d(grid.grid_coordinate(x, 0), &grid.axes[0]);
     let sy = S::eval_1d(grid.grid_coordinate(x, 1), &grid.axes[1]);
     let [_, stride_y, stride_z] = grid.strides;
     if D::N == 2 {
         for j in 0..S::SUPPORT {
-            let row = (sy.base + j) * stride_y + sx.base;
-            for i in 0..S::SUPPORT {
-                let grad = D::vec_from([sx.dw[i] * sy.w[j], sx.w[i] * sy.dw[j], 0.0]);
-                f(row + i, sx.w[i] * sy.w[j], grad);
-            }
+            row(&sx, (sy.base + j) * stride_y + sx.base, sy.w[j], sy.dw[j], 0.0);
         }
     } else {
         let sz = S::eval_1d(grid.grid_coordinate(x, 2), &grid.axes[2]);
         for k in 0..S::SUPPORT {
             for j in 0..S::SUPPORT {
-                let row = (sz.base + k) * stride_z + (sy.base + j) * stride_y + sx.base;
-                let wyz = sy.w[j] * sz.w[k];
-                let dyz = sy.dw[j] * sz.w[k];
-                let ydz = sy.w[j] * sz.dw[k];
-                for i in 0..S::SUPPORT {
-                    let grad = D::vec_from([sx.dw[i] * wyz, sx.w[i] * dyz, sx.w[i] * ydz]);
-                    f(row + i, sx.w[i] * wyz, grad);
-                }
+                row(
+                    &sx,
+                    (sz.base + k) * stride_z + (sy.base + j) * stride_y + sx.base,
+                    sy.w[j] * sz.w[k],
+                    sy.dw[j] * sz.w[k],
+                    sy.w[j] * sz.dw[k],
+                );
             }
         }
     }
