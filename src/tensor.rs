@@ -3,7 +3,7 @@
 //!
 //! Sign convention: tension positive, as in continuum mechanics.
 
-use crate::lanes::{gather, F64x4, Lanes, LANES};
+use crate::lanes::{F64x4, Lanes, LANES};
 use glam::{DMat3, DVec3};
 use std::ops::{Add, AddAssign, Mul, Sub, SubAssign};
 
@@ -91,14 +91,18 @@ impl Sym3x4 {
     /// The tensors `f(0), …, f(3)` in lanes 0 to 3.
     #[inline(always)]
     pub fn gather(f: impl Fn(usize) -> Sym3) -> Sym3x4 {
-        let s: [Sym3; LANES] = std::array::from_fn(f);
+        // Four named values rather than `array::from_fn`: built through memory, that array
+        // was stored a point at a time and read back across the halves of those stores,
+        // which the CPU cannot forward (a fifth of the slope's stress update in some builds).
+        let (s0, s1, s2, s3) = (f(0), f(1), f(2), f(3));
+        let lanes = |c: fn(&Sym3) -> f64| F64x4::new([c(&s0), c(&s1), c(&s2), c(&s3)]);
         Sym {
-            xx: gather(|l| s[l].xx),
-            yy: gather(|l| s[l].yy),
-            zz: gather(|l| s[l].zz),
-            xy: gather(|l| s[l].xy),
-            yz: gather(|l| s[l].yz),
-            zx: gather(|l| s[l].zx),
+            xx: lanes(|s| s.xx),
+            yy: lanes(|s| s.yy),
+            zz: lanes(|s| s.zz),
+            xy: lanes(|s| s.xy),
+            yz: lanes(|s| s.yz),
+            zx: lanes(|s| s.zx),
         }
     }
 
@@ -112,7 +116,17 @@ impl Sym3x4 {
     /// The four tensors, lane by lane.
     #[inline(always)]
     pub fn lanes(&self) -> [Sym3; LANES] {
-        let c = [self.xx, self.yy, self.zz, self.xy, self.yz, self.zx].map(|v| v.to_array());
+        // Written out rather than with `[..].map`: left outlined, that copy went through
+        // memory and stalled on loading lanes stored one by one (a quarter of the slope's
+        // stress update in some builds).
+        let c = [
+            self.xx.to_array(),
+            self.yy.to_array(),
+            self.zz.to_array(),
+            self.xy.to_array(),
+            self.yz.to_array(),
+            self.zx.to_array(),
+        ];
         std::array::from_fn(|l| Sym {
             xx: c[0][l],
             yy: c[1][l],
@@ -521,6 +535,7 @@ impl SubAssign for Sym3 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::lanes::gather;
 
     fn sample() -> Sym3 {
         Sym3 {
