@@ -1,6 +1,7 @@
 //! Linear hat functions (bilinear/trilinear by tensor product).
 
-use super::{for_each_row, Shape, Stencil1};
+use super::{for_each_row, GradientSum, Shape, Stencil1};
+use crate::lanes::{F64x4, Lanes};
 use crate::dim::{Dim, Vector};
 use crate::grid::{cell_index, index_to_f64, Axis, Grid};
 use crate::tensor::Sym3;
@@ -37,20 +38,19 @@ impl Shape for Linear {
         x: D::Vec,
         v: impl Fn(usize) -> D::Vec,
     ) -> (D::Mat, D::Vec) {
-        let mut cols = [D::Vec::ZERO; 3];
-        let mut vel = D::Vec::ZERO;
+        let mut acc = GradientSum::default();
         for_each_row::<D, Self>(grid, x, |sx, first, w, dw_dy, dw_dz| {
-            let v0 = v(first);
-            let dv = v(first + 1) - v0;
-            let mean = dv.madd(sx.w[1], v0);
-            cols[0] = dv.madd(sx.dw[1] * w, cols[0]);
-            cols[1] = mean.madd(dw_dy, cols[1]);
+            let v0 = GradientSum::lanes::<D>(v(first));
+            let dv = GradientSum::lanes::<D>(v(first + 1)) - v0;
+            let mean = Lanes::madd(dv, F64x4::splat(sx.w[1]), v0);
+            acc.add_column(0, dv, sx.dw[1] * w);
+            acc.add_column(1, mean, dw_dy);
             if D::N == 3 {
-                cols[2] = mean.madd(dw_dz, cols[2]);
+                acc.add_column(2, mean, dw_dz);
             }
-            vel = mean.madd(w, vel);
+            acc.add_velocity(mean, w);
         });
-        (D::mat_from_cols(cols), vel)
+        acc.finish::<D>()
     }
 
     /// Row by row along x, as the gather. A row's nodes share w_r, so with P = −Vσ the far

@@ -12,6 +12,7 @@ pub use linear::Linear;
 
 use crate::dim::{Dim, Vector};
 use crate::grid::{Axis, Grid};
+use crate::lanes::{F64x4, Lanes};
 use crate::tensor::Sym3;
 
 /// The 1D weights of one point along one axis: nodes `base .. base + SUPPORT`.
@@ -77,14 +78,67 @@ pub fn gather_node_by_node<D: Dim, S: Shape>(
     x: D::Vec,
     v: impl Fn(usize) -> D::Vec,
 ) -> (D::Mat, D::Vec) {
-    let mut l = D::MAT_ZERO;
-    let mut vel = D::Vec::ZERO;
+    let mut acc = GradientSum::default();
     for_each_node::<D, S>(grid, x, |i, w, grad| {
-        let vi = v(i);
-        D::add_outer(&mut l, vi, grad);
-        vel = vi.madd(w, vel);
+        acc.add::<D>(GradientSum::lanes::<D>(v(i)), grad, w);
     });
-    (l, vel)
+    acc.finish::<D>()
+}
+
+/// The running sums of a gather: the columns of Σ v_i ⊗ g_i and Σ w_i v_i, each vector in
+/// the lanes of one register (x, y, z, 0; z = 0 in 2D).
+///
+/// As glam vectors the twelve sums of a 3D gather did not all stay in registers: some went
+/// to the stack, and every node's multiply-add waited on a store and a reload (the 3D
+/// kinematics' hottest instruction). Four registers hold them, and each lane rounds as the
+/// scalar [`crate::dim::madd`], so the bits are those of the glam form.
+#[derive(Clone, Copy, Default)]
+pub(crate) struct GradientSum {
+    /// Column j of the velocity gradient (1/s).
+    cols: [F64x4; 3],
+    /// The velocity (m/s).
+    vel: F64x4,
+}
+
+impl GradientSum {
+    /// A nodal vector in lanes.
+    #[inline(always)]
+    pub(crate) fn lanes<D: Dim>(v: D::Vec) -> F64x4 {
+        let [x, y, z] = D::vec_to3(v);
+        F64x4::new([x, y, z, 0.0])
+    }
+
+    /// Adds `v ⊗ g` to the gradient and `w v` to the velocity.
+    #[inline(always)]
+    pub(crate) fn add<D: Dim>(&mut self, v: F64x4, g: D::Vec, w: f64) {
+        for j in 0..D::N {
+            self.add_column(j, v, g.get(j));
+        }
+        self.add_velocity(v, w);
+    }
+
+    /// Adds `v k` to column `j` of the gradient.
+    #[inline(always)]
+    pub(crate) fn add_column(&mut self, j: usize, v: F64x4, k: f64) {
+        self.cols[j] = Lanes::madd(v, F64x4::splat(k), self.cols[j]);
+    }
+
+    /// Adds `v w` to the velocity.
+    #[inline(always)]
+    pub(crate) fn add_velocity(&mut self, v: F64x4, w: f64) {
+        self.vel = Lanes::madd(v, F64x4::splat(w), self.vel);
+    }
+
+    /// The velocity gradient and the velocity.
+    #[inline(always)]
+    pub(crate) fn finish<D: Dim>(self) -> (D::Mat, D::Vec) {
+        let vector = |v: F64x4| {
+            let [x, y, z, _] = v.to_array();
+            D::vec_from([x, y, z])
+        };
+        let cols = [vector(self.cols[0]), vector(self.cols[1]), vector(self.cols[2])];
+        (D::mat_from_cols(cols), vector(self.vel))
+    }
 }
 
 /// [`Shape::scatter_with_gradient`] from every node's weight and gradient
