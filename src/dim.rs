@@ -107,10 +107,6 @@ pub trait Dim: Copy + Send + Sync + Debug + Default + 'static {
     fn vec_from(xyz: [f64; 3]) -> Self::Vec;
     /// The vector padded with zeros to three components.
     fn vec_to3(v: Self::Vec) -> [f64; 3];
-    /// `m += a ⊗ b`, i.e. m_ij += a_i b_j.
-    fn add_outer(m: &mut Self::Mat, a: Self::Vec, b: Self::Vec);
-    /// σ·n for the in-plane components of the stress (N/m² · m² = N per unit of n).
-    fn stress_dot(s: &Sym3, n: Self::Vec) -> Self::Vec;
     /// Strain increment sym(L)·dt and spin increment skew(L)·dt embedded in 3D
     /// (plane strain: zero out-of-plane components), with `l(i, j)` = L_ij (1/s) of one
     /// point or four in lanes. Spin is (W_yz, W_zx, W_xy).
@@ -151,15 +147,6 @@ impl Dim for Dim2 {
     #[inline(always)]
     fn vec_to3(v: DVec2) -> [f64; 3] {
         [v.x, v.y, 0.0]
-    }
-    #[inline(always)]
-    fn add_outer(m: &mut DMat2, a: DVec2, b: DVec2) {
-        m.x_axis = a.madd(b.x, m.x_axis);
-        m.y_axis = a.madd(b.y, m.y_axis);
-    }
-    #[inline(always)]
-    fn stress_dot(s: &Sym3, n: DVec2) -> DVec2 {
-        DVec2::new(madd(s.xx, n.x, s.xy * n.y), madd(s.xy, n.x, s.yy * n.y))
     }
     #[inline(always)]
     fn jaumann_rotate<T: Lanes>(s: &Sym<T>, w: [T; 3]) -> Sym<T> {
@@ -212,20 +199,6 @@ impl Dim for Dim3 {
     #[inline(always)]
     fn vec_to3(v: DVec3) -> [f64; 3] {
         v.to_array()
-    }
-    #[inline(always)]
-    fn add_outer(m: &mut DMat3, a: DVec3, b: DVec3) {
-        m.x_axis = a.madd(b.x, m.x_axis);
-        m.y_axis = a.madd(b.y, m.y_axis);
-        m.z_axis = a.madd(b.z, m.z_axis);
-    }
-    #[inline(always)]
-    fn stress_dot(s: &Sym3, n: DVec3) -> DVec3 {
-        DVec3::new(
-            madd(s.xx, n.x, madd(s.xy, n.y, s.zx * n.z)),
-            madd(s.xy, n.x, madd(s.yy, n.y, s.yz * n.z)),
-            madd(s.zx, n.x, madd(s.yz, n.y, s.zz * n.z)),
-        )
     }
     #[inline(always)]
     fn jaumann_rotate<T: Lanes>(s: &Sym<T>, w: [T; 3]) -> Sym<T> {

@@ -1,8 +1,8 @@
 //! Linear hat functions (bilinear/trilinear by tensor product).
 
-use super::{for_each_row, GradientSum, Shape, Stencil1};
+use super::{for_each_row, from_lanes, in_lanes, GradientSum, Shape, Stencil1, StressColumns};
 use crate::lanes::{F64x4, Lanes};
-use crate::dim::{Dim, Vector};
+use crate::dim::Dim;
 use crate::grid::{cell_index, index_to_f64, Axis, Grid};
 use crate::tensor::Sym3;
 
@@ -40,8 +40,8 @@ impl Shape for Linear {
     ) -> (D::Mat, D::Vec) {
         let mut acc = GradientSum::default();
         for_each_row::<D, Self>(grid, x, |sx, first, w, dw_dy, dw_dz| {
-            let v0 = GradientSum::lanes::<D>(v(first));
-            let dv = GradientSum::lanes::<D>(v(first + 1)) - v0;
+            let v0 = in_lanes::<D>(v(first));
+            let dv = in_lanes::<D>(v(first + 1)) - v0;
             let mean = Lanes::madd(dv, F64x4::splat(sx.w[1]), v0);
             acc.add_column(0, dv, sx.dw[1] * w);
             acc.add_column(1, mean, dw_dy);
@@ -67,21 +67,24 @@ impl Shape for Linear {
         neg_vol: f64,
         mut add: impl FnMut(usize, f64, D::Vec, D::Vec),
     ) {
-        // Columns of −Vσ (only the first N entries of each are kept in 2D).
-        let p = |a: f64, b: f64, c: f64| D::vec_from([a * neg_vol, b * neg_vol, c * neg_vol]);
-        let (px, py, pz) = (p(s.xx, s.xy, s.zx), p(s.xy, s.yy, s.yz), p(s.zx, s.yz, s.zz));
+        // Columns of −Vσ and the momentum in lanes (see `in_lanes`; only the first N
+        // entries count in 2D).
+        let p = StressColumns::of(s, neg_vol);
+        let (px, py, pz) = (p.column(0), p.column(1), p.column(2));
+        let q = in_lanes::<D>(q);
+        let k = F64x4::splat;
         for_each_row::<D, Self>(grid, x, |sx, first, w, dw_dy, dw_dz| {
             let f = sx.w[1];
-            let a = px * (sx.dw[1] * w);
+            let a = px * k(sx.dw[1] * w);
             let b = if D::N == 3 {
-                py.madd(dw_dy, pz * dw_dz)
+                Lanes::madd(py, k(dw_dy), pz * k(dw_dz))
             } else {
-                py * dw_dy
+                py * k(dw_dy)
             };
-            let (mr, qr) = (m * w, q * w);
-            let (m1, q1, f1) = (mr * f, qr * f, b.madd(f, a));
-            add(first, mr - m1, qr - q1, b - f1);
-            add(first + 1, m1, q1, f1);
+            let (mr, qr) = (m * w, q * k(w));
+            let (m1, q1, f1) = (mr * f, qr * k(f), Lanes::madd(b, k(f), a));
+            add(first, mr - m1, from_lanes::<D>(qr - q1), from_lanes::<D>(b - f1));
+            add(first + 1, m1, from_lanes::<D>(q1), from_lanes::<D>(f1));
         });
     }
 }

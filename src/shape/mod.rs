@@ -80,7 +80,7 @@ pub fn gather_node_by_node<D: Dim, S: Shape>(
 ) -> (D::Mat, D::Vec) {
     let mut acc = GradientSum::default();
     for_each_node::<D, S>(grid, x, |i, w, grad| {
-        acc.add::<D>(GradientSum::lanes::<D>(v(i)), grad, w);
+        acc.add::<D>(in_lanes::<D>(v(i)), grad, w);
     });
     acc.finish::<D>()
 }
@@ -100,13 +100,24 @@ pub(crate) struct GradientSum {
     vel: F64x4,
 }
 
+/// A vector in the lanes of one register: (x, y, z, 0), z = 0 in 2D.
+///
+/// The transfers keep their per-point vectors so: as glam vectors each takes two registers in
+/// 3D (xy and z), and the compiler ran short of registers and spilled to the stack.
+#[inline(always)]
+pub(crate) fn in_lanes<D: Dim>(v: D::Vec) -> F64x4 {
+    let [x, y, z] = D::vec_to3(v);
+    F64x4::new([x, y, z, 0.0])
+}
+
+/// The vector in the first N lanes of `v` (the inverse of [`in_lanes`]).
+#[inline(always)]
+pub(crate) fn from_lanes<D: Dim>(v: F64x4) -> D::Vec {
+    let [x, y, z, _] = v.to_array();
+    D::vec_from([x, y, z])
+}
+
 impl GradientSum {
-    /// A nodal vector in lanes.
-    #[inline(always)]
-    pub(crate) fn lanes<D: Dim>(v: D::Vec) -> F64x4 {
-        let [x, y, z] = D::vec_to3(v);
-        F64x4::new([x, y, z, 0.0])
-    }
 
     /// Adds `v ⊗ g` to the gradient and `w v` to the velocity.
     #[inline(always)]
@@ -132,12 +143,9 @@ impl GradientSum {
     /// The velocity gradient and the velocity.
     #[inline(always)]
     pub(crate) fn finish<D: Dim>(self) -> (D::Mat, D::Vec) {
-        let vector = |v: F64x4| {
-            let [x, y, z, _] = v.to_array();
-            D::vec_from([x, y, z])
-        };
-        let cols = [vector(self.cols[0]), vector(self.cols[1]), vector(self.cols[2])];
-        (D::mat_from_cols(cols), vector(self.vel))
+        let c = &self.cols;
+        let cols = [from_lanes::<D>(c[0]), from_lanes::<D>(c[1]), from_lanes::<D>(c[2])];
+        (D::mat_from_cols(cols), from_lanes::<D>(self.vel))
     }
 }
 
@@ -153,9 +161,44 @@ pub fn scatter_node_by_node<D: Dim, S: Shape>(
     neg_vol: f64,
     mut add: impl FnMut(usize, f64, D::Vec, D::Vec),
 ) {
+    let (sigma, q, k) = (StressColumns::of(s, 1.0), in_lanes::<D>(q), F64x4::splat);
     for_each_node::<D, S>(grid, x, |i, w, grad| {
-        add(i, w * m, q * w, D::stress_dot(s, grad) * neg_vol)
+        let f = sigma.dot::<D>(grad) * k(neg_vol);
+        add(i, w * m, from_lanes::<D>(q * k(w)), from_lanes::<D>(f));
     });
+}
+
+/// The columns of k σ in lanes (see [`in_lanes`]), for (kσ)·n at each node of a point.
+#[derive(Clone, Copy)]
+pub(crate) struct StressColumns([F64x4; 3]);
+
+impl StressColumns {
+    /// The columns of `k` σ (k = 1 leaves σ's bits; k = −V gives the columns of −Vσ).
+    #[inline(always)]
+    pub(crate) fn of(s: &Sym3, k: f64) -> Self {
+        let col = |a: f64, b: f64, c: f64| F64x4::new([a * k, b * k, c * k, 0.0]);
+        StressColumns([col(s.xx, s.xy, s.zx), col(s.xy, s.yy, s.yz), col(s.zx, s.yz, s.zz)])
+    }
+
+    /// Column `j` (0 = x, 1 = y, 2 = z).
+    #[inline(always)]
+    pub(crate) fn column(&self, j: usize) -> F64x4 {
+        self.0[j]
+    }
+
+    /// (kσ)·n with the in-plane components alone in 2D (Pa · m² = N per unit of n).
+    #[inline(always)]
+    pub(crate) fn dot<D: Dim>(&self, n: D::Vec) -> F64x4 {
+        let [nx, ny, nz] = D::vec_to3(n);
+        let [cx, cy, cz] = self.0;
+        let k = F64x4::splat;
+        let rest = if D::N == 3 {
+            Lanes::madd(cy, k(ny), cz * k(nz))
+        } else {
+            cy * k(ny)
+        };
+        Lanes::madd(cx, k(nx), rest)
+    }
 }
 
 /// Calls `f(node_id, w, ∇w)` for every node in the support of a point at `x`.

@@ -6,7 +6,8 @@ use crate::dim::Dim;
 use crate::error::StepError;
 use crate::parallel::{scatter, Disjoint};
 use crate::schedule::System;
-use crate::shape::{for_each_node, Shape};
+use crate::lanes::F64x4;
+use crate::shape::{for_each_node, from_lanes, Shape, StressColumns};
 use crate::simulation::Context;
 use crate::tensor::StoredSym;
 use std::marker::PhantomData;
@@ -117,9 +118,11 @@ impl<D: Dim, S: Shape> System<D> for P2g<D, S> {
                                 np[k].0 += mv * w;
                             }),
                             (false, Some((s, neg_vol))) => {
-                                let s = s.to_sym3();
+                                let sigma = StressColumns::of(&s.to_sym3(), 1.0);
+                                let neg_vol = F64x4::splat(neg_vol);
                                 for_each_node::<D, S>(grid, x[p].0, |i, _, grad| {
-                                    nf[i - lo].0 += D::stress_dot(&s, grad) * neg_vol;
+                                    let f = sigma.dot::<D>(grad) * neg_vol;
+                                    nf[i - lo].0 += from_lanes::<D>(f);
                                 })
                             }
                             (false, None) => {}
