@@ -1,9 +1,9 @@
 //! Linear hat functions (bilinear/trilinear by tensor product).
 
 use super::{for_each_row, from_lanes, in_lanes, GradientSum, Shape, Stencil1, StressColumns};
-use crate::lanes::{F64x4, Lanes};
 use crate::dim::Dim;
 use crate::grid::{cell_index, index_to_f64, Axis, Grid};
+use crate::lanes::{F64x4, Lanes};
 use crate::tensor::Sym3;
 
 /// Linear hat function: w = 1 − |x − x_i|/h on the two nodes of the cell holding the point.

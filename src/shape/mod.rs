@@ -85,21 +85,6 @@ pub fn gather_node_by_node<D: Dim, S: Shape>(
     acc.finish::<D>()
 }
 
-/// The running sums of a gather: the columns of Σ v_i ⊗ g_i and Σ w_i v_i, each vector in
-/// the lanes of one register (x, y, z, 0; z = 0 in 2D).
-///
-/// As glam vectors the twelve sums of a 3D gather did not all stay in registers: some went
-/// to the stack, and every node's multiply-add waited on a store and a reload (the 3D
-/// kinematics' hottest instruction). Four registers hold them, and each lane rounds as the
-/// scalar [`crate::dim::madd`], so the bits are those of the glam form.
-#[derive(Clone, Copy, Default)]
-pub(crate) struct GradientSum {
-    /// Column j of the velocity gradient (1/s).
-    cols: [F64x4; 3],
-    /// The velocity (m/s).
-    vel: F64x4,
-}
-
 /// A vector in the lanes of one register: (x, y, z, 0), z = 0 in 2D.
 ///
 /// The transfers keep their per-point vectors so: as glam vectors each takes two registers in
@@ -117,8 +102,22 @@ pub(crate) fn from_lanes<D: Dim>(v: F64x4) -> D::Vec {
     D::vec_from([x, y, z])
 }
 
-impl GradientSum {
+/// The running sums of a gather: the columns of Σ v_i ⊗ g_i and Σ w_i v_i, each in lanes
+/// ([`in_lanes`]).
+///
+/// As glam vectors the twelve sums of a 3D gather did not all stay in registers, and every
+/// node's multiply-add waited on a store and a reload (the 3D kinematics' hottest
+/// instruction). Four registers hold them, and each lane rounds as the scalar
+/// [`crate::dim::madd`], so the bits are those of the glam form.
+#[derive(Clone, Copy, Default)]
+pub(crate) struct GradientSum {
+    /// Column j of the velocity gradient (1/s).
+    cols: [F64x4; 3],
+    /// The velocity (m/s).
+    vel: F64x4,
+}
 
+impl GradientSum {
     /// Adds `v ⊗ g` to the gradient and `w v` to the velocity.
     #[inline(always)]
     pub(crate) fn add<D: Dim>(&mut self, v: F64x4, g: D::Vec, w: f64) {
@@ -144,7 +143,11 @@ impl GradientSum {
     #[inline(always)]
     pub(crate) fn finish<D: Dim>(self) -> (D::Mat, D::Vec) {
         let c = &self.cols;
-        let cols = [from_lanes::<D>(c[0]), from_lanes::<D>(c[1]), from_lanes::<D>(c[2])];
+        let cols = [
+            from_lanes::<D>(c[0]),
+            from_lanes::<D>(c[1]),
+            from_lanes::<D>(c[2]),
+        ];
         (D::mat_from_cols(cols), from_lanes::<D>(self.vel))
     }
 }
@@ -177,7 +180,11 @@ impl StressColumns {
     #[inline(always)]
     pub(crate) fn of(s: &Sym3, k: f64) -> Self {
         let col = |a: f64, b: f64, c: f64| F64x4::new([a * k, b * k, c * k, 0.0]);
-        StressColumns([col(s.xx, s.xy, s.zx), col(s.xy, s.yy, s.yz), col(s.zx, s.yz, s.zz)])
+        StressColumns([
+            col(s.xx, s.xy, s.zx),
+            col(s.xy, s.yy, s.yz),
+            col(s.zx, s.yz, s.zz),
+        ])
     }
 
     /// Column `j` (0 = x, 1 = y, 2 = z).
