@@ -482,6 +482,83 @@ pub(crate) mod tests {
         }
     }
 
+    /// `gather_node_by_node` and `scatter_node_by_node` against the same sums written one
+    /// component at a time with `dim::madd`, bit for bit, at `x` for an arbitrary nodal field.
+    fn check_lanes_round_as_scalars<D: Dim, S: Shape>(grid: &Grid<D>, x: D::Vec) {
+        use crate::dim::madd;
+        let field = |i: usize| {
+            let i = i as f64;
+            [(i * 0.37).sin(), (i * 0.11).cos() * 3.0, (i * 0.53).sin() - 0.2]
+        };
+        let v = |i: usize| D::vec_from(field(i));
+        let (n, bits) = (D::N, |a: f64| a.to_bits());
+        let (mut l, mut vel) = ([[0.0; 3]; 3], [0.0; 3]);
+        for_each_node::<D, S>(grid, x, |i, w, grad| {
+            let (vi, g) = (field(i), D::vec_to3(grad));
+            for a in 0..n {
+                for b in 0..n {
+                    l[a][b] = madd(vi[a], g[b], l[a][b]);
+                }
+                vel[a] = madd(vi[a], w, vel[a]);
+            }
+        });
+        let (l_lanes, vel_lanes) = gather_node_by_node::<D, S>(grid, x, v);
+        for a in 0..n {
+            assert_eq!(bits(D::vec_to3(vel_lanes)[a]), bits(vel[a]), "v_{a} at {x:?}");
+            for b in 0..n {
+                let entry = D::mat_entry(&l_lanes, a, b);
+                assert_eq!(bits(entry), bits(l[a][b]), "L_{a}{b} at {x:?}");
+            }
+        }
+        let s = Sym3 {
+            xx: -3.1e5,
+            yy: 1.7e5,
+            zz: -0.4e5,
+            xy: 2.2e5,
+            yz: -0.9e5,
+            zx: 1.3e5,
+        };
+        let sigma = [[s.xx, s.xy, s.zx], [s.xy, s.yy, s.yz], [s.zx, s.yz, s.zz]];
+        let (m, q, neg_vol) = (2.5, [0.7, -1.9, 0.4], -0.125);
+        let mut expect = Vec::new();
+        for_each_node::<D, S>(grid, x, |i, w, grad| {
+            let g = D::vec_to3(grad);
+            let force = |a: usize| {
+                let rest = if n == 3 {
+                    madd(sigma[a][1], g[1], sigma[a][2] * g[2])
+                } else {
+                    sigma[a][1] * g[1]
+                };
+                madd(sigma[a][0], g[0], rest) * neg_vol
+            };
+            expect.push((i, w * m, q.map(|qa| qa * w), [force(0), force(1), force(2)]));
+        });
+        let mut k = 0;
+        scatter_node_by_node::<D, S>(grid, x, m, D::vec_from(q), &s, neg_vol, |i, dm, dp, df| {
+            let (node, mass, momentum, force) = expect[k];
+            assert_eq!((i, bits(dm)), (node, bits(mass)), "node {k} at {x:?}");
+            for a in 0..n {
+                assert_eq!(bits(D::vec_to3(dp)[a]), bits(momentum[a]), "q_{a} at {x:?}");
+                assert_eq!(bits(D::vec_to3(df)[a]), bits(force[a]), "f_{a} at {x:?}");
+            }
+            k += 1;
+        });
+        assert_eq!(k, expect.len());
+    }
+
+    #[test]
+    fn node_by_node_transfers_in_lanes_give_the_bits_of_scalar_multiply_adds() {
+        // The lanes (`GradientSum`, `StressColumns`) exist for speed alone: each lane must
+        // round exactly as the one-component formula, on faces and inside, for both shapes.
+        let (g3, g2, points) = row_form_cases();
+        for (x3, x2) in points {
+            check_lanes_round_as_scalars::<Dim3, Linear>(&g3, x3);
+            check_lanes_round_as_scalars::<Dim3, QuadraticBSpline>(&g3, x3);
+            check_lanes_round_as_scalars::<Dim2, Linear>(&g2, x2);
+            check_lanes_round_as_scalars::<Dim2, QuadraticBSpline>(&g2, x2);
+        }
+    }
+
     #[test]
     fn shape_weights_are_never_negative() {
         let axis = Axis::new(5, 1.0);
