@@ -1,7 +1,10 @@
 //! Quadratic B-splines with a boundary modification.
 
-use super::{Shape, Stencil1};
-use crate::grid::{cell_index, index_to_f64, Axis};
+use super::{for_each_row, from_lanes, in_lanes, GradientSum, Shape, Stencil1, StressColumns};
+use crate::dim::Dim;
+use crate::grid::{cell_index, index_to_f64, Axis, Grid};
+use crate::lanes::{F64x4, Lanes};
+use crate::tensor::Sym3;
 
 /// Quadratic B-spline centred on each node (support 3h, C¹ continuous).
 ///
@@ -58,6 +61,74 @@ impl Shape for QuadraticBSpline {
                 dw: [g0, g1, g2],
             }
         }
+    }
+
+    /// Row by row along x: with v̄ = Σ_i w_i v_i and v' = Σ_i w_i' v_i over a row's three
+    /// nodes, the row adds v' w_r to the x column of L, v̄ ∂w_r/∂y and v̄ ∂w_r/∂z to the
+    /// others and v̄ w_r to the velocity. Node by node, each node formed its own gradient
+    /// and outer product; this is a third of the multiply-adds in 3D (slope_3d's kinematics
+    /// 1.93 → 1.27 ms a step on 2 threads), equal to them up to round-off.
+    #[inline(always)]
+    fn gather_with_gradient<D: Dim>(
+        grid: &Grid<D>,
+        x: D::Vec,
+        v: impl Fn(usize) -> D::Vec,
+    ) -> (D::Mat, D::Vec) {
+        let mut acc = GradientSum::default();
+        let k = F64x4::splat;
+        for_each_row::<D, Self>(grid, x, |sx, first, w, dw_dy, dw_dz| {
+            let (v0, v1, v2) = (
+                in_lanes::<D>(v(first)),
+                in_lanes::<D>(v(first + 1)),
+                in_lanes::<D>(v(first + 2)),
+            );
+            let mean = Lanes::madd(v2, k(sx.w[2]), Lanes::madd(v1, k(sx.w[1]), v0 * k(sx.w[0])));
+            let slope = Lanes::madd(v2, k(sx.dw[2]), Lanes::madd(v1, k(sx.dw[1]), v0 * k(sx.dw[0])));
+            acc.add_column(0, slope, w);
+            acc.add_column(1, mean, dw_dy);
+            if D::N == 3 {
+                acc.add_column(2, mean, dw_dz);
+            }
+            acc.add_velocity(mean, w);
+        });
+        acc.finish::<D>()
+    }
+
+    /// Row by row along x, as the gather: with P = −Vσ, node i of a row gets w_i (w_r m),
+    /// w_i (w_r q) and w_i' a + w_i b, where a = P_x w_r and b = P_y ∂w_r/∂y + P_z ∂w_r/∂z:
+    /// no node forms its own gradient or σ·∇w (slope_3d's p2g 2.70 → 1.99 ms a step).
+    #[inline(always)]
+    fn scatter_with_gradient<D: Dim>(
+        grid: &Grid<D>,
+        x: D::Vec,
+        m: f64,
+        q: D::Vec,
+        s: &Sym3,
+        neg_vol: f64,
+        mut add: impl FnMut(usize, f64, D::Vec, D::Vec),
+    ) {
+        let p = StressColumns::of(s, neg_vol);
+        let (px, py, pz) = (p.column(0), p.column(1), p.column(2));
+        let q = in_lanes::<D>(q);
+        let k = F64x4::splat;
+        for_each_row::<D, Self>(grid, x, |sx, first, w, dw_dy, dw_dz| {
+            let a = px * k(w);
+            let b = if D::N == 3 {
+                Lanes::madd(py, k(dw_dy), pz * k(dw_dz))
+            } else {
+                py * k(dw_dy)
+            };
+            let (mr, qr) = (m * w, q * k(w));
+            for i in 0..3 {
+                let f = Lanes::madd(b, k(sx.w[i]), a * k(sx.dw[i]));
+                add(
+                    first + i,
+                    mr * sx.w[i],
+                    from_lanes::<D>(qr * k(sx.w[i])),
+                    from_lanes::<D>(f),
+                );
+            }
+        });
     }
 }
 

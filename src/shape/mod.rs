@@ -355,15 +355,15 @@ pub(crate) mod tests {
         }
     }
 
-    /// The row-wise gather of [`Linear`] against the node-by-node sums at `x` for an
-    /// arbitrary nodal field; `entries` lists a velocity gradient's entries.
-    fn check_linear_gather<D: Dim>(grid: &Grid<D>, x: D::Vec, entries: impl Fn(D::Mat) -> Vec<f64>) {
+    /// A shape's row-wise gather against the node-by-node sums at `x` for an arbitrary nodal
+    /// field; `entries` lists a velocity gradient's entries.
+    fn check_row_gather<D: Dim, S: Shape>(grid: &Grid<D>, x: D::Vec, entries: impl Fn(D::Mat) -> Vec<f64>) {
         let v = |i: usize| {
             let i = i as f64;
             D::vec_from([(i * 0.37).sin(), (i * 0.11).cos(), (i * 0.53).sin() - 0.2])
         };
-        let (l, vel) = Linear::gather_with_gradient(grid, x, v);
-        let (l_ref, vel_ref) = gather_node_by_node::<D, Linear>(grid, x, v);
+        let (l, vel) = S::gather_with_gradient(grid, x, v);
+        let (l_ref, vel_ref) = gather_node_by_node::<D, S>(grid, x, v);
         for (a, b) in entries(l).iter().zip(entries(l_ref)) {
             assert!((a - b).abs() < 1e-12, "{x:?}");
         }
@@ -373,8 +373,8 @@ pub(crate) mod tests {
         }
     }
 
-    /// The grids and points on which Linear's row-wise forms are checked against the
-    /// node-by-node sums: a 3D and a 2D grid, points on their faces and inside.
+    /// The grids and points on which the row-wise forms are checked against the node-by-node
+    /// sums: a 3D and a 2D grid, points on their faces, in the boundary cells and inside.
     fn row_form_cases() -> (Grid<Dim3>, Grid<Dim2>, Vec<(DVec3, DVec2)>) {
         let g3 = Grid::<Dim3>::new(DVec3::new(0.0, -1.0, 3.0), 0.25, [4, 5, 3]);
         let g2 = Grid::<Dim2>::new(DVec2::new(-1.0, 2.0), 0.5, [6, 4, 0]);
@@ -390,29 +390,36 @@ pub(crate) mod tests {
         (g3, g2, points)
     }
 
-    #[test]
-    fn linear_shape_gathers_row_by_row_what_the_node_by_node_sums_give() {
-        // The row-wise form must agree with every node's outer product to round-off, in 2D
-        // and 3D, on faces and inside.
+    fn check_row_gathers<S: Shape>() {
         let (g3, g2, points) = row_form_cases();
         for (x3, x2) in points {
-            check_linear_gather(&g3, x3, |m: glam::DMat3| m.to_cols_array().to_vec());
-            check_linear_gather(&g2, x2, |m: glam::DMat2| m.to_cols_array().to_vec());
+            check_row_gather::<_, S>(&g3, x3, |m: glam::DMat3| m.to_cols_array().to_vec());
+            check_row_gather::<_, S>(&g2, x2, |m: glam::DMat2| m.to_cols_array().to_vec());
         }
-        // An affine field v = A x + c is reproduced exactly: L = A and v_p = A x_p + c.
+        // An affine field v = A x + c is reproduced exactly: L = A and v_p = A x_p + c, in
+        // the boundary cells too.
         let a = glam::DMat3::from_cols_array(&[0.3, -1.2, 0.5, 2.0, 0.1, -0.7, -0.4, 0.9, 1.5]);
         let c = DVec3::new(0.2, -0.1, 0.05);
         let affine = |i: usize| a * g3.node_position(g3.node_ijk(i)) + c;
-        let x = DVec3::new(0.61, 0.13, 3.37);
-        let (l, vel) = Linear::gather_with_gradient(&g3, x, affine);
-        assert!((l - a).to_cols_array().iter().all(|d| d.abs() < 1e-12));
-        assert!((vel - (a * x + c)).abs().max_element() < 1e-12);
+        for x in [DVec3::new(0.61, 0.13, 3.37), DVec3::new(0.02, -0.97, 3.74)] {
+            let (l, vel) = S::gather_with_gradient(&g3, x, affine);
+            assert!((l - a).to_cols_array().iter().all(|d| d.abs() < 1e-12), "{x:?}");
+            assert!((vel - (a * x + c)).abs().max_element() < 1e-12, "{x:?}");
+        }
     }
 
-    /// The row-wise scatter of [`Linear`] against the node-by-node products at `x`, and
+    #[test]
+    fn shapes_gather_row_by_row_what_the_node_by_node_sums_give() {
+        // The row-wise forms must agree with every node's outer product to round-off, in 2D
+        // and 3D, on faces and inside.
+        check_row_gathers::<Linear>();
+        check_row_gathers::<QuadraticBSpline>();
+    }
+
+    /// A shape's row-wise scatter against the node-by-node products at `x`, and
     /// the sums any scatter must give: Σ w_i m = m, Σ w_i q = q, Σ f_i = 0 (the gradients
     /// sum to zero) and Σ f_i ⊗ x_i = −Vσ (from Σ ∇w_i ⊗ x_i = I).
-    fn check_linear_scatter<D: Dim>(grid: &Grid<D>, x: D::Vec) {
+    fn check_row_scatter<D: Dim, S: Shape>(grid: &Grid<D>, x: D::Vec) {
         let s = Sym3 {
             xx: -3.1e5,
             yy: 1.7e5,
@@ -432,12 +439,12 @@ pub(crate) mod tests {
             }
         };
         let mut rows = vec![(0.0, [0.0; 3], [0.0; 3]); grid.node_count()];
-        Linear::scatter_with_gradient(grid, x, m, q, &s, neg_vol, |i, dm, dp, df| {
+        S::scatter_with_gradient(grid, x, m, q, &s, neg_vol, |i, dm, dp, df| {
             add(&mut rows, i, dm, dp, df)
         });
         let mut nodes = rows.clone();
         nodes.fill((0.0, [0.0; 3], [0.0; 3]));
-        scatter_node_by_node::<D, Linear>(grid, x, m, q, &s, neg_vol, |i, dm, dp, df| {
+        scatter_node_by_node::<D, S>(grid, x, m, q, &s, neg_vol, |i, dm, dp, df| {
             add(&mut nodes, i, dm, dp, df)
         });
         let force_scale = 3.1e5 * neg_vol.abs() / grid.cell_size;
@@ -474,11 +481,13 @@ pub(crate) mod tests {
     }
 
     #[test]
-    fn linear_shape_scatters_row_by_row_what_the_node_by_node_products_give() {
+    fn shapes_scatter_row_by_row_what_the_node_by_node_products_give() {
         let (g3, g2, points) = row_form_cases();
         for (x3, x2) in points {
-            check_linear_scatter(&g3, x3);
-            check_linear_scatter(&g2, x2);
+            check_row_scatter::<_, Linear>(&g3, x3);
+            check_row_scatter::<_, Linear>(&g2, x2);
+            check_row_scatter::<_, QuadraticBSpline>(&g3, x3);
+            check_row_scatter::<_, QuadraticBSpline>(&g2, x2);
         }
     }
 
