@@ -30,6 +30,8 @@ pub mod simulation;
 pub mod state;
 pub mod systems;
 pub mod tensor;
+#[cfg(test)]
+mod testing;
 
 pub use dim::{Dim, Dim2, Dim3};
 pub use error::{SceneError, StepError};

@@ -178,10 +178,9 @@ mod tests {
                 }
             }
         }
-        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut seed = 7;
         for _ in 0..1_000_000 {
-            state = state.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
-            check((state >> 11) as f64 / (1u64 << 53) as f64 * 180.0);
+            check(90.0 * (1.0 + crate::testing::uniform(&mut seed)));
         }
     }
 
