@@ -362,11 +362,35 @@ pub fn cell_index(xi: f64, axis: &Axis) -> usize {
     // bound and one truncation: clamped in floating point first, the unchecked conversion
     // needs none of the saturating cast's fix-ups. The result is the one truncating then
     // clamping gives for every `xi`, infinities and NaN (cell 0) included.
-    let c = if xi > 0.0 { xi } else { 0.0 };
-    let c = if c < axis.last_cell { c } else { axis.last_cell };
+    let c = clamped_coordinate(xi, axis);
     // SAFETY: `c` lies in 0 ..= cells − 1 (a NaN fails `xi > 0` and becomes 0), so it is
     // finite and fits an i64.
     unsafe { c.to_int_unchecked::<i64>() as usize }
+}
+
+/// The cell index of `xi` as a float: `index_to_f64(cell_index(xi, axis))`, bit for bit.
+///
+/// Where the build has SSE4.1 it is one rounding instruction on the clamped coordinate
+/// (non-negative, so floor is truncation) instead of a conversion to an integer and back: a
+/// point's weights wait on it in every transfer, and the integer index then only picks nodes.
+#[inline(always)]
+pub fn cell_floor(xi: f64, axis: &Axis) -> f64 {
+    if cfg!(target_feature = "sse4.1") {
+        clamped_coordinate(xi, axis).floor()
+    } else {
+        index_to_f64(cell_index(xi, axis))
+    }
+}
+
+/// `xi` clamped into [0, cells − 1] (NaN to 0), the coordinate whose truncation is the cell.
+#[inline(always)]
+fn clamped_coordinate(xi: f64, axis: &Axis) -> f64 {
+    let c = if xi > 0.0 { xi } else { 0.0 };
+    if c < axis.last_cell {
+        c
+    } else {
+        axis.last_cell
+    }
 }
 
 #[cfg(test)]
@@ -376,7 +400,7 @@ mod tests {
     use glam::{DVec2, DVec3};
 
     #[test]
-    fn cell_index_truncates_then_clamps_into_the_grid_for_any_coordinate() {
+    fn cell_index_truncates_then_clamps_into_the_grid_for_any_coordinate_as_does_cell_floor() {
         // The plain definition: truncate toward zero (saturating), then clamp.
         let reference = |xi: f64, cells: usize| (xi as i64).max(0).min(cells as i64 - 1) as usize;
         let mut coordinates = vec![f64::NAN, f64::INFINITY, f64::NEG_INFINITY, -0.0, 1e300, -1e300];
@@ -385,11 +409,14 @@ mod tests {
             let c = cells as f64;
             coordinates.extend([c, c - 1e-12, c + 1e-12, f64::EPSILON, -f64::EPSILON]);
             for &xi in &coordinates {
+                let axis = Axis::new(cells, 1.0);
                 assert_eq!(
-                    cell_index(xi, &Axis::new(cells, 1.0)),
+                    cell_index(xi, &axis),
                     reference(xi, cells),
                     "xi = {xi}, {cells} cells"
                 );
+                let as_float = index_to_f64(reference(xi, cells));
+                assert_eq!(cell_floor(xi, &axis).to_bits(), as_float.to_bits(), "xi = {xi}");
             }
         }
     }

@@ -2,7 +2,7 @@
 
 use super::{for_each_row, from_lanes, in_lanes, GradientSum, Shape, Stencil1, StressColumns};
 use crate::dim::Dim;
-use crate::grid::{cell_index, index_to_f64, Axis, Grid};
+use crate::grid::{cell_floor, cell_index, Axis, Grid};
 use crate::lanes::{F64x4, Lanes};
 use crate::tensor::Sym3;
 
@@ -19,7 +19,7 @@ impl Shape for Linear {
         // A point on the upper face belongs to the last cell, so it never reaches a node
         // beyond the grid.
         let base = cell_index(xi, axis);
-        let f = xi - index_to_f64(base);
+        let f = xi - cell_floor(xi, axis);
         Stencil1 {
             base,
             w: [1.0 - f, f, 0.0],
