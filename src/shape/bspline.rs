@@ -82,12 +82,7 @@ impl Shape for QuadraticBSpline {
             );
             let mean = Lanes::madd(v2, k(sx.w[2]), Lanes::madd(v1, k(sx.w[1]), v0 * k(sx.w[0])));
             let slope = Lanes::madd(v2, k(sx.dw[2]), Lanes::madd(v1, k(sx.dw[1]), v0 * k(sx.dw[0])));
-            acc.add_column(0, slope, w);
-            acc.add_column(1, mean, dw_dy);
-            if D::N == 3 {
-                acc.add_column(2, mean, dw_dz);
-            }
-            acc.add_velocity(mean, w);
+            acc.add_row::<D>((slope, w), mean, (w, dw_dy, dw_dz));
         });
         acc.finish::<D>()
     }
@@ -106,16 +101,9 @@ impl Shape for QuadraticBSpline {
         mut add: impl FnMut(usize, f64, D::Vec, D::Vec),
     ) {
         let p = StressColumns::of(s, neg_vol);
-        let (px, py, pz) = (p.column(0), p.column(1), p.column(2));
-        let q = in_lanes::<D>(q);
-        let k = F64x4::splat;
+        let (px, q, k) = (p.column(0), in_lanes::<D>(q), F64x4::splat);
         for_each_row::<D, Self>(grid, x, |sx, first, w, dw_dy, dw_dz| {
-            let a = px * k(w);
-            let b = if D::N == 3 {
-                Lanes::madd(py, k(dw_dy), pz * k(dw_dz))
-            } else {
-                py * k(dw_dy)
-            };
+            let (a, b) = (px * k(w), p.dot_yz::<D>(dw_dy, dw_dz));
             let (mr, qr) = (m * w, q * k(w));
             for i in 0..3 {
                 let f = Lanes::madd(b, k(sx.w[i]), a * k(sx.dw[i]));

@@ -43,12 +43,7 @@ impl Shape for Linear {
             let v0 = in_lanes::<D>(v(first));
             let dv = in_lanes::<D>(v(first + 1)) - v0;
             let mean = Lanes::madd(dv, F64x4::splat(sx.w[1]), v0);
-            acc.add_column(0, dv, sx.dw[1] * w);
-            acc.add_column(1, mean, dw_dy);
-            if D::N == 3 {
-                acc.add_column(2, mean, dw_dz);
-            }
-            acc.add_velocity(mean, w);
+            acc.add_row::<D>((dv, sx.dw[1] * w), mean, (w, dw_dy, dw_dz));
         });
         acc.finish::<D>()
     }
@@ -70,17 +65,10 @@ impl Shape for Linear {
         // Columns of −Vσ and the momentum in lanes (see `in_lanes`; only the first N
         // entries count in 2D).
         let p = StressColumns::of(s, neg_vol);
-        let (px, py, pz) = (p.column(0), p.column(1), p.column(2));
-        let q = in_lanes::<D>(q);
-        let k = F64x4::splat;
+        let (px, q, k) = (p.column(0), in_lanes::<D>(q), F64x4::splat);
         for_each_row::<D, Self>(grid, x, |sx, first, w, dw_dy, dw_dz| {
             let f = sx.w[1];
-            let a = px * k(sx.dw[1] * w);
-            let b = if D::N == 3 {
-                Lanes::madd(py, k(dw_dy), pz * k(dw_dz))
-            } else {
-                py * k(dw_dy)
-            };
+            let (a, b) = (px * k(sx.dw[1] * w), p.dot_yz::<D>(dw_dy, dw_dz));
             let (mr, qr) = (m * w, q * k(w));
             let (m1, q1, f1) = (mr * f, qr * k(f), Lanes::madd(b, k(f), a));
             add(first, mr - m1, from_lanes::<D>(qr - q1), from_lanes::<D>(b - f1));

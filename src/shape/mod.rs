@@ -127,15 +127,33 @@ impl GradientSum {
         self.add_velocity(v, w);
     }
 
+    /// Adds one x-row of nodes ([`for_each_row`]): `x_part · x_factor` to the x column,
+    /// where the row's x-slopes live, and the row's weighted velocity `mean` times ∂w_r/∂y,
+    /// ∂w_r/∂z and w_r to the other columns and to the velocity.
+    #[inline(always)]
+    pub(crate) fn add_row<D: Dim>(
+        &mut self,
+        (x_part, x_factor): (F64x4, f64),
+        mean: F64x4,
+        (w, dw_dy, dw_dz): (f64, f64, f64),
+    ) {
+        self.add_column(0, x_part, x_factor);
+        self.add_column(1, mean, dw_dy);
+        if D::N == 3 {
+            self.add_column(2, mean, dw_dz);
+        }
+        self.add_velocity(mean, w);
+    }
+
     /// Adds `v k` to column `j` of the gradient.
     #[inline(always)]
-    pub(crate) fn add_column(&mut self, j: usize, v: F64x4, k: f64) {
+    fn add_column(&mut self, j: usize, v: F64x4, k: f64) {
         self.cols[j] = Lanes::madd(v, F64x4::splat(k), self.cols[j]);
     }
 
     /// Adds `v w` to the velocity.
     #[inline(always)]
-    pub(crate) fn add_velocity(&mut self, v: F64x4, w: f64) {
+    fn add_velocity(&mut self, v: F64x4, w: f64) {
         self.vel = Lanes::madd(v, F64x4::splat(w), self.vel);
     }
 
@@ -197,14 +215,20 @@ impl StressColumns {
     #[inline(always)]
     pub(crate) fn dot<D: Dim>(&self, n: D::Vec) -> F64x4 {
         let [nx, ny, nz] = D::vec_to3(n);
-        let [cx, cy, cz] = self.0;
+        Lanes::madd(self.0[0], F64x4::splat(nx), self.dot_yz::<D>(ny, nz))
+    }
+
+    /// The y and z terms of [`StressColumns::dot`]: (kσ)_y n_y + (kσ)_z n_z (n_z unused in
+    /// 2D). The row forms apply them once a row, with n_y, n_z the row's ∂w_r/∂y, ∂w_r/∂z.
+    #[inline(always)]
+    pub(crate) fn dot_yz<D: Dim>(&self, ny: f64, nz: f64) -> F64x4 {
+        let [_, cy, cz] = self.0;
         let k = F64x4::splat;
-        let rest = if D::N == 3 {
+        if D::N == 3 {
             Lanes::madd(cy, k(ny), cz * k(nz))
         } else {
             cy * k(ny)
-        };
-        Lanes::madd(cx, k(nx), rest)
+        }
     }
 }
 
@@ -355,13 +379,30 @@ pub(crate) mod tests {
         }
     }
 
+    /// An arbitrary nodal field: node id → three components, none of them affine in the id.
+    fn nodal_field(i: usize) -> [f64; 3] {
+        let i = i as f64;
+        [(i * 0.37).sin(), (i * 0.11).cos(), (i * 0.53).sin() - 0.2]
+    }
+
+    /// A point's share to scatter: mass (kg), momentum (kg·m/s), a stress with every
+    /// component set (Pa) and −V (m³).
+    fn sample_load() -> (f64, [f64; 3], Sym3, f64) {
+        let s = Sym3 {
+            xx: -3.1e5,
+            yy: 1.7e5,
+            zz: -0.4e5,
+            xy: 2.2e5,
+            yz: -0.9e5,
+            zx: 1.3e5,
+        };
+        (2.5, [0.7, -1.9, 0.4], s, -0.125)
+    }
+
     /// A shape's row-wise gather against the node-by-node sums at `x` for an arbitrary nodal
     /// field; `entries` lists a velocity gradient's entries.
     fn check_row_gather<D: Dim, S: Shape>(grid: &Grid<D>, x: D::Vec, entries: impl Fn(D::Mat) -> Vec<f64>) {
-        let v = |i: usize| {
-            let i = i as f64;
-            D::vec_from([(i * 0.37).sin(), (i * 0.11).cos(), (i * 0.53).sin() - 0.2])
-        };
+        let v = |i: usize| D::vec_from(nodal_field(i));
         let (l, vel) = S::gather_with_gradient(grid, x, v);
         let (l_ref, vel_ref) = gather_node_by_node::<D, S>(grid, x, v);
         for (a, b) in entries(l).iter().zip(entries(l_ref)) {
@@ -420,15 +461,8 @@ pub(crate) mod tests {
     /// the sums any scatter must give: Σ w_i m = m, Σ w_i q = q, Σ f_i = 0 (the gradients
     /// sum to zero) and Σ f_i ⊗ x_i = −Vσ (from Σ ∇w_i ⊗ x_i = I).
     fn check_row_scatter<D: Dim, S: Shape>(grid: &Grid<D>, x: D::Vec) {
-        let s = Sym3 {
-            xx: -3.1e5,
-            yy: 1.7e5,
-            zz: -0.4e5,
-            xy: 2.2e5,
-            yz: -0.9e5,
-            zx: 1.3e5,
-        };
-        let (m, q, neg_vol) = (2.5, D::vec_from([0.7, -1.9, 0.4]), -0.125);
+        let (m, q, s, neg_vol) = sample_load();
+        let q = D::vec_from(q);
         type Share = (f64, [f64; 3], [f64; 3]);
         let add = |into: &mut [Share], i: usize, dm: f64, dp: D::Vec, df: D::Vec| {
             let (dp, df) = (D::vec_to3(dp), D::vec_to3(df));
@@ -495,15 +529,11 @@ pub(crate) mod tests {
     /// component at a time with `dim::madd`, bit for bit, at `x` for an arbitrary nodal field.
     fn check_lanes_round_as_scalars<D: Dim, S: Shape>(grid: &Grid<D>, x: D::Vec) {
         use crate::dim::madd;
-        let field = |i: usize| {
-            let i = i as f64;
-            [(i * 0.37).sin(), (i * 0.11).cos() * 3.0, (i * 0.53).sin() - 0.2]
-        };
-        let v = |i: usize| D::vec_from(field(i));
+        let v = |i: usize| D::vec_from(nodal_field(i));
         let (n, bits) = (D::N, |a: f64| a.to_bits());
         let (mut l, mut vel) = ([[0.0; 3]; 3], [0.0; 3]);
         for_each_node::<D, S>(grid, x, |i, w, grad| {
-            let (vi, g) = (field(i), D::vec_to3(grad));
+            let (vi, g) = (nodal_field(i), D::vec_to3(grad));
             for a in 0..n {
                 for b in 0..n {
                     l[a][b] = madd(vi[a], g[b], l[a][b]);
@@ -519,16 +549,8 @@ pub(crate) mod tests {
                 assert_eq!(bits(entry), bits(l[a][b]), "L_{a}{b} at {x:?}");
             }
         }
-        let s = Sym3 {
-            xx: -3.1e5,
-            yy: 1.7e5,
-            zz: -0.4e5,
-            xy: 2.2e5,
-            yz: -0.9e5,
-            zx: 1.3e5,
-        };
+        let (m, q, s, neg_vol) = sample_load();
         let sigma = [[s.xx, s.xy, s.zx], [s.xy, s.yy, s.yz], [s.zx, s.yz, s.zz]];
-        let (m, q, neg_vol) = (2.5, [0.7, -1.9, 0.4], -0.125);
         let mut expect = Vec::new();
         for_each_node::<D, S>(grid, x, |i, w, grad| {
             let g = D::vec_to3(grad);
