@@ -29,7 +29,7 @@ pub enum SceneError {
         message: String,
     },
     /// A value breaks a rule (non-physical, inconsistent, unknown reference, ...).
-    #[error("{path}:{line}:{column}: field `{field}`: {rule}")]
+    #[error("{path}:{line}:{column}: field `{field}`{note}: {rule}")]
     Invalid {
         /// The scene file.
         path: PathBuf,
@@ -39,6 +39,8 @@ pub enum SceneError {
         column: usize,
         /// Dotted path of the field, e.g. `materials.soil.youngs_modulus`.
         field: String,
+        /// " (set by --set `path=value`)" when an override wrote the value, else empty.
+        note: String,
         /// The rule it breaks and the value found.
         rule: String,
     },

@@ -135,6 +135,12 @@ fn check(path: &Path, overrides: &[String]) -> ExitCode {
                 d.time_step,
                 d.time_step / d.critical_time_step
             );
+            println!(
+                "  memory (bound)        {:.1} MB ({} points, {} nodes at most)",
+                d.estimate.bytes as f64 / 1e6,
+                d.estimate.points,
+                d.estimate.nodes
+            );
             println!("  systems               {}", d.systems.join(" → "));
             if !d.unused_materials.is_empty() {
                 println!(

@@ -21,6 +21,7 @@ const SCENE: &str = r#"Scene(
     grid: (origin: [0.0, 0.0, 0.0], cell_size: 1.0, cells: [40, 40, 40]),
     materials: { "soil": LinearElastic(density: 2000.0, youngs_modulus: 2e7, poisson_ratio: 0.3) },
     bodies: [(material: "soil", region: Box(min: [0.0, 0.0, 0.0], max: [8.0, 8.0, 8.0]), points_per_cell: [4, 4, 4])],
+    gravity: (acceleration: [0.0, 0.0, -9.81]),
     solver: (time_step: Courant(0.3), max_steps: 1),
 )"#;
 

@@ -15,7 +15,7 @@ const GOOD: &str = r#"Scene(
         (material: "rod", region: Box(min: [0.0, 0.0], max: [10.0, 1.0]), points_per_cell: [2, 2]),
     ],
     boundaries: [(face: XMin, condition: Fixed)],
-    traced: [(name: "A", position: [4.75, 0.5])],
+    traced: [(name: "A", position: [4.75, 0.5])], point_loads: [(name: "P", position: [9.75, 0.5], force: [0.01, 0.0])],
     solver: (time_step: Fixed(0.01), tolerance: 0.01, max_steps: 10),
 )
 "#;

@@ -35,6 +35,7 @@ const SCENE: &str = r#"Scene(
         (material: "clay", region: Box(min: [3.0, 0.0, 3.0], max: [5.0, 5.0, 6.0]), points_per_cell: [1, 1, 1]),
     ],
     boundaries: [(face: ZMin, condition: Fixed)],
+    gravity: (acceleration: [0.0, 0.0, -9.81]),
     solver: (damping: Kinetic, scheme: Musl, time_step: Courant(0.3), max_steps: 1, sort_every: 1),
 )"#;
 

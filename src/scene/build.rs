@@ -63,8 +63,8 @@ fn in_polygon(vertices: &[Vec<f64>], x: f64, y: f64) -> bool {
     inside
 }
 
-/// Bounding box and membership test of a region.
-fn region_bounds(region: &Region, n: usize) -> ([f64; 3], [f64; 3]) {
+/// Bounding box of a region (m, x y z; z is 0..0 in 2D).
+pub(super) fn region_bounds(region: &Region, n: usize) -> ([f64; 3], [f64; 3]) {
     match region {
         Region::Box { min, max } => (pad3(min), pad3(max)),
         Region::Polygon { vertices, z } => {
@@ -158,6 +158,7 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         critical_time_step: dt_crit,
         time_step: dt,
         unused_materials,
+        estimate,
     } = checked;
     let s: &Scene = &loaded.scene;
     let n = D::N;
@@ -215,7 +216,23 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
             ));
         }
         let points = fill_points(&grid, &body.region, &body.points_per_cell);
-        let count = points.clone().count();
+        // Bodies may not overlap: a point inside two bodies would be two points, its mass
+        // counted twice. Split the region or change one body's material instead.
+        let earlier = &s.bodies[..b];
+        let mut count = 0usize;
+        for x in points.clone() {
+            if let Some(o) = earlier.iter().position(|e| region_contains(&e.region, x, n)) {
+                return Err(loaded.invalid(
+                    &format!("bodies[{b}].region"),
+                    format!(
+                        "overlaps bodies[{o}] (at {:?}): bodies must not overlap, as a point in two \
+                         bodies would count its mass twice",
+                        &x[..n]
+                    ),
+                ));
+            }
+            count += 1;
+        }
         let xs = Counted {
             left: count,
             inner: points.zip(next_id..),
@@ -407,6 +424,7 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         grid_nodes: grid.node_count(),
         systems: schedule.names(),
         unused_materials,
+        estimate,
     };
     let state = SolverState {
         dt,

@@ -32,7 +32,7 @@ pub fn enclosing_field(text: &str, line: usize, column: usize) -> Option<String>
 }
 
 /// Byte offset of 1-based (line, column), columns counted in characters.
-fn offset(text: &str, line: usize, column: usize) -> usize {
+pub fn offset(text: &str, line: usize, column: usize) -> usize {
     let start_of_line: usize = text
         .split_inclusive('\n')
         .take(line.saturating_sub(1))
@@ -113,7 +113,7 @@ fn field_of_value(text: &str, open: usize) -> Option<String> {
 pub fn field_position(text: &str, path: &str) -> Option<(usize, usize)> {
     let mut found = None;
     let mut open = top_open(text)?;
-    for seg in segments(path) {
+    for seg in segments(path).ok()? {
         match seg {
             Seg::Field(name) => match find_field(text, open, name) {
                 Some((key, value)) => {
@@ -143,6 +143,43 @@ pub fn field_position(text: &str, path: &str) -> Option<(usize, usize)> {
 /// Applies one override `path=value`, replacing the value in the text (or inserting the
 /// field into its parent when the scene relies on the default).
 pub fn apply_override(text: &str, assignment: &str) -> Result<String, SceneError> {
+    Ok(override_edit(text, assignment)?.0)
+}
+
+/// One `--set` applied to a scene's text: the bytes `at..at + new_len` of the new text
+/// replaced `old_len` bytes of the text before it.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Edit {
+    /// Byte offset of the replacement in both texts.
+    pub at: usize,
+    /// Length of what was replaced (bytes).
+    pub old_len: usize,
+    /// Length of the replacement (bytes).
+    pub new_len: usize,
+    /// The `path=value` that made it.
+    pub assignment: String,
+}
+
+/// Where byte offset `at` of a text edited by `edits` (in the order applied) stood in the
+/// text before them, and the edit whose replacement holds it, if one does: messages point
+/// into the file the user wrote, not into the text the overrides made.
+pub fn original_offset(edits: &[Edit], mut at: usize) -> (usize, Option<&Edit>) {
+    let mut inside = None;
+    for e in edits.iter().rev() {
+        if at > e.at + e.new_len {
+            at = at - e.new_len + e.old_len;
+        } else if at >= e.at {
+            // Inside a replacement or right after it (where a parser notices that the
+            // value ended wrongly): the place of the value it replaced.
+            at = e.at;
+            inside = inside.or(Some(e));
+        }
+    }
+    (at, inside)
+}
+
+/// Applies `path=value` to `text`; returns the new text and the edit made.
+pub fn override_edit(text: &str, assignment: &str) -> Result<(String, Edit), SceneError> {
     let err = |m: &str| SceneError::Override(assignment.to_string(), m.to_string());
     let (path, value) = assignment
         .split_once('=')
@@ -151,7 +188,16 @@ pub fn apply_override(text: &str, assignment: &str) -> Result<String, SceneError
     if path.is_empty() || value.is_empty() {
         return Err(err("expected path=value"));
     }
-    let segs = segments(path);
+    let segs = segments(path).map_err(|m| err(&m))?;
+    let edit = |at: usize, old_len: usize, new: String| {
+        let e = Edit {
+            at,
+            old_len,
+            new_len: new.len(),
+            assignment: assignment.to_string(),
+        };
+        (format!("{}{}{}", &text[..at], new, &text[at + old_len..]), e)
+    };
     let mut open = top_open(text).ok_or_else(|| err("the scene has no top-level struct"))?;
     for (k, seg) in segs.iter().enumerate() {
         let last = k + 1 == segs.len();
@@ -159,22 +205,19 @@ pub fn apply_override(text: &str, assignment: &str) -> Result<String, SceneError
             Seg::Field(name) => match find_field(text, open, name) {
                 Some((_, v)) if last => {
                     let end = value_end(text, v);
-                    return Ok(format!("{}{}{}", &text[..v], value, &text[end..]));
+                    return Ok(edit(v, end - v, value.to_string()));
                 }
                 Some((_, v)) => {
                     open = descend(text, v).ok_or_else(|| err(&format!("`{name}` holds no fields")))?
                 }
-                None if last => {
-                    let at = open + 1;
-                    return Ok(format!("{} {name}: {value},{}", &text[..at], &text[at..]));
-                }
+                None if last => return Ok(edit(open + 1, 0, format!(" {name}: {value},"))),
                 None => return Err(err(&format!("no field `{name}` in the scene"))),
             },
             Seg::Index(i) => {
                 let e = element(text, open, i).ok_or_else(|| err(&format!("no element [{i}]")))?;
                 if last {
                     let end = value_end(text, e);
-                    return Ok(format!("{}{}{}", &text[..e], value, &text[end..]));
+                    return Ok(edit(e, end - e, value.to_string()));
                 }
                 open = descend(text, e).ok_or_else(|| err(&format!("element [{i}] holds no fields")))?;
             }
@@ -188,20 +231,32 @@ enum Seg<'a> {
     Index(usize),
 }
 
-fn segments(path: &str) -> Vec<Seg<'_>> {
+/// The segments of a dotted path: `name`, `name[3]`, `name[0][1]`. Anything else (an
+/// index that is not a whole number, text after a `]`, an empty name) is an error.
+fn segments(path: &str) -> Result<Vec<Seg<'_>>, String> {
     let mut out = Vec::new();
     for part in path.split('.') {
-        let (name, rest) = part.split_once('[').map_or((part, ""), |(n, r)| (n, r));
-        if !name.is_empty() {
-            out.push(Seg::Field(name));
+        let (name, mut rest) = part.split_once('[').map_or((part, ""), |(n, r)| (n, r));
+        if name.is_empty() || name.contains(']') {
+            return Err(format!("`{part}` does not start with a field name"));
         }
-        for idx in rest.split('[') {
-            if let Ok(i) = idx.trim_end_matches(']').parse() {
-                out.push(Seg::Index(i));
-            }
+        out.push(Seg::Field(name));
+        while !rest.is_empty() {
+            let (index, after) = rest
+                .split_once(']')
+                .ok_or_else(|| format!("`[{rest}` has no closing `]`"))?;
+            let i = index
+                .parse()
+                .map_err(|_| format!("`[{index}]` is not an index (a whole number ≥ 0)"))?;
+            out.push(Seg::Index(i));
+            rest = match after.strip_prefix('[') {
+                Some(r) => r,
+                None if after.is_empty() => "",
+                None => return Err(format!("`{after}` after `[{index}]` is not part of a path")),
+            };
         }
     }
-    out
+    Ok(out)
 }
 
 /// A character of a RON identifier (a field, variant or struct name).
@@ -287,8 +342,13 @@ fn scan<T>(text: &str, open: usize, mut f: impl FnMut(usize, u8) -> Option<T>) -
             }
             _ => {}
         }
-        at += 1;
+        at = next_char(text, at);
     }
+}
+
+/// Offset of the character after the one starting at `at`.
+fn next_char(text: &str, at: usize) -> usize {
+    at + text[at..].chars().next().map_or(1, char::len_utf8)
 }
 
 /// Finds `name: value` directly inside the container at `open`; returns the offsets of the
@@ -304,7 +364,8 @@ fn find_field(text: &str, open: usize, name: &str) -> Option<(usize, usize)> {
         }
         let key_end = if c == b'"' {
             let end = string_end(text, at);
-            (&text[at + 1..end - 1] == name).then_some(end)
+            // An unterminated string ends the text: compare what it holds.
+            (text.get(at + 1..end.saturating_sub(1)) == Some(name)).then_some(end)
         } else {
             let end = ident_end(text, at);
             (&text[at..end] == name).then_some(end)
@@ -379,7 +440,7 @@ fn value_end(text: &str, value: usize) -> usize {
             }
             _ => {}
         }
-        at += 1;
+        at = next_char(text, at);
     }
     value + text[value..at].trim_end().len()
 }

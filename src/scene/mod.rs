@@ -8,7 +8,8 @@ pub mod locate;
 mod validate;
 
 pub use build::build;
-pub use validate::Derived;
+use build::region_bounds;
+pub use validate::{Derived, Estimate};
 
 use crate::error::SceneError;
 use crate::grid::Face;
@@ -29,7 +30,8 @@ pub struct Scene {
     /// Shape functions.
     #[serde(default)]
     pub shape: ShapeKind,
-    /// Materials by name.
+    /// Materials by name; a name given twice is an error.
+    #[serde(deserialize_with = "unique_keys")]
     pub materials: BTreeMap<String, MaterialSpec>,
     /// Bodies filled with material points.
     pub bodies: Vec<BodySpec>,
@@ -245,6 +247,36 @@ pub struct SolverSpec {
     pub max_time: Option<f64>,
 }
 
+/// A map whose keys are all different: serde's own map keeps the last of two equal keys
+/// without a word, so that a second `"soil"` would silently replace the first.
+fn unique_keys<'de, D, V>(deserializer: D) -> Result<BTreeMap<String, V>, D::Error>
+where
+    D: serde::Deserializer<'de>,
+    V: Deserialize<'de>,
+{
+    struct Unique<V>(std::marker::PhantomData<V>);
+    impl<'de, V: Deserialize<'de>> serde::de::Visitor<'de> for Unique<V> {
+        type Value = BTreeMap<String, V>;
+        fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+            f.write_str("a map with distinct names")
+        }
+        fn visit_map<A: serde::de::MapAccess<'de>>(self, mut map: A) -> Result<Self::Value, A::Error> {
+            let mut out = BTreeMap::new();
+            while let Some(key) = map.next_key::<String>()? {
+                if out.contains_key(&key) {
+                    return Err(serde::de::Error::custom(format!(
+                        "the name \"{key}\" is given twice: each entry needs its own name"
+                    )));
+                }
+                let value = map.next_value()?;
+                out.insert(key, value);
+            }
+            Ok(out)
+        }
+    }
+    deserializer.deserialize_map(Unique(std::marker::PhantomData))
+}
+
 fn default_node_mass_cutoff() -> f64 {
     1e-3
 }
@@ -309,6 +341,11 @@ pub struct LoadedScene {
     pub path: PathBuf,
     /// Its text (after overrides).
     pub text: String,
+    /// Its text as written (before overrides).
+    pub source: String,
+    /// The overrides' edits of the file's text, in the order applied: messages map their
+    /// positions back through them to the file as written.
+    pub edits: Vec<locate::Edit>,
 }
 
 fn ron_options() -> ron::Options {
@@ -327,9 +364,13 @@ impl LoadedScene {
 
     /// Parses scene text; `path` is used in messages.
     pub fn from_text(path: &Path, text: &str, overrides: &[String]) -> Result<Self, SceneError> {
+        let original = text;
         let mut text = text.to_string();
+        let mut edits = Vec::new();
         for o in overrides {
-            text = locate::apply_override(&text, o)?;
+            let (t, e) = locate::override_edit(&text, o)?;
+            text = t;
+            edits.push(e);
         }
         let scene: Scene = ron_options().from_str(&text).map_err(|e| {
             let message = e.code.to_string();
@@ -342,30 +383,60 @@ impl LoadedScene {
             }
             .filter(|f| !message.contains(&format!("`{f}`")))
             .map_or(String::new(), |f| format!("field `{f}`: "));
+            let at = locate::offset(&text, line, column);
+            let (line, column, from) = Self::place(original, &edits, at);
             SceneError::Syntax {
                 path: path.to_path_buf(),
                 line,
                 column,
-                field,
+                field: format!("{field}{from}"),
                 message,
             }
         })?;
-        let loaded = LoadedScene {
+        Ok(LoadedScene {
             scene,
             path: path.to_path_buf(),
             text,
-        };
-        Ok(loaded)
+            source: original.to_string(),
+            edits,
+        })
+    }
+
+    /// 1-based (line, column) in the file as written of byte offset `at` of the edited
+    /// text, and a note naming the override when the offset lies in the value it set.
+    fn place(original: &str, edits: &[locate::Edit], at: usize) -> (usize, usize, String) {
+        let (at, edit) = locate::original_offset(edits, at);
+        let (line, column) = locate::line_column(original, at);
+        let note = edit.map_or(String::new(), |e| format!("(set by --set `{}`) ", e.assignment));
+        (line, column, note)
     }
 
     /// An error for the field at dotted `field` path (e.g. `materials.soil.density`).
     pub fn invalid(&self, field: &str, rule: impl Into<String>) -> SceneError {
-        let (line, column) = locate::field_position(&self.text, field).unwrap_or((0, 0));
+        let (mut line, mut column, mut note) = (0, 0, String::new());
+        if let Some((l, c)) = locate::field_position(&self.text, field) {
+            let at = locate::offset(&self.text, l, c);
+            let (l, c, set_by) = Self::place(&self.source, &self.edits, at);
+            (line, column) = (l, c);
+            if !set_by.is_empty() {
+                note = format!(" {}", set_by.trim_end());
+            }
+        }
+        // A value replaced whole by an override: its name stands in the file, its value
+        // does not.
+        let set = self.edits.iter().rev().find(|e| {
+            let path = e.assignment.split('=').next().unwrap_or("").trim();
+            field == path || field.starts_with(&format!("{path}.")) || field.starts_with(&format!("{path}["))
+        });
+        if let (true, Some(e)) = (note.is_empty(), set) {
+            note = format!(" (set by --set `{}`)", e.assignment);
+        }
         SceneError::Invalid {
             path: self.path.clone(),
             line,
             column,
             field: field.to_string(),
+            note,
             rule: rule.into(),
         }
     }

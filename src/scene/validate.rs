@@ -27,6 +27,8 @@ pub struct Derived {
     /// Materials the scene defines but no body uses, in name order. They are validated
     /// like the others but do not set the time step.
     pub unused_materials: Vec<String>,
+    /// The memory bound checked before anything was allocated.
+    pub estimate: Estimate,
 }
 
 /// What [`check`] establishes.
@@ -42,6 +44,162 @@ pub struct Checked {
     pub time_step: f64,
     /// Materials no body uses, in name order.
     pub unused_materials: Vec<String>,
+    /// What the run will hold in memory, at most.
+    pub estimate: Estimate,
+}
+
+/// An upper bound of what a scene holds in memory, computed before anything is allocated.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct Estimate {
+    /// Points at most: every sub-cell centre in each body's bounding box, plus the load
+    /// carriers (a polygon fills less than its box).
+    pub points: u64,
+    /// Grid nodes, Π (cells + 1).
+    pub nodes: u64,
+    /// Bytes of the point and node columns and of the largest set-up and sort buffers.
+    pub bytes: u64,
+}
+
+/// Bytes a point costs besides its components: the ECS entity record (16 B), its slot in
+/// the scatter's slab grouping (4 B) and the sort's permutation (4 B), rounded up.
+const POINT_OVERHEAD: u64 = 32;
+
+/// Bytes a node costs: mass (8 B), momentum, force, external force, acceleration and
+/// velocity (five vectors of 8·D B), fixity (1 B), its entity record (16 B), and the set-up
+/// and sort buffers indexed by node (fixity, touched flag, a u32 count).
+fn node_bytes(n: u64) -> u64 {
+    8 + 5 * 8 * n + 1 + 16 + 1 + 1 + 4
+}
+
+/// Bytes of a point's components: position, velocity, displacement (when kept), mass,
+/// volume, stress (4 or 6 components), velocity gradient, material and point ids, and the
+/// plastic strain of plastic materials.
+fn point_bytes(n: u64, displacements: bool, plastic: bool) -> u64 {
+    let vector = 8 * n;
+    let stress = if n == 2 { 32 } else { 48 };
+    3 * vector - if displacements { 0 } else { vector }
+        + 8
+        + 8
+        + stress
+        + vector * n
+        + 2
+        + 4
+        + if plastic { 8 } else { 0 }
+        + POINT_OVERHEAD
+}
+
+/// The machine's memory (bytes), from `/proc/meminfo`; `None` where it cannot be read.
+pub fn machine_memory_bytes() -> Option<u64> {
+    let info = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = info.lines().find(|l| l.starts_with("MemTotal:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    kib.checked_mul(1024)
+}
+
+/// Counts points and nodes in checked arithmetic: a count that overflows is an error, not
+/// a different problem.
+fn estimate(loaded: &LoadedScene, table: &[(String, MaterialModel)]) -> Result<Estimate, SceneError> {
+    let s = &loaded.scene;
+    let n = s.dimension as usize;
+    let too_many =
+        |field: &str, what: &str| loaded.invalid(field, format!("{what} overflows a 64-bit count"));
+    let nodes = s
+        .grid
+        .cells
+        .iter()
+        .try_fold(1u64, |acc, &c| acc.checked_mul((c as u64).checked_add(1)?))
+        .filter(|&nodes| usize::try_from(nodes).is_ok())
+        .ok_or_else(|| too_many("grid.cells", "the node count Π (cells + 1)"))?;
+    let mut points = s.point_loads.len() as u64;
+    let mut bytes = nodes
+        .checked_mul(node_bytes(n as u64))
+        .ok_or_else(|| too_many("grid.cells", "the grid's memory"))?;
+    for (b, body) in s.bodies.iter().enumerate() {
+        let field = format!("bodies[{b}].points_per_cell");
+        let (lo, hi) = super::region_bounds(&body.region, n);
+        let mut count = 1u64;
+        for a in 0..n {
+            // Cells of the bounding box along the axis, clamped to the grid.
+            let o = s.grid.origin[a];
+            let first = ((lo[a] - o) / s.grid.cell_size).floor().max(0.0);
+            let last = ((hi[a] - o) / s.grid.cell_size)
+                .ceil()
+                .clamp(0.0, s.grid.cells[a] as f64);
+            let cells = (last - first).max(0.0) as u64;
+            count = cells
+                .checked_mul(body.points_per_cell[a] as u64)
+                .and_then(|c| count.checked_mul(c))
+                .ok_or_else(|| too_many(&field, "the point count"))?;
+        }
+        let plastic = table
+            .iter()
+            .find(|(name, _)| *name == body.material)
+            .is_some_and(|(_, m)| m.is_plastic());
+        points = points
+            .checked_add(count)
+            .ok_or_else(|| too_many(&field, "the point count"))?;
+        bytes = count
+            .checked_mul(point_bytes(n as u64, s.output.displacements, plastic))
+            .and_then(|b| bytes.checked_add(b))
+            .ok_or_else(|| too_many(&field, "the points' memory"))?;
+    }
+    Ok(Estimate { points, nodes, bytes })
+}
+
+/// Largest step count a `max_time` without `max_steps` may imply: 10^12 steps of the
+/// smallest scene would take days; a larger count is a time step too small to mean it.
+const MAX_IMPLIED_STEPS: f64 = 1e12;
+
+/// Why a polygon cannot be filled, if it cannot: zero area, or two edges that cross or
+/// touch other than at their shared vertex (the even-odd fill of a self-intersecting
+/// polygon is rarely the region meant).
+fn polygon_fault(vertices: &[Vec<f64>]) -> Option<String> {
+    let m = vertices.len();
+    let p = |i: usize| (vertices[i % m][0], vertices[i % m][1]);
+    let twice_area: f64 = (0..m)
+        .map(|i| {
+            let ((x0, y0), (x1, y1)) = (p(i), p(i + 1));
+            x0 * y1 - x1 * y0
+        })
+        .sum();
+    if !(twice_area.abs() > 0.0) {
+        return Some("the polygon encloses no area".into());
+    }
+    let cross =
+        |o: (f64, f64), a: (f64, f64), b: (f64, f64)| (a.0 - o.0) * (b.1 - o.1) - (a.1 - o.1) * (b.0 - o.0);
+    let on = |a: (f64, f64), b: (f64, f64), q: (f64, f64)| {
+        q.0 >= a.0.min(b.0) && q.0 <= a.0.max(b.0) && q.1 >= a.1.min(b.1) && q.1 <= a.1.max(b.1)
+    };
+    // Segments a-b and c-d meet (proper crossing, or one end on the other segment).
+    let meet = |a, b, c, d| {
+        let (d1, d2, d3, d4) = (cross(c, d, a), cross(c, d, b), cross(a, b, c), cross(a, b, d));
+        (d1 * d2 < 0.0 && d3 * d4 < 0.0)
+            || (d1 == 0.0 && on(c, d, a))
+            || (d2 == 0.0 && on(c, d, b))
+            || (d3 == 0.0 && on(a, b, c))
+            || (d4 == 0.0 && on(a, b, d))
+    };
+    for i in 0..m {
+        for j in i + 1..m {
+            // Neighbouring edges share a vertex; they fault only by folding back on each other.
+            let adjacent = j == i + 1 || (i == 0 && j == m - 1);
+            let (a, b, c, d) = (p(i), p(i + 1), p(j), p(j + 1));
+            if adjacent {
+                let (shared, u, v) = if j == i + 1 { (b, a, d) } else { (a, b, c) };
+                let collinear_back = cross(shared, u, v) == 0.0
+                    && (u.0 - shared.0) * (v.0 - shared.0) + (u.1 - shared.1) * (v.1 - shared.1) > 0.0;
+                if collinear_back {
+                    return Some(format!("edges {i} and {j} fold back on each other"));
+                }
+            } else if meet(a, b, c, d) {
+                return Some(format!(
+                    "edges {i} ({:?} to {:?}) and {j} ({:?} to {:?}) cross: give the vertices of a simple polygon, in order",
+                    vertices[i], vertices[(i + 1) % m], vertices[j], vertices[(j + 1) % m]
+                ));
+            }
+        }
+    }
+    None
 }
 
 /// True for a finite number > 0 (NaN fails).
@@ -68,7 +226,19 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
         }
         Ok(())
     };
+    // Every coordinate, force and acceleration is a finite number: a NaN or infinity in
+    // the input would reach the state and be written out.
+    let finite = |field: &str, v: &[f64], unit: &str| -> Result<(), SceneError> {
+        match v.iter().position(|x| !x.is_finite()) {
+            Some(k) => Err(loaded.invalid(
+                field,
+                format!("entry {k} must be a finite number ({unit}), found {}", v[k]),
+            )),
+            None => Ok(()),
+        }
+    };
     len("grid.origin", s.grid.origin.len())?;
+    finite("grid.origin", &s.grid.origin, "m")?;
     len("grid.cells", s.grid.cells.len())?;
     if !positive(s.grid.cell_size) {
         return bad(
@@ -81,6 +251,26 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
     } else {
         1
     };
+    // The grid's far corner and a cell's volume h^D must be finite numbers > 0: a cell
+    // size of 1e-200 m would give cells of zero volume and points of zero mass.
+    let cell_volume = s.grid.cell_size.powi(n as i32);
+    if !(cell_volume.is_normal() && cell_volume.is_finite()) {
+        return bad(
+            "grid.cell_size",
+            format!(
+                "h = {:e} m gives a cell volume h^{n} = {cell_volume:e}, which is not a finite number > 0",
+                s.grid.cell_size
+            ),
+        );
+    }
+    if let Some(a) =
+        (0..n).find(|&a| !(s.grid.origin[a] + s.grid.cell_size * s.grid.cells[a] as f64).is_finite())
+    {
+        return bad(
+            "grid.cells",
+            format!("the grid's far corner along axis {a} is not a finite coordinate"),
+        );
+    }
     if let Some(c) = s.grid.cells.iter().find(|&&c| c < min_cells) {
         return bad(
             "grid.cells",
@@ -118,6 +308,18 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
         if !(0.0..0.5).contains(&nu) {
             return bad(&at("poisson_ratio"), format!("must be in [0, 0.5), found {nu}"));
         }
+        // The P-wave speed sets the time step: it must be a finite number > 0 (an E near
+        // the largest double overflows M, a density near the smallest overflows M/ρ).
+        let speed = (LinearElastic::new(rho, e, nu).p_wave_modulus() / rho).sqrt();
+        if !positive(speed) {
+            return bad(
+                &at("youngs_modulus"),
+                format!(
+                    "E = {e} Pa with ρ = {rho} kg/m³ and ν = {nu} gives a P-wave speed of {speed} m/s, \
+                     not a finite number > 0"
+                ),
+            );
+        }
         let model = match m {
             MaterialSpec::LinearElastic { .. } => {
                 MaterialModel::LinearElastic(LinearElastic::new(rho, e, nu))
@@ -144,6 +346,14 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
                         &at("dilatancy_angle"),
                         format!("must be in [0°, φ = {phi}°], found {psi}°"),
                     );
+                }
+                if let Some(t) = tension_cutoff {
+                    if !non_negative(*t) {
+                        return bad(
+                            &at("tension_cutoff"),
+                            format!("must be a finite stress ≥ 0 Pa (at most c·cot φ), found {t}"),
+                        );
+                    }
                 }
                 if phi == 0.0 && c == 0.0 {
                     return bad(
@@ -250,6 +460,8 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
             Region::Box { min, max } => {
                 len(&format!("bodies[{b}].region.min"), min.len())?;
                 len(&format!("bodies[{b}].region.max"), max.len())?;
+                finite(&format!("bodies[{b}].region.min"), min, "m")?;
+                finite(&format!("bodies[{b}].region.max"), max, "m")?;
                 if min.iter().zip(max).any(|(a, b)| !positive(b - a)) {
                     return bad(
                         &format!("bodies[{b}].region"),
@@ -270,6 +482,15 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
                         format!("vertex {k} needs 2 entries [x, y], found {}", vertices[k].len()),
                     );
                 }
+                for (k, v) in vertices.iter().enumerate() {
+                    finite(&format!("bodies[{b}].region.vertices[{k}]"), v, "m")?;
+                }
+                if let Some(z) = z {
+                    finite(&format!("bodies[{b}].region.z"), z, "m")?;
+                }
+                if let Some(rule) = polygon_fault(vertices) {
+                    return bad(&format!("bodies[{b}].region.vertices"), rule);
+                }
                 if n == 3 && !z.as_ref().is_some_and(|z| z.len() == 2 && positive(z[1] - z[0])) {
                     return bad(
                         &format!("bodies[{b}].region"),
@@ -286,9 +507,21 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
                 format!("{:?} does not exist in {n}D", bc.face),
             );
         }
+        // One condition a face: two would leave the reader to guess which one holds.
+        if let Some(j) = s.boundaries[..i].iter().position(|o| o.face == bc.face) {
+            return bad(
+                &format!("boundaries[{i}].face"),
+                format!(
+                    "{:?} already has a condition (boundaries[{j}]): give each face one condition \
+                     (Fixed holds every component, Roller the normal one)",
+                    bc.face
+                ),
+            );
+        }
     }
     if let Some(g) = &s.gravity {
         len("gravity.acceleration", g.acceleration.len())?;
+        finite("gravity.acceleration", &g.acceleration, "m/s²")?;
         if !non_negative(g.ramp_time) {
             return bad(
                 "gravity.ramp_time",
@@ -299,9 +532,31 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
     for (i, l) in s.point_loads.iter().enumerate() {
         len(&format!("point_loads[{i}].position"), l.position.len())?;
         len(&format!("point_loads[{i}].force"), l.force.len())?;
+        finite(&format!("point_loads[{i}].position"), &l.position, "m")?;
+        finite(&format!("point_loads[{i}].force"), &l.force, "N")?;
     }
     for (i, t) in s.traced.iter().enumerate() {
         len(&format!("traced[{i}].position"), t.position.len())?;
+        finite(&format!("traced[{i}].position"), &t.position, "m")?;
+    }
+    // A scene without load is static as it stands: K_F and K_E are 0/0 at every step and
+    // there is nothing to solve. Say so rather than run it.
+    let gravity = s
+        .gravity
+        .as_ref()
+        .is_some_and(|g| g.acceleration.iter().any(|&a| a != 0.0));
+    let loads = s.point_loads.iter().any(|l| l.force.iter().any(|&f| f != 0.0));
+    if !gravity && !loads {
+        return bad(
+            if s.gravity.is_some() {
+                "gravity.acceleration"
+            } else {
+                "gravity"
+            },
+            "the scene applies no load (no gravity and no non-zero point load): its static \
+             state is the state it starts in; add gravity or point_loads"
+                .into(),
+        );
     }
     // Only materials that bodies use set the time step: a stiff material kept in a scene
     // for later would otherwise make every run take more steps for nothing.
@@ -317,6 +572,15 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
         .map(|(name, _)| name.clone())
         .collect();
     let dt_crit = s.grid.cell_size / c_p;
+    if !positive(dt_crit) {
+        return bad(
+            "grid.cell_size",
+            format!(
+                "the critical time step h/c_p = {} m / {c_p} m/s = {dt_crit} s is not a finite number > 0",
+                s.grid.cell_size
+            ),
+        );
+    }
     let dt = match s.solver.time_step {
         TimeStep::Fixed(dt) => {
             if !positive(dt) {
@@ -347,11 +611,48 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
             a * dt_crit
         }
     };
+    // A time step that rounds to zero or to a subnormal never advances the clock: the run
+    // would write history rows for ever without getting anywhere.
+    if !dt.is_normal() {
+        return bad(
+            "solver.time_step",
+            format!("gives Δt = {dt:e} s, too small to advance the simulated time"),
+        );
+    }
+    if let (Some(t), None) = (s.solver.max_time, s.solver.max_steps) {
+        let steps = t / dt;
+        if steps > MAX_IMPLIED_STEPS {
+            return bad(
+                "solver.max_time",
+                format!(
+                    "{t} s at Δt = {dt:e} s is {steps:.3e} steps (more than {MAX_IMPLIED_STEPS:e}): \
+                     set max_steps as well, or a shorter max_time"
+                ),
+            );
+        }
+    }
+    let estimate = estimate(loaded, &table)?;
+    if let Some(total) = machine_memory_bytes() {
+        if estimate.bytes > total {
+            return bad(
+                "grid",
+                format!(
+                    "the scene needs up to {:.3} GB ({} points, {} nodes at most), more than this machine's {:.3} GB: \
+                     use larger cells, fewer points per cell or a smaller grid",
+                    estimate.bytes as f64 / 1e9,
+                    estimate.points,
+                    estimate.nodes,
+                    total as f64 / 1e9
+                ),
+            );
+        }
+    }
     Ok(Checked {
         materials: table,
         p_wave_speed: c_p,
         critical_time_step: dt_crit,
         time_step: dt,
         unused_materials,
+        estimate,
     })
 }

@@ -150,6 +150,7 @@ mod tests {
         grid: (origin: ORIGIN, cell_size: 0.5, cells: CELLS),
         materials: { "m": LinearElastic(density: 1800.0, youngs_modulus: 1e7, poisson_ratio: 0.3) },
         bodies: [(material: "m", region: Box(min: MIN, max: MAX), points_per_cell: PPC)],
+        gravity: (acceleration: GRAVITY),
         solver: (time_step: Courant(0.5), max_steps: 1),
     )"#;
 
@@ -162,6 +163,7 @@ mod tests {
                 .replace("MIN", "[0.2, 0.0, 0.3]")
                 .replace("MAX", "[2.9, 1.7, 2.0]")
                 .replace("PPC", "[2, 3, 2]")
+                .replace("GRAVITY", "[0.0, -9.81, 0.0]")
         } else {
             SCENE
                 .replace("DIM", "2")
@@ -170,6 +172,7 @@ mod tests {
                 .replace("MIN", "[-1.0, 0.0]")
                 .replace("MAX", "[2.7, 2.3]")
                 .replace("PPC", "[3, 2]")
+                .replace("GRAVITY", "[0.0, -9.81]")
         };
         LoadedScene::from_text(std::path::Path::new("test.ron"), &t, &[]).unwrap()
     }
