@@ -162,7 +162,7 @@ fn polygon_fault(vertices: &[Vec<f64>]) -> Option<String> {
             x0 * y1 - x1 * y0
         })
         .sum();
-    if !(twice_area.abs() > 0.0) {
+    if !positive(twice_area.abs()) {
         return Some("the polygon encloses no area".into());
     }
     let cross =
