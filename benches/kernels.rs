@@ -40,7 +40,7 @@ fn kernels(c: &mut Criterion) {
     c.bench_function("g2p (2D slope, B-spline, 23k points)", |b| {
         b.iter(|| g2p.run(&mut sim.ctx).unwrap())
     });
-    let mut conv = Convergence::default();
+    let mut conv = Convergence;
     c.bench_function("convergence (2D slope grid)", |b| {
         b.iter(|| conv.run(&mut sim.ctx).unwrap())
     });

@@ -104,3 +104,26 @@ impl NodeFixity {
         self.0 & (1 << axis) != 0
     }
 }
+
+/// Calls macro `$mac` with the list of every component type a point can carry in dimension
+/// `$d`: the one list that the spatial sort (which moves them all) and checkpoints (which
+/// save them all) work from. A new point component is added here.
+#[macro_export]
+#[doc(hidden)]
+macro_rules! point_components {
+    ($d:ty, $mac:ident) => {
+        $mac!(
+            Position<<$d as Dim>::Vec>,
+            Velocity<<$d as Dim>::Vec>,
+            Displacement<<$d as Dim>::Vec>,
+            PointLoad<<$d as Dim>::Vec>,
+            VelocityGradient<<$d as Dim>::Mat>,
+            Mass,
+            Volume,
+            Stress<<$d as Dim>::Stress>,
+            MaterialId,
+            PlasticStrain,
+            PointId
+        )
+    };
+}

@@ -65,7 +65,11 @@ pub enum StepError {
         position: [f64; 3],
     },
     /// A NaN or infinite value appeared.
-    #[error("step {step}, system `{system}`: non-finite {what} at {location}")]
+    #[error(
+        "step {step}, system `{system}`: non-finite {what} at {location}; the state of the step before is kept. \
+         A smaller time step (solver.time_step: Courant(α) with a smaller α) or a larger \
+         solver.virtual_mass_floor usually cures it"
+    )]
     NonFinite {
         /// Step number.
         step: u64,

@@ -13,6 +13,7 @@
 #![warn(missing_docs)]
 
 pub mod alloc;
+pub mod checkpoint;
 pub mod columns;
 pub mod components;
 pub mod dim;

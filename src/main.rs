@@ -1,11 +1,16 @@
 //! The `kdmpm` command line: run or check a scene.
 
 use clap::{Parser, Subcommand};
-use kdmpm::output::{History, Summary};
-use kdmpm::scene::{build, LoadedScene};
+use kdmpm::checkpoint;
+use kdmpm::output::{History, OutputDir, Summary};
+use kdmpm::scene::{build, CheckpointEvery, LoadedScene};
+use kdmpm::state::StopReason;
+use kdmpm::systems::convergence::is_defined;
 use kdmpm::{with_simulation, Dim, Simulation};
+use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 /// Large blocks coloured, so that the columns a kernel uses together never share their
@@ -50,6 +55,21 @@ enum Command {
         #[arg(long, value_name = "FILE")]
         trace: Option<PathBuf>,
     },
+    /// Continue a run from the checkpoint in its output directory (`checkpoint.kdc`, written
+    /// by `solver.checkpoint_every` or Ctrl-C), bit for bit as if it had not stopped.
+    Resume {
+        /// The run's output directory.
+        dir: PathBuf,
+        /// Print the per-system timing table at the end.
+        #[arg(long)]
+        profile: bool,
+        /// Print nothing but errors.
+        #[arg(long, short)]
+        quiet: bool,
+        /// Worker threads (default: all cores). Results are identical for any count.
+        #[arg(long)]
+        threads: Option<std::num::NonZeroUsize>,
+    },
     /// Parse and validate a scene without running it; print the derived figures.
     Check {
         /// Scene file (RON).
@@ -68,6 +88,15 @@ const RUN_FAILED: u8 = 1;
 fn main() -> ExitCode {
     match Cli::parse().command {
         Command::Check { scene, overrides } => check(&scene, &overrides),
+        Command::Resume {
+            dir,
+            profile,
+            quiet,
+            threads,
+        } => match start_threads(threads) {
+            Ok(()) => resume(&dir, profile, quiet),
+            Err(code) => code,
+        },
         Command::Run {
             scene,
             out,
@@ -84,18 +113,26 @@ fn main() -> ExitCode {
                     return ExitCode::from(BAD_INPUT);
                 }
             };
-            if let Some(n) = threads {
-                if let Err(e) = rayon::ThreadPoolBuilder::new()
-                    .num_threads(n.get())
-                    .build_global()
-                {
-                    eprintln!("error: cannot start {n} threads: {e}");
-                    return ExitCode::from(BAD_INPUT);
-                }
+            match start_threads(threads) {
+                Ok(()) => run(&scene, out, &overrides, profile, quiet),
+                Err(code) => code,
             }
-            run(&scene, out, &overrides, profile, quiet)
         }
     }
+}
+
+/// Sizes the global thread pool when `--threads` is given.
+fn start_threads(threads: Option<std::num::NonZeroUsize>) -> Result<(), ExitCode> {
+    if let Some(n) = threads {
+        if let Err(e) = rayon::ThreadPoolBuilder::new()
+            .num_threads(n.get())
+            .build_global()
+        {
+            eprintln!("error: cannot start {n} threads: {e}");
+            return Err(ExitCode::from(BAD_INPUT));
+        }
+    }
+    Ok(())
 }
 
 /// Starts the Chrome-trace writer; the returned guard flushes the file when dropped.
@@ -170,85 +207,233 @@ fn run(path: &Path, out: Option<PathBuf>, overrides: &[String], profile: bool, q
         .file_stem()
         .map_or("scene".into(), |s| s.to_string_lossy().into_owned());
     let out = out.unwrap_or_else(|| Path::new("out").join(&stem));
-    if let Err(e) = std::fs::create_dir_all(&out) {
-        eprintln!("error: cannot create output directory {}: {e}", out.display());
-        return ExitCode::from(BAD_INPUT);
-    }
-    let every = loaded.scene.output.history_every;
-    with_simulation!(&mut sim, s => run_dim(s, path, &out, every, profile, quiet))
-}
-
-fn run_dim<D: Dim>(
-    sim: &mut Simulation<D>,
-    scene: &Path,
-    out: &Path,
-    every: u64,
-    profile: bool,
-    quiet: bool,
-) -> ExitCode {
-    let history = match History::<D>::create(&out.join("history.csv"), every, &sim.traced) {
-        Ok(h) => h,
+    let dir = match OutputDir::claim(&out) {
+        Ok(d) => d,
         Err(e) => {
-            eprintln!("error: cannot write {}: {e}", out.join("history.csv").display());
+            eprintln!("error: {e}");
             return ExitCode::from(BAD_INPUT);
         }
     };
+    let header = checkpoint::Header {
+        scene_path: path.to_path_buf(),
+        scene_text: loaded.text.clone(),
+        history_bytes: 0,
+        wall_seconds: 0.0,
+    };
+    let options = Options { profile, quiet };
+    with_simulation!(&mut sim, s => {
+        let every = loaded.scene.output.history_every;
+        match History::create(&dir.file("history.csv"), every, &s.traced) {
+            Ok(h) => drive(s, &loaded, &dir, h, header, options),
+            Err(e) => {
+                eprintln!("error: cannot write {}: {e}", dir.file("history.csv").display());
+                ExitCode::from(BAD_INPUT)
+            }
+        }
+    })
+}
+
+/// Continues the run whose checkpoint is in `dir`.
+fn resume(dir_path: &Path, profile: bool, quiet: bool) -> ExitCode {
+    let file = dir_path.join(checkpoint::FILE_NAME);
+    let bytes = match std::fs::read(&file) {
+        Ok(b) => b,
+        Err(e) => {
+            eprintln!("error: cannot read checkpoint {}: {e}", file.display());
+            return ExitCode::from(BAD_INPUT);
+        }
+    };
+    let fail = |e: &dyn std::fmt::Display| {
+        eprintln!("error: {e}");
+        ExitCode::from(BAD_INPUT)
+    };
+    let header = match checkpoint::header(&bytes, &file) {
+        Ok(h) => h,
+        Err(e) => return fail(&e),
+    };
+    let built = LoadedScene::from_text(&header.scene_path, &header.scene_text, &[])
+        .and_then(|l| build(&l).map(|(s, _)| (l, s)));
+    let (loaded, mut sim) = match built {
+        Ok(v) => v,
+        Err(e) => return fail(&e),
+    };
+    let dir = match OutputDir::claim(dir_path) {
+        Ok(d) => d,
+        Err(e) => return fail(&e),
+    };
+    let options = Options { profile, quiet };
+    with_simulation!(&mut sim, s => {
+        if let Err(e) = checkpoint::restore(s, &bytes, &file) {
+            return fail(&e);
+        }
+        let every = loaded.scene.output.history_every;
+        match History::resume(&dir.file("history.csv"), header.history_bytes, every, &s.traced) {
+            Ok(h) => drive(s, &loaded, &dir, h, header, options),
+            Err(e) => fail(&format!("cannot continue {}: {e}", dir.file("history.csv").display())),
+        }
+    })
+}
+
+/// What the user asked of the terminal output.
+#[derive(Clone, Copy)]
+struct Options {
+    profile: bool,
+    quiet: bool,
+}
+
+/// Set by Ctrl-C: the run checkpoints and stops after the step under way.
+static INTERRUPTED: AtomicBool = AtomicBool::new(false);
+
+/// Exit code of a run stopped by Ctrl-C (128 + SIGINT, as shells report it).
+const INTERRUPTED_EXIT: u8 = 130;
+
+/// Steps `sim` to its end, writing history, checkpoints, points.vtu and summary.json into
+/// `dir`. `header` carries the scene and, for a resumed run, the wall time before.
+fn drive<D: Dim>(
+    sim: &mut Simulation<D>,
+    loaded: &LoadedScene,
+    dir: &OutputDir,
+    history: History<D>,
+    mut header: checkpoint::Header,
+    options: Options,
+) -> ExitCode {
+    let scene = &header.scene_path.clone();
+    let rows = history.rows();
     sim.schedule.push(history);
-    if !quiet {
+    // A second Ctrl-C while the first is being honoured ends the process at once; every
+    // file is written whole or not at all, so nothing torn is left.
+    let _ = ctrlc::set_handler(|| {
+        if INTERRUPTED.swap(true, Ordering::SeqCst) {
+            std::process::exit(INTERRUPTED_EXIT.into());
+        }
+    });
+    if !options.quiet {
         eprintln!(
-            "{}: {} points, {}D, Δt = {:.4e} s",
+            "{}: {} points, {}D, Δt = {:.4e} s{}",
             scene.display(),
             sim.point_count(),
             D::N,
-            sim.ctx.state.dt
+            sim.ctx.state.dt,
+            if sim.ctx.state.step > 0 {
+                format!(", resumed at step {}", sim.ctx.state.step)
+            } else {
+                String::new()
+            }
         );
     }
+    let before = header.wall_seconds;
     let start = Instant::now();
     let mut last_report = Instant::now();
-    let result = sim.run(|s| {
-        if !quiet && last_report.elapsed().as_secs_f64() > 2.0 {
+    let mut last_checkpoint = Instant::now();
+    let every = loaded.scene.solver.checkpoint_every;
+    let save = |sim: &Simulation<D>, header: &mut checkpoint::Header| -> std::io::Result<()> {
+        let mut rows = kdmpm::output::history::lock(&rows);
+        rows.flush()?;
+        header.history_bytes = rows.committed();
+        header.wall_seconds = before + start.elapsed().as_secs_f64();
+        let bytes = checkpoint::encode(sim, header);
+        dir.write_atomic(checkpoint::FILE_NAME, |out| out.write_all(&bytes))
+    };
+    let result = sim.run_with(|s| {
+        let st = &s.ctx.state;
+        if !options.quiet && last_report.elapsed().as_secs_f64() > 2.0 {
             last_report = Instant::now();
             eprintln!(
-                "  step {:>8}  t = {:<10.4}  K_F = {:.3e}  K_E = {:.3e}  resets {}",
-                s.step, s.time, s.force_ratio_max, s.energy_ratio, s.resets
+                "  step {:>8}  t = {:<10.4}  K_F = {}  K_E = {}  resets {}",
+                st.step,
+                st.time,
+                ratio(st.force_ratio_max),
+                ratio(st.energy_ratio),
+                st.resets
             );
         }
+        let interrupted = INTERRUPTED.load(Ordering::SeqCst);
+        let due = st.stop.is_none()
+            && match every {
+                Some(CheckpointEvery::Steps(n)) => st.step.is_multiple_of(n),
+                Some(CheckpointEvery::Seconds(t)) => last_checkpoint.elapsed().as_secs_f64() >= t,
+                None => false,
+            };
+        if interrupted || due {
+            last_checkpoint = Instant::now();
+            save(s, &mut header)?;
+        }
+        if interrupted && s.ctx.state.stop.is_none() {
+            s.ctx.state.stop = Some(StopReason::Interrupted);
+        }
+        Ok(())
     });
-    let wall = start.elapsed().as_secs_f64();
+    let wall = before + start.elapsed().as_secs_f64();
     let error = result.as_ref().err().map(|e| e.to_string());
-    if let Err(e) = kdmpm::output::vtk::write_points(sim, &out.join("points.vtu")) {
-        eprintln!("error: cannot write points.vtu: {e}");
-        return ExitCode::from(BAD_INPUT);
+    // The last step's state is written unless it holds a non-finite value (a failure
+    // caught after a point moved with it): nothing is ever written as NaN.
+    let mut notes = Vec::new();
+    match sim.first_non_finite() {
+        None => {
+            if let Err(e) = kdmpm::output::vtk::write_points(sim, &dir.file("points.vtu")) {
+                eprintln!("error: cannot write points.vtu: {e}");
+                return ExitCode::from(RUN_FAILED);
+            }
+        }
+        Some(what) => notes.push(format!(
+            "points.vtu not written: the state holds a non-finite {what}{}",
+            if dir.file(checkpoint::FILE_NAME).exists() {
+                "; the last checkpoint holds a finite state (kdmpm resume)"
+            } else {
+                ""
+            }
+        )),
     }
     // After the output, so that the peak memory covers the whole run.
     let summary = Summary::collect(&scene.display().to_string(), sim, wall, error);
-    let json = serde_json::to_string_pretty(&summary).expect("summary serialises");
-    if let Err(e) = std::fs::write(out.join("summary.json"), json) {
+    let written = dir.write_atomic("summary.json", |out| {
+        serde_json::to_writer_pretty(&mut *out, &summary).map_err(std::io::Error::other)
+    });
+    if let Err(e) = written {
         eprintln!("error: cannot write summary.json: {e}");
-        return ExitCode::from(BAD_INPUT);
+        return ExitCode::from(RUN_FAILED);
     }
-    if profile {
+    if options.profile {
         print_profile(&summary);
     }
     if let Err(e) = result {
         eprintln!("error: {e}");
+        for n in notes {
+            eprintln!("  {n}");
+        }
         return ExitCode::from(RUN_FAILED);
     }
-    if !quiet {
+    if !options.quiet || summary.outcome == "interrupted" {
         eprintln!(
-            "{} after {} steps, t = {:.4} s: K_F = {:.3e} (max) / {:.3e} (mean), K_E = {:.3e}, {} resets, {:.2} s wall → {}",
-            if summary.converged { "converged" } else { "stopped" },
+            "{} after {} steps, t = {:.4} s: K_F = {} (max) / {} (mean), K_E = {}, {} resets, {:.2} s wall → {}",
+            match summary.outcome.as_str() {
+                "converged" => "converged",
+                "interrupted" => "interrupted (kdmpm resume continues it)",
+                _ => "stopped at its limit",
+            },
             summary.steps,
             summary.time,
-            summary.force_ratio_max,
-            summary.force_ratio_mean,
-            summary.energy_ratio,
+            ratio(summary.force_ratio_max),
+            ratio(summary.force_ratio_mean),
+            ratio(summary.energy_ratio),
             summary.kinetic_resets,
             wall,
-            out.display()
+            dir.path().display()
         );
     }
+    if summary.outcome == "interrupted" {
+        return ExitCode::from(INTERRUPTED_EXIT);
+    }
     ExitCode::SUCCESS
+}
+
+/// A ratio for the terminal: its value, or `undefined` (zero denominator).
+fn ratio(r: f64) -> String {
+    if is_defined(r) {
+        format!("{r:.3e}")
+    } else {
+        "undefined".into()
+    }
 }
 
 fn print_profile(summary: &Summary) {

@@ -125,14 +125,67 @@ impl<D: Dim> Simulation<D> {
     /// is done: two thread wake-ups per loop, about 15 % of a step of the 2D slope on one
     /// thread.
     pub fn run(&mut self, mut observe: impl FnMut(&SolverState) + Send) -> Result<(), StepError> {
+        self.run_with(|sim| {
+            observe(&sim.ctx.state);
+            Ok(())
+        })
+    }
+
+    /// As [`Simulation::run`], with `between` given the whole simulation after every step:
+    /// it may write output, checkpoint, or end the run by setting `ctx.state.stop`.
+    pub fn run_with(
+        &mut self,
+        mut between: impl FnMut(&mut Simulation<D>) -> Result<(), StepError> + Send,
+    ) -> Result<(), StepError> {
         rayon::scope(|_| {
             self.ctx.state.stop = None;
             while self.ctx.state.stop.is_none() {
                 self.step()?;
-                observe(&self.ctx.state);
+                between(self)?;
             }
             Ok(())
         })
+    }
+
+    /// The first non-finite value of the point state that output would write (position,
+    /// displacement, stress, volume, plastic strain), as "<quantity> of point <id>".
+    pub fn first_non_finite(&self) -> Option<String> {
+        let w = &self.ctx.world;
+        let finite = |v: &[f64]| v.iter().all(|c| c.is_finite());
+        for arch in points_with::<Position<D::Vec>>(w) {
+            let id = col::<PointId>(arch);
+            let bad = |what: &str, r: usize| Some(format!("{what} of point {}", id[r].0));
+            if let Some(r) = col::<Position<D::Vec>>(arch)
+                .iter()
+                .position(|x| !finite(&D::vec_to3(x.0)))
+            {
+                return bad("position", r);
+            }
+            if let Some(u) = arch.get::<&Displacement<D::Vec>>() {
+                if let Some(r) = u.iter().position(|u| !finite(&D::vec_to3(u.0))) {
+                    return bad("displacement", r);
+                }
+            }
+            if let Some(s) = arch.get::<&Stress<D::Stress>>() {
+                if let Some(r) = s.iter().position(|s| {
+                    let s = s.0.to_sym3();
+                    !finite(&[s.xx, s.yy, s.zz, s.xy, s.yz, s.zx])
+                }) {
+                    return bad("stress", r);
+                }
+            }
+            if let Some(v) = arch.get::<&Volume>() {
+                if let Some(r) = v.iter().position(|v| !v.0.is_finite()) {
+                    return bad("volume", r);
+                }
+            }
+            if let Some(e) = arch.get::<&PlasticStrain>() {
+                if let Some(r) = e.iter().position(|e| !e.0.is_finite()) {
+                    return bad("plastic strain", r);
+                }
+            }
+        }
+        None
     }
 
     /// Number of material points (load carriers included).

@@ -47,6 +47,8 @@ pub enum ForceNorm {
 pub enum StopReason {
     /// K_F and K_E both at or below the tolerance.
     Converged,
+    /// Stopped from outside (Ctrl-C); a checkpoint holds the state to resume from.
+    Interrupted,
     /// The step limit was reached first.
     MaxSteps,
     /// The time limit was reached first.
@@ -169,6 +171,9 @@ pub struct SolverState {
     pub static_window_start: Option<f64>,
     /// Largest point movement over the last completed static-check window (m).
     pub static_window_movement: Option<f64>,
+    /// Point positions (m, x y z, by [`PointId`](crate::components::PointId)) when the
+    /// current static-check window opened.
+    pub static_window_snapshot: Vec<[f64; 3]>,
     /// The nodes the points reached this step. Every node outside holds zeros (mass,
     /// momentum, forces, acceleration, velocity), so grid passes skip it: a scatter adds the
     /// nodes it reaches, the grid reset zeroes the box and empties it.

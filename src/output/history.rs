@@ -2,53 +2,106 @@
 
 use crate::dim::Dim;
 use crate::error::StepError;
+use crate::output::dir::RowFile;
 use crate::schedule::System;
 use crate::simulation::{Context, TracedPoint};
-use std::fs::File;
-use std::io::BufWriter;
+use crate::systems::convergence::is_defined;
 use std::marker::PhantomData;
 use std::path::Path;
+use std::sync::{Arc, Mutex, MutexGuard};
 
 /// Writes step, time, E_k (J), W_ext (J), K_F (max and mean norm), K_E, resets and each
-/// traced point's displacement (m) every `every` steps and at the last step.
-/// Rows reach the disk whenever the buffer fills and at the end, so a run stopped by an
-/// error leaves a valid file with every row before the error.
+/// traced point's displacement (m) every `every` steps and at the last step. A ratio whose
+/// denominator is zero is written `undefined`.
+///
+/// The file only ever holds whole rows ([`RowFile`]): a run stopped by an error, a crash or
+/// a full disk leaves a valid file with every row that reached it. The row file is shared
+/// ([`History::rows`]) so that a checkpoint can flush it and note its length.
 pub struct History<D> {
-    writer: csv::Writer<BufWriter<File>>,
+    rows: Arc<Mutex<RowFile>>,
     every: u64,
     traced: Vec<TracedPoint>,
     _marker: PhantomData<fn() -> D>,
 }
 
+/// The column names of `history.csv` for these traced points.
+pub fn header<D: Dim>(traced: &[TracedPoint]) -> Vec<String> {
+    let mut header: Vec<String> = [
+        "step",
+        "time",
+        "kinetic_energy",
+        "external_work",
+        "force_ratio_max",
+        "force_ratio_mean",
+        "energy_ratio",
+        "resets",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
+    for t in traced {
+        for axis in ["x", "y", "z"].iter().take(D::N) {
+            header.push(format!("{}_u{axis}", t.name));
+        }
+    }
+    header
+}
+
+/// One CSV line: fields quoted where they hold a comma, quote or line break.
+fn line(fields: &[String]) -> Vec<u8> {
+    let quoted: Vec<String> = fields
+        .iter()
+        .map(|f| {
+            if f.contains([',', '"', '\n', '\r']) {
+                format!("\"{}\"", f.replace('"', "\"\""))
+            } else {
+                f.clone()
+            }
+        })
+        .collect();
+    format!("{}\n", quoted.join(",")).into_bytes()
+}
+
 impl<D: Dim> History<D> {
     /// Creates `path` and writes the header.
     pub fn create(path: &Path, every: u64, traced: &[TracedPoint]) -> std::io::Result<Self> {
-        let mut writer = csv::Writer::from_writer(BufWriter::new(File::create(path)?));
-        let mut header: Vec<String> = [
-            "step",
-            "time",
-            "kinetic_energy",
-            "external_work",
-            "force_ratio_max",
-            "force_ratio_mean",
-            "energy_ratio",
-            "resets",
-        ]
-        .iter()
-        .map(|s| s.to_string())
-        .collect();
-        for t in traced {
-            for axis in ["x", "y", "z"].iter().take(D::N) {
-                header.push(format!("{}_u{axis}", t.name));
-            }
-        }
-        writer.write_record(&header).map_err(std::io::Error::other)?;
-        Ok(History {
-            writer,
+        let mut rows = RowFile::create(path)?;
+        rows.row(&line(&header::<D>(traced)))?;
+        rows.flush()?;
+        Ok(Self::with(rows, every, traced))
+    }
+
+    /// Continues `path` after its first `bytes` bytes (a checkpoint's length of it).
+    pub fn resume(path: &Path, bytes: u64, every: u64, traced: &[TracedPoint]) -> std::io::Result<Self> {
+        Ok(Self::with(RowFile::resume(path, bytes)?, every, traced))
+    }
+
+    fn with(rows: RowFile, every: u64, traced: &[TracedPoint]) -> Self {
+        History {
+            rows: Arc::new(Mutex::new(rows)),
             every,
             traced: traced.to_vec(),
             _marker: PhantomData,
-        })
+        }
+    }
+
+    /// The row file, shared: flush it and read its length to checkpoint.
+    pub fn rows(&self) -> Arc<Mutex<RowFile>> {
+        self.rows.clone()
+    }
+}
+
+/// Locks a row file (a panic elsewhere while holding it leaves whole rows all the same).
+pub fn lock(rows: &Mutex<RowFile>) -> MutexGuard<'_, RowFile> {
+    rows.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// A ratio K_F or K_E as written: `undefined` where its denominator was zero.
+fn ratio(r: f64) -> String {
+    if is_defined(r) {
+        format!("{r:.9e}")
+    } else {
+        "undefined".into()
     }
 }
 
@@ -59,7 +112,7 @@ impl<D: Dim> System<D> for History<D> {
     fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
         let s = &ctx.state;
         let last = s.stop.is_some();
-        if s.step % self.every != 0 && !last {
+        if !s.step.is_multiple_of(self.every) && !last {
             return Ok(());
         }
         let mut row = vec![
@@ -67,9 +120,9 @@ impl<D: Dim> System<D> for History<D> {
             format!("{:.9e}", s.time),
             format!("{:.9e}", s.kinetic_energy),
             format!("{:.9e}", s.external_work),
-            format!("{:.9e}", s.force_ratio_max),
-            format!("{:.9e}", s.force_ratio_mean),
-            format!("{:.9e}", s.energy_ratio),
+            ratio(s.force_ratio_max),
+            ratio(s.force_ratio_mean),
+            ratio(s.energy_ratio),
             s.resets.to_string(),
         ];
         for t in &self.traced {
@@ -77,10 +130,18 @@ impl<D: Dim> System<D> for History<D> {
             let u = t.displacement::<D>(&ctx.world);
             row.extend(u.iter().take(D::N).map(|c| format!("{c:.9e}")));
         }
-        self.writer.write_record(&row).map_err(std::io::Error::other)?;
+        let mut rows = lock(&self.rows);
+        rows.row(&line(&row))?;
         if last {
-            self.writer.flush()?;
+            rows.flush()?;
         }
         Ok(())
+    }
+}
+
+impl<D> Drop for History<D> {
+    fn drop(&mut self) {
+        // Rows of a run that ended without a last step (an error) still reach the file.
+        let _ = lock(&self.rows).flush();
     }
 }

@@ -5,20 +5,28 @@ use crate::measure::{max_displacements, surface_angle, SurfaceAngle};
 use crate::schedule::Timing;
 use crate::simulation::{Simulation, TracedResult};
 use crate::state::{ForceNorm, Peak, StopReason};
+use crate::systems::convergence::is_defined;
 use serde::Serialize;
 
-/// The outcome of a run, as written to `summary.json`.
+/// The outcome of a run, as written to `summary.json`. Nothing is written as `null`: an
+/// absent optional figure is left out, and a ratio whose denominator was zero is the
+/// string `"undefined"`.
 #[derive(Clone, Debug, Serialize)]
 pub struct Summary {
     /// Scene file.
     pub scene: String,
     /// 2 or 3.
     pub dimension: usize,
+    /// How the run ended: `converged`, `max_steps`, `max_time`, `interrupted` (Ctrl-C;
+    /// `kdmpm resume` continues it) or `failed` (see `error`).
+    pub outcome: String,
     /// True when K_F and K_E both reached the tolerance.
     pub converged: bool,
     /// Why the run stopped (absent after an error).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub stop_reason: Option<StopReason>,
     /// The error that stopped the run, if any.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub error: Option<String>,
     /// Steps taken.
     pub steps: u64,
@@ -27,22 +35,28 @@ pub struct Summary {
     /// Time step (s).
     pub time_step: f64,
     /// K_F in the norm the stopping rule reads.
+    #[serde(serialize_with = "ratio")]
     pub force_ratio: f64,
     /// That norm.
     pub force_norm: ForceNorm,
     /// K_F, max-norm (paper eq. 3).
+    #[serde(serialize_with = "ratio")]
     pub force_ratio_max: f64,
     /// K_F, mean norm.
+    #[serde(serialize_with = "ratio")]
     pub force_ratio_mean: f64,
     /// K_E (eq. 4).
+    #[serde(serialize_with = "ratio")]
     pub energy_ratio: f64,
     /// Tolerance for both.
     pub tolerance: f64,
     /// Largest point movement over the last completed static-check window (m).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub static_window_movement: Option<f64>,
     /// Kinetic-damping resets.
     pub kinetic_resets: u64,
     /// The first kinetic-energy peak (s, J).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub first_peak: Option<Peak>,
     /// Kinetic energy (J) at the end.
     pub kinetic_energy: f64,
@@ -58,17 +72,30 @@ pub struct Summary {
     pub particle_steps_per_second: f64,
     /// Peak resident memory of the process over the whole run, set-up and the writing of
     /// `points.vtu` included (bytes; Linux only).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub peak_memory_bytes: Option<u64>,
     /// Largest displacement magnitude of any point (m), unless the scene keeps none.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub max_displacement: Option<f64>,
     /// Largest |horizontal displacement| of any point (m), unless the scene keeps none.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub max_horizontal_displacement: Option<f64>,
     /// Free-surface angle, when the scene asks for it (`output.surface_angle`).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub surface_angle: Option<SurfaceAngle>,
     /// Traced points.
     pub traced: Vec<TracedResult>,
     /// Per-system cost.
     pub systems: Vec<Timing>,
+}
+
+/// A ratio K_F or K_E: its value, or `"undefined"` where its denominator was zero.
+fn ratio<S: serde::Serializer>(r: &f64, s: S) -> Result<S::Ok, S::Error> {
+    if is_defined(*r) {
+        s.serialize_f64(*r)
+    } else {
+        s.serialize_str("undefined")
+    }
 }
 
 impl Summary {
@@ -86,6 +113,13 @@ impl Summary {
         Summary {
             scene: scene.to_string(),
             dimension: D::N,
+            outcome: match (&error, s.stop) {
+                (Some(_), _) | (None, None) => "failed".into(),
+                (None, Some(stop)) => serde_json::to_value(stop)
+                    .ok()
+                    .and_then(|v| v.as_str().map(str::to_string))
+                    .unwrap_or_default(),
+            },
             converged: s.stop == Some(StopReason::Converged),
             stop_reason: if error.is_some() { None } else { s.stop },
             error,

@@ -11,7 +11,8 @@ use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::Path;
 
-/// Writes every material point (load carriers excluded) in [`PointId`] order, whatever
+/// Writes (whole or not at all, see [`crate::output::dir::write_atomic`]) every material
+/// point (load carriers excluded) in [`PointId`] order, whatever
 /// order the spatial sort left them in, with its id, displacement (m, when kept), stress
 /// (Pa, tension positive: xx yy zz xy yz zx), mean stress (Pa), volume (m³) and
 /// accumulated plastic strain (0 for bodies without plastic state).
@@ -100,7 +101,11 @@ pub fn write_points<D: Dim>(sim: &Simulation<D>, path: &Path) -> std::io::Result
         offset += 8 + array.bytes;
     }
 
-    let mut out = BufWriter::with_capacity(1 << 20, File::create(path)?);
+    crate::output::dir::write_atomic(path, |out| write_arrays(out, n, &arrays))
+}
+
+/// The XML head and the appended section of [`write_points`].
+fn write_arrays(out: &mut BufWriter<File>, n: usize, arrays: &[Array]) -> std::io::Result<()> {
     out.write_all(b"<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n")?;
     writeln!(
         out,
@@ -113,15 +118,15 @@ pub fn write_points<D: Dim>(sim: &Simulation<D>, path: &Path) -> std::io::Result
     ] {
         writeln!(out, "<{section}>")?;
         for array in arrays.iter().filter(|a| a.part == part) {
-            array.tag(&mut out)?;
+            array.tag(out)?;
         }
         writeln!(out, "</{section}>")?;
     }
     out.write_all(b"</Piece></UnstructuredGrid>\n<AppendedData encoding=\"raw\">\n_")?;
     // Each block: its length in bytes (UInt64), then the values.
-    for array in &arrays {
+    for array in arrays {
         out.write_all(&(array.bytes as u64).to_le_bytes())?;
-        (array.values)(&mut out)?;
+        (array.values)(out)?;
     }
     out.write_all(b"\n</AppendedData>\n</VTKFile>\n")?;
     out.flush()

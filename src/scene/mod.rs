@@ -245,6 +245,20 @@ pub struct SolverSpec {
     /// Simulated-time limit (s).
     #[serde(default)]
     pub max_time: Option<f64>,
+    /// Write the whole state to `checkpoint.kdc` in the output directory this often, so
+    /// that `kdmpm resume DIR` can continue the run bit for bit (default: never, except on
+    /// Ctrl-C).
+    #[serde(default)]
+    pub checkpoint_every: Option<CheckpointEvery>,
+}
+
+/// How often a run writes its checkpoint.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub enum CheckpointEvery {
+    /// Every this many steps (≥ 1).
+    Steps(u64),
+    /// Every this many seconds of wall time (> 0).
+    Seconds(f64),
 }
 
 /// A map whose keys are all different: serde's own map keeps the last of two equal keys

@@ -425,6 +425,18 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
             return bad("solver.max_time", format!("must be > 0 s, found {t}"));
         }
     }
+    match s.solver.checkpoint_every {
+        Some(super::CheckpointEvery::Steps(0)) => {
+            return bad("solver.checkpoint_every", "Steps(n) needs n ≥ 1".into());
+        }
+        Some(super::CheckpointEvery::Seconds(t)) if !positive(t) => {
+            return bad(
+                "solver.checkpoint_every",
+                format!("Seconds(t) needs a wall time t > 0 s, found {t}"),
+            );
+        }
+        _ => {}
+    }
     if s.output.history_every == 0 {
         return bad("output.history_every", "must be ≥ 1".into());
     }

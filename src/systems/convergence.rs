@@ -14,10 +14,21 @@ use crate::state::{StaticCheck, StopReason};
 /// K_E above which a run is declared unstable (a sound run stays at or below 1).
 pub const UNSTABLE_ENERGY_RATIO: f64 = 10.0;
 
+/// The value of a ratio whose denominator is zero (no external force on a free degree of
+/// freedom, no external work yet). It is not 0: it compares false with every tolerance,
+/// so it never counts as met, and writers show it as `undefined` (see [`is_defined`]).
+pub const UNDEFINED: f64 = f64::NAN;
+
+/// True when a ratio K_F or K_E has a value (its denominator was not zero).
+pub fn is_defined(ratio: f64) -> bool {
+    !ratio.is_nan()
+}
+
 /// Force-ratio sums over the free degrees of freedom of nodes that carry mass.
 ///
 /// Fixed components are left out (their reaction keeps K_F near 1 for ever), and so are
-/// massless nodes (they carry no degree of freedom).
+/// massless nodes (they carry no degree of freedom). With no external force on any free
+/// degree of freedom both ratios are [`UNDEFINED`].
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct ForceRatios {
     /// K_F = max|F_ext + F_int| / max|F_ext|.
@@ -62,15 +73,7 @@ pub fn force_ratios<D: Dim>(ctx: &Context<D>) -> ForceRatios {
     let [max_u, max_e, sum_u, sum_e] = parts.iter().fold([0.0f64; 4], |t, p| {
         [t[0].max(p[0]), t[1].max(p[1]), t[2] + p[2], t[3] + p[3]]
     });
-    let ratio = |u: f64, e: f64| {
-        if e > 0.0 {
-            u / e
-        } else if u > 0.0 {
-            f64::INFINITY
-        } else {
-            0.0
-        }
-    };
+    let ratio = |u: f64, e: f64| if e > 0.0 { u / e } else { UNDEFINED };
     ForceRatios {
         max_norm: ratio(max_u, max_e),
         mean_norm: ratio(sum_u, sum_e),
@@ -88,20 +91,20 @@ pub fn force_ratios<D: Dim>(ctx: &Context<D>) -> ForceRatios {
 /// stops at the end of the window only if the ratios are met again and no point moved
 /// more than the allowed distance, otherwise a new window opens at the next step that
 /// meets them.
+///
+/// It keeps nothing itself: the window and its snapshot live in [`crate::state::SolverState`],
+/// so that a checkpoint holds them.
 #[derive(Debug, Default)]
-pub struct Convergence {
-    /// Point positions (m, x y z) when the static-check window opened.
-    snapshot: Vec<[f64; 3]>,
-}
+pub struct Convergence;
 
 impl Convergence {
     fn confirm_static<D: Dim>(&mut self, ctx: &mut Context<D>, met: bool, check: StaticCheck) -> bool {
         let now = ctx.state.time;
         match ctx.state.static_window_start {
             Some(start) if now >= start + check.window * (1.0 - 1e-12) => {
-                let mut current = Vec::with_capacity(self.snapshot.len());
+                let mut current = Vec::with_capacity(ctx.state.static_window_snapshot.len());
                 positions::<D>(&ctx.world, &mut current);
-                let moved = max_movement(&self.snapshot, &current);
+                let moved = max_movement(&ctx.state.static_window_snapshot, &current);
                 ctx.state.static_window_movement = Some(moved);
                 ctx.state.static_window_start = None;
                 if met && moved <= check.max_displacement {
@@ -110,7 +113,7 @@ impl Convergence {
                 if met {
                     // Still balanced but moving: a creeping state. Watch a new window.
                     ctx.state.static_window_start = Some(now);
-                    self.snapshot = current;
+                    ctx.state.static_window_snapshot = current;
                 }
                 false
             }
@@ -118,7 +121,7 @@ impl Convergence {
             None => {
                 if met {
                     ctx.state.static_window_start = Some(now);
-                    positions::<D>(&ctx.world, &mut self.snapshot);
+                    positions::<D>(&ctx.world, &mut ctx.state.static_window_snapshot);
                 }
                 false
             }
@@ -155,10 +158,8 @@ impl<D: Dim> System<D> for Convergence {
         s.force_ratio_mean = ratios.mean_norm;
         s.energy_ratio = if s.external_work > 0.0 {
             s.kinetic_energy / s.external_work
-        } else if s.kinetic_energy > 0.0 {
-            f64::INFINITY
         } else {
-            0.0
+            UNDEFINED
         };
         // Energy balance: W_ext = E_k + stored + dissipated, so K_E ≤ 1 in a sound run.
         // Well above that the scheme is creating energy; stop before it turns into NaN.
@@ -172,7 +173,11 @@ impl<D: Dim> System<D> for Convergence {
         }
         let tol = ctx.settings.tolerance;
         let (step, time) = (s.step, s.time);
-        let met = s.force_ratio(ctx.settings.force_norm) <= tol && s.energy_ratio <= tol;
+        // A load still ramping up is not a static state, however balanced this step is:
+        // the load of this step acted over [t − Δt, t] (see `systems::gravity`).
+        let loading = ctx.settings.gravity.is_some_and(|g| g.factor(time - s.dt) < 1.0);
+        // An undefined ratio (NaN) compares false: it never meets the tolerance.
+        let met = !loading && s.force_ratio(ctx.settings.force_norm) <= tol && s.energy_ratio <= tol;
         let converged = match ctx.settings.static_check {
             None => met,
             Some(check) => self.confirm_static(ctx, met, check),

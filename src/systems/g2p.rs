@@ -11,6 +11,20 @@ use crate::simulation::Context;
 use rayon::prelude::*;
 use std::marker::PhantomData;
 
+/// The first point (by row) whose velocity is not finite, as "point <id>" for a message.
+fn first_non_finite_velocity<D: Dim>(world: &hecs::World) -> String {
+    for arch in points_with::<Velocity<D::Vec>>(world) {
+        let (v, id) = (col::<Velocity<D::Vec>>(arch), col::<PointId>(arch));
+        if let Some(r) = v
+            .iter()
+            .position(|v| !D::vec_to3(v.0).iter().all(|c| c.is_finite()))
+        {
+            return format!("point {}", id[r].0);
+        }
+    }
+    "a point (the energy's sum overflowed)".into()
+}
+
 /// v_p ← α (v_p + Δt Σ_i w_ip a_i) + (1 − α) Σ_i w_ip v_i (FLIP for α = 1, PIC for α = 0),
 /// then E_k = ½ Σ m_p v_p·v_p.
 #[derive(Debug)]
@@ -67,6 +81,17 @@ impl<D: Dim, S: Shape> System<D> for G2p<D, S> {
                 .collect();
             // Partial sums added in chunk order: the same bits for any thread count.
             twice_ek += parts.iter().sum::<f64>();
+        }
+        // A NaN or infinite velocity shows in the energy's sum. Stop here, before any point
+        // moves with it: positions, stresses and the solver state stay those of the last
+        // finite step.
+        if !twice_ek.is_finite() {
+            return Err(StepError::NonFinite {
+                step: ctx.state.step,
+                system: "g2p",
+                what: "velocity",
+                location: first_non_finite_velocity::<D>(&ctx.world),
+            });
         }
         ctx.state.kinetic_energy = 0.5 * twice_ek;
         Ok(())

@@ -405,7 +405,7 @@ fn make<D: Dim, S: Shape>(name: &str, settings: &Settings) -> Box<dyn System<D>>
         "volumetric_smoothing" => Box::new(VolumetricSmoothing::<D, S>::default()),
         "stress_update" => Box::new(StressUpdate),
         "volume_update" => Box::new(VolumeUpdate),
-        "convergence" => Box::new(Convergence::default()),
+        "convergence" => Box::new(Convergence),
         other => unreachable!("checked by check_names: {other}"),
     }
 }

@@ -14,6 +14,7 @@ use crate::components::*;
 use crate::dim::Dim;
 use crate::error::StepError;
 use crate::grid::Grid;
+use crate::point_components;
 use crate::schedule::System;
 use crate::simulation::Context;
 use hecs::{Archetype, World};
@@ -73,7 +74,7 @@ impl<D: Dim> System<D> for SpatialSort {
 
     fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
         ctx.state.points_reordered = false;
-        if ctx.state.step % self.every != 0 {
+        if !ctx.state.step.is_multiple_of(self.every) {
             return Ok(());
         }
         let sorted = sort_points(&ctx.world, &ctx.grid);
@@ -145,25 +146,6 @@ impl<T: Copy + Send> Reorder for &mut [T] {
             }
         }
     }
-}
-
-/// Calls `$body` with `$ty` bound to every component type a point can carry.
-macro_rules! point_components {
-    ($d:ty, $mac:ident) => {
-        $mac!(
-            Position<<$d as Dim>::Vec>,
-            Velocity<<$d as Dim>::Vec>,
-            Displacement<<$d as Dim>::Vec>,
-            PointLoad<<$d as Dim>::Vec>,
-            VelocityGradient<<$d as Dim>::Mat>,
-            Mass,
-            Volume,
-            Stress<<$d as Dim>::Stress>,
-            MaterialId,
-            PlasticStrain,
-            PointId
-        )
-    };
 }
 
 /// True when `arch` holds a component that is none of the point components above (added

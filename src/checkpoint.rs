@@ -1,0 +1,353 @@
+//! Checkpoints: the whole state of a run between two steps, to resume it bit for bit.
+//!
+//! A step's outcome depends on the solver state ([`SolverState`], which also holds the
+//! static-check window) and on the point columns, row by row: the scatters add points in
+//! row order. Everything else is rebuilt from the scene: node columns are zero between
+//! steps once the next grid reset has run, and the slab grouping of the scatters is a
+//! function of the positions. So a checkpoint holds the scene's text, the solver state and
+//! every point column of every archetype in row order; resuming builds the scene again
+//! (which spawns the same archetypes with the same row counts) and overwrites them.
+//!
+//! The file is binary, little-endian, written for the machine that reads it back (same
+//! build of kdmpm): numbers are stored as their bits, so nothing is rounded on the way.
+
+use crate::columns::points_with;
+use crate::components::*;
+use crate::dim::Dim;
+use crate::grid::NodeBox;
+use crate::parallel::SlabCache;
+use crate::point_components;
+use crate::simulation::Simulation;
+use crate::state::{Peak, SolverState, StopReason};
+use hecs::Archetype;
+use std::path::{Path, PathBuf};
+use thiserror::Error;
+
+/// The first bytes of a checkpoint file.
+const MAGIC: &[u8; 8] = b"KDMPMCK\0";
+/// Format version; a file of another version is refused.
+const VERSION: u32 = 1;
+/// The file's name in an output directory.
+pub const FILE_NAME: &str = "checkpoint.kdc";
+
+/// A checkpoint that cannot be read or does not fit its scene.
+#[derive(Debug, Error)]
+pub enum CheckpointError {
+    /// The file could not be read or written.
+    #[error("checkpoint {path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The I/O error.
+        source: std::io::Error,
+    },
+    /// The file is not a checkpoint of this version, or is cut short.
+    #[error("checkpoint {path}: {reason}")]
+    Format {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        reason: String,
+    },
+}
+
+/// What a checkpoint holds besides the simulation's state.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Header {
+    /// The scene file the run was started from (for messages).
+    pub scene_path: PathBuf,
+    /// The scene's text, overrides applied.
+    pub scene_text: String,
+    /// Bytes of `history.csv` written up to this step.
+    pub history_bytes: u64,
+    /// Wall time of the stepping loop so far (s).
+    pub wall_seconds: f64,
+}
+
+/// Serialises the header, the solver state and every point column of `sim`.
+pub fn encode<D: Dim>(sim: &Simulation<D>, header: &Header) -> Vec<u8> {
+    let mut w = Writer(Vec::new());
+    w.0.extend_from_slice(MAGIC);
+    w.u32(VERSION);
+    w.u64(D::N as u64);
+    w.str(&header.scene_path.to_string_lossy());
+    w.str(&header.scene_text);
+    w.u64(header.history_bytes);
+    w.f64(header.wall_seconds);
+    encode_state(&mut w, &sim.ctx.state);
+    let archs: Vec<&Archetype> = points_with::<Position<D::Vec>>(&sim.ctx.world).collect();
+    w.u64(archs.len() as u64);
+    for arch in archs {
+        w.u64(arch.len() as u64);
+        macro_rules! save {
+            ($($t:ty),*) => {$(
+                match arch.get::<&$t>() {
+                    Some(c) => {
+                        w.u8(1);
+                        // SAFETY: every point component is a plain struct of f64, u32 or u16
+                        // fields without padding (`point_components_have_no_padding`), so each
+                        // of its bytes is initialised.
+                        let bytes = unsafe { as_bytes(&c) };
+                        w.u64(bytes.len() as u64);
+                        w.0.extend_from_slice(bytes);
+                    }
+                    None => w.u8(0),
+                }
+            )*};
+        }
+        point_components!(D, save);
+    }
+    w.0
+}
+
+/// Reads the header of checkpoint bytes (the scene to build before [`restore`]).
+pub fn header(bytes: &[u8], path: &Path) -> Result<Header, CheckpointError> {
+    let mut r = Reader::new(bytes, path);
+    r.header()
+}
+
+/// Puts the state saved in `bytes` into `sim`, freshly built from the checkpoint's scene.
+pub fn restore<D: Dim>(
+    sim: &mut Simulation<D>,
+    bytes: &[u8],
+    path: &Path,
+) -> Result<Header, CheckpointError> {
+    let mut r = Reader::new(bytes, path);
+    let header = r.header()?;
+    if r.dimension != D::N as u64 {
+        return Err(r.fault(format!("saved in {}D, the scene is {}D", r.dimension, D::N)));
+    }
+    let state = decode_state(&mut r)?;
+    let archs: Vec<&Archetype> = points_with::<Position<D::Vec>>(&sim.ctx.world).collect();
+    if r.u64()? != archs.len() as u64 {
+        return Err(r.fault("the scene's point archetypes differ from the saved ones".into()));
+    }
+    for arch in archs {
+        if r.u64()? != arch.len() as u64 {
+            return Err(r.fault("a point archetype's row count differs from the saved one".into()));
+        }
+        macro_rules! load {
+            ($($t:ty),*) => {$(
+                let saved = r.u8()? == 1;
+                match arch.get::<&mut $t>() {
+                    Some(mut c) if saved => {
+                        let n = r.u64()? as usize;
+                        let src = r.take(n)?;
+                        if n != std::mem::size_of_val(&*c) {
+                            return Err(r.fault(format!("column {} has another length", stringify!($t))));
+                        }
+                        // SAFETY: `c` is exactly `n` bytes long (checked above) and its type is a
+                        // plain struct of f64, u32 or u16 fields without padding, for which every
+                        // bit pattern is a valid value; `src` is a distinct allocation.
+                        unsafe {
+                            std::ptr::copy_nonoverlapping(src.as_ptr(), c.as_mut_ptr().cast::<u8>(), n)
+                        };
+                    }
+                    None if !saved => {}
+                    _ => return Err(r.fault(format!("column {} is not in both", stringify!($t)))),
+                }
+            )*};
+        }
+        point_components!(D, load);
+    }
+    if r.at != bytes.len() {
+        return Err(r.fault("bytes left after the last column".into()));
+    }
+    sim.ctx.state = state;
+    // Nodes are zero and no box is active right after building, as after a grid reset.
+    sim.ctx.state.active_nodes = NodeBox::default();
+    sim.ctx.slabs = SlabCache::default();
+    for t in &mut sim.traced {
+        t.entity = t.current_entity(&sim.ctx.world);
+    }
+    Ok(header)
+}
+
+/// The bytes of a column.
+///
+/// # Safety
+/// `T` must have no padding bytes (every byte of a value initialised).
+unsafe fn as_bytes<T: Copy>(column: &[T]) -> &[u8] {
+    // SAFETY: the caller guarantees every byte is initialised; the length is the slice's.
+    unsafe { std::slice::from_raw_parts(column.as_ptr().cast::<u8>(), std::mem::size_of_val(column)) }
+}
+
+fn encode_state(w: &mut Writer, s: &SolverState) {
+    w.u64(s.step);
+    w.f64(s.time);
+    w.f64(s.dt);
+    w.f64(s.kinetic_energy);
+    w.f64(s.previous_kinetic_energy);
+    w.f64(s.external_work);
+    w.f64(s.force_ratio_max);
+    w.f64(s.force_ratio_mean);
+    w.f64(s.energy_ratio);
+    w.u64(s.resets);
+    w.u8(s.reset_this_step as u8);
+    w.u8(s.points_reordered as u8);
+    w.u64(s.peaks.len() as u64);
+    for p in &s.peaks {
+        w.f64(p.time);
+        w.f64(p.energy);
+    }
+    // A checkpoint is taken between steps of a run that goes on: no stop reason.
+    w.opt(s.static_window_start);
+    w.opt(s.static_window_movement);
+    w.u64(s.static_window_snapshot.len() as u64);
+    for x in &s.static_window_snapshot {
+        x.iter().for_each(|&c| w.f64(c));
+    }
+}
+
+fn decode_state(r: &mut Reader) -> Result<SolverState, CheckpointError> {
+    let mut s = SolverState {
+        step: r.u64()?,
+        time: r.f64()?,
+        dt: r.f64()?,
+        kinetic_energy: r.f64()?,
+        previous_kinetic_energy: r.f64()?,
+        external_work: r.f64()?,
+        force_ratio_max: r.f64()?,
+        force_ratio_mean: r.f64()?,
+        energy_ratio: r.f64()?,
+        resets: r.u64()?,
+        reset_this_step: r.u8()? == 1,
+        points_reordered: r.u8()? == 1,
+        ..SolverState::default()
+    };
+    let peaks = r.u64()?;
+    for _ in 0..peaks {
+        s.peaks.push(Peak {
+            time: r.f64()?,
+            energy: r.f64()?,
+        });
+    }
+    s.stop = None::<StopReason>;
+    s.static_window_start = r.opt()?;
+    s.static_window_movement = r.opt()?;
+    let n = r.u64()?;
+    for _ in 0..n {
+        s.static_window_snapshot.push([r.f64()?, r.f64()?, r.f64()?]);
+    }
+    Ok(s)
+}
+
+struct Writer(Vec<u8>);
+
+impl Writer {
+    fn u8(&mut self, v: u8) {
+        self.0.push(v);
+    }
+    fn u32(&mut self, v: u32) {
+        self.0.extend_from_slice(&v.to_le_bytes());
+    }
+    fn u64(&mut self, v: u64) {
+        self.0.extend_from_slice(&v.to_le_bytes());
+    }
+    fn f64(&mut self, v: f64) {
+        self.u64(v.to_bits());
+    }
+    fn opt(&mut self, v: Option<f64>) {
+        self.u8(v.is_some() as u8);
+        self.f64(v.unwrap_or(0.0));
+    }
+    fn str(&mut self, v: &str) {
+        self.u64(v.len() as u64);
+        self.0.extend_from_slice(v.as_bytes());
+    }
+}
+
+struct Reader<'a> {
+    bytes: &'a [u8],
+    at: usize,
+    path: &'a Path,
+    dimension: u64,
+}
+
+impl<'a> Reader<'a> {
+    fn new(bytes: &'a [u8], path: &'a Path) -> Self {
+        Reader {
+            bytes,
+            at: 0,
+            path,
+            dimension: 0,
+        }
+    }
+    fn fault(&self, reason: String) -> CheckpointError {
+        CheckpointError::Format {
+            path: self.path.to_path_buf(),
+            reason,
+        }
+    }
+    fn take(&mut self, n: usize) -> Result<&'a [u8], CheckpointError> {
+        let end = self.at.checked_add(n).filter(|&e| e <= self.bytes.len());
+        let end = end.ok_or_else(|| self.fault("the file is cut short".into()))?;
+        let out = &self.bytes[self.at..end];
+        self.at = end;
+        Ok(out)
+    }
+    fn u8(&mut self) -> Result<u8, CheckpointError> {
+        Ok(self.take(1)?[0])
+    }
+    fn u64(&mut self) -> Result<u64, CheckpointError> {
+        Ok(u64::from_le_bytes(self.take(8)?.try_into().expect("8 bytes")))
+    }
+    fn f64(&mut self) -> Result<f64, CheckpointError> {
+        Ok(f64::from_bits(self.u64()?))
+    }
+    fn opt(&mut self) -> Result<Option<f64>, CheckpointError> {
+        let some = self.u8()? == 1;
+        let v = self.f64()?;
+        Ok(some.then_some(v))
+    }
+    fn str(&mut self) -> Result<String, CheckpointError> {
+        let n = self.u64()? as usize;
+        let b = self.take(n)?;
+        String::from_utf8(b.to_vec()).map_err(|_| self.fault("a text field is not UTF-8".into()))
+    }
+    fn header(&mut self) -> Result<Header, CheckpointError> {
+        if self.take(MAGIC.len()).ok() != Some(MAGIC.as_slice()) {
+            return Err(self.fault("not a kdmpm checkpoint".into()));
+        }
+        let version = u32::from_le_bytes(self.take(4)?.try_into().expect("4 bytes"));
+        if version != VERSION {
+            return Err(self.fault(format!(
+                "format version {version}; this kdmpm reads version {VERSION}"
+            )));
+        }
+        self.dimension = self.u64()?;
+        Ok(Header {
+            scene_path: PathBuf::from(self.str()?),
+            scene_text: self.str()?,
+            history_bytes: self.u64()?,
+            wall_seconds: self.f64()?,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::components::*;
+    use crate::dim::{Dim, Dim2, Dim3};
+    use crate::point_components;
+    use std::mem::size_of;
+
+    /// Checkpoints copy point columns byte for byte: no component may hold padding, whose
+    /// bytes are uninitialised. Each size must equal the sum of its fields' sizes.
+    #[test]
+    fn point_components_have_no_padding() {
+        fn fields<D: Dim>() -> Vec<usize> {
+            let (v, m) = (8 * D::N, 8 * D::N * D::N);
+            let s = if D::N == 2 { 32 } else { 48 };
+            vec![v, v, v, v, m, 8, 8, s, 2, 8, 4]
+        }
+        fn sizes<D: Dim>() -> Vec<usize> {
+            macro_rules! size {
+                ($($t:ty),*) => { vec![$(size_of::<$t>()),*] };
+            }
+            point_components!(D, size)
+        }
+        assert_eq!(sizes::<Dim2>(), fields::<Dim2>());
+        assert_eq!(sizes::<Dim3>(), fields::<Dim3>());
+    }
+}
