@@ -126,13 +126,15 @@ pub fn write_atomic(
 }
 
 /// A file written row by row that only ever holds whole rows: rows are buffered and
-/// appended in whole rows; a failed append (a full disk) is cut back to the last whole row
-/// before the error is returned.
+/// appended in whole rows (when the buffer fills, and at least once a second so that a
+/// running output can be watched); a failed append (a full disk) is cut back to the last
+/// whole row before the error is returned.
 #[derive(Debug)]
 pub struct RowFile {
     file: File,
     buffer: Vec<u8>,
     committed: u64,
+    flushed: std::time::Instant,
 }
 
 /// Rows are appended to the file once this many bytes are buffered.
@@ -144,6 +146,7 @@ impl RowFile {
         Ok(RowFile {
             file: File::create(path)?,
             buffer: Vec::with_capacity(ROW_BUFFER),
+            flushed: std::time::Instant::now(),
             committed: 0,
         })
     }
@@ -166,6 +169,7 @@ impl RowFile {
         Ok(RowFile {
             file,
             buffer: Vec::with_capacity(ROW_BUFFER),
+            flushed: std::time::Instant::now(),
             committed: bytes,
         })
     }
@@ -173,7 +177,7 @@ impl RowFile {
     /// Adds one row (its text must end with a newline).
     pub fn row(&mut self, row: &[u8]) -> std::io::Result<()> {
         self.buffer.extend_from_slice(row);
-        if self.buffer.len() >= ROW_BUFFER {
+        if self.buffer.len() >= ROW_BUFFER || self.flushed.elapsed().as_secs_f64() >= 1.0 {
             self.flush()?;
         }
         Ok(())
@@ -193,6 +197,7 @@ impl RowFile {
         }
         self.committed += self.buffer.len() as u64;
         self.buffer.clear();
+        self.flushed = std::time::Instant::now();
         Ok(())
     }
 

@@ -1,0 +1,303 @@
+//! A run resumed from a checkpoint gives the bits of the run that never stopped: the same
+//! point columns row by row and the same solver state in memory, and the same points.vtu,
+//! history.csv and summary.json numbers on disk, for 1 and 2 threads, from any step —
+//! the first, one inside the static-check window, the step before and the step of a
+//! kinetic-energy reset — and after Ctrl-C.
+
+mod common;
+
+use kdmpm::checkpoint::{self, Header};
+use kdmpm::scene::{build, LoadedScene};
+use kdmpm::{AnySimulation, Dim, Dim2, Dim3, Simulation};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn load(name: &str, overrides: &[&str]) -> LoadedScene {
+    let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+    LoadedScene::from_file(&common::scene(name), &overrides).expect("scene loads")
+}
+
+/// The simulation of dimension `D` that `loaded` builds.
+fn sim<D: Dim>(loaded: &LoadedScene) -> Simulation<D> {
+    let any: Box<dyn std::any::Any> = match build(loaded).unwrap().0 {
+        AnySimulation::Two(s) => Box::new(s),
+        AnySimulation::Three(s) => Box::new(s),
+    };
+    *any.downcast().expect("the scene's dimension")
+}
+
+fn pool(threads: usize) -> rayon::ThreadPool {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap()
+}
+
+/// The whole state as checkpoint bytes (a fixed header): equal bytes, equal bits.
+fn bits<D: Dim>(sim: &Simulation<D>) -> Vec<u8> {
+    let header = Header {
+        scene_path: PathBuf::new(),
+        scene_text: String::new(),
+        history_bytes: 0,
+        wall_seconds: 0.0,
+    };
+    checkpoint::encode(sim, &header)
+}
+
+/// Steps taken, steps with a reset, steps inside a static-check window, and final bits.
+struct Reference {
+    steps: u64,
+    resets: Vec<u64>,
+    in_window: Vec<u64>,
+    end: Vec<u8>,
+}
+
+fn reference<D: Dim>(sim: &mut Simulation<D>) -> Reference {
+    let (mut resets, mut in_window) = (Vec::new(), Vec::new());
+    sim.run(|s| {
+        if s.reset_this_step {
+            resets.push(s.step);
+        }
+        if s.static_window_start.is_some() {
+            in_window.push(s.step);
+        }
+    })
+    .unwrap();
+    Reference {
+        steps: sim.ctx.state.step,
+        resets,
+        in_window,
+        end: bits(sim),
+    }
+}
+
+/// Checkpoints `loaded` after `k` steps on `before` threads, restores it into a freshly
+/// built simulation and finishes it on `after` threads; returns the final bits.
+fn resumed<D: Dim>(loaded: &LoadedScene, k: u64, before: usize, after: usize) -> Vec<u8> {
+    let header = Header {
+        scene_path: loaded.path.clone(),
+        scene_text: loaded.text.clone(),
+        history_bytes: 0,
+        wall_seconds: 0.0,
+    };
+    let mut first = sim::<D>(loaded);
+    let saved = pool(before).install(|| {
+        for _ in 0..k {
+            first.step().unwrap();
+        }
+        checkpoint::encode(&first, &header)
+    });
+    let mut second = sim::<D>(loaded);
+    let read = checkpoint::restore(&mut second, &saved, Path::new("memory")).unwrap();
+    assert_eq!(read, header);
+    pool(after).install(|| second.run(|_| {}).unwrap());
+    bits(&second)
+}
+
+/// Checks resumption of `loaded` at the first step, the step before and the step of a
+/// reset, and a step inside the static-check window (when it has one), both ways round in
+/// thread count.
+fn resumes_bit_for_bit<D: Dim>(loaded: &LoadedScene, window: bool) {
+    let mut whole = sim::<D>(loaded);
+    let r = pool(2).install(|| reference(&mut whole));
+    let reset = *r
+        .resets
+        .get(1)
+        .expect("the run resets its velocities at least twice");
+    let mut at = vec![1, reset - 1, reset];
+    if window {
+        let inside = r.in_window.get(r.in_window.len() / 2).copied();
+        at.push(inside.expect("the run opens a static-check window"));
+    }
+    for k in at {
+        assert!(k < r.steps, "checkpoint step {k} before the end {}", r.steps);
+        for (before, after) in [(1, 2), (2, 1)] {
+            assert!(
+                resumed::<D>(loaded, k, before, after) == r.end,
+                "resumed at step {k} ({before} → {after} threads) differs from the run that never stopped"
+            );
+        }
+    }
+}
+
+#[test]
+fn the_bar_resumed_at_any_step_has_the_bits_of_the_run_that_never_stopped() {
+    resumes_bit_for_bit::<Dim3>(&load("bar.ron", &[]), false);
+}
+
+#[test]
+fn a_run_resumed_inside_its_static_check_window_has_the_bits_of_the_run_that_never_stopped() {
+    let loaded = load(
+        "soil_column.ron",
+        &["solver.static_check=(window: 0.3, max_displacement: 1e-4)"],
+    );
+    resumes_bit_for_bit::<Dim2>(&loaded, true);
+}
+
+#[test]
+fn a_checkpoint_of_another_scene_is_refused() {
+    let mut column = sim::<Dim2>(&load("soil_column.ron", &[]));
+    column.step().unwrap();
+    let saved = bits(&column);
+    let mut other = sim::<Dim2>(&load("slope.ron", &[]));
+    let e = checkpoint::restore(&mut other, &saved, Path::new("c")).unwrap_err();
+    assert!(e.to_string().contains("differs"), "{e}");
+    let e = checkpoint::restore(&mut other, &saved[..saved.len() / 2], Path::new("c")).unwrap_err();
+    assert!(
+        e.to_string().contains("cut short") || e.to_string().contains("differs"),
+        "{e}"
+    );
+    let e = checkpoint::restore(&mut other, b"nonsense", Path::new("c")).unwrap_err();
+    assert!(e.to_string().contains("not a kdmpm checkpoint"), "{e}");
+}
+
+// ---- The binary: files on disk -------------------------------------------------------
+
+fn kdmpm(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_kdmpm"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("kdmpm-resume-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    d
+}
+
+/// summary.json without the figures of wall time, memory and per-system cost.
+fn summary_numbers(dir: &Path) -> serde_json::Value {
+    let text = std::fs::read_to_string(dir.join("summary.json")).unwrap();
+    let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    for key in [
+        "wall_seconds",
+        "particle_steps_per_second",
+        "peak_memory_bytes",
+        "systems",
+    ] {
+        v.as_object_mut().unwrap().remove(key);
+    }
+    v
+}
+
+/// Every output of run directory `a` equals that of `b`.
+fn same_results(a: &Path, b: &Path) {
+    for file in ["points.vtu", "history.csv"] {
+        let (x, y) = (
+            std::fs::read(a.join(file)).unwrap(),
+            std::fs::read(b.join(file)).unwrap(),
+        );
+        assert!(
+            x == y,
+            "{file} differs between {} and {}",
+            a.display(),
+            b.display()
+        );
+    }
+    assert_eq!(summary_numbers(a), summary_numbers(b));
+}
+
+fn copy_dir(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for e in std::fs::read_dir(from).unwrap() {
+        let e = e.unwrap();
+        std::fs::copy(e.path(), to.join(e.file_name())).unwrap();
+    }
+}
+
+/// Runs `scene` to its end on 2 threads with checkpoints every `every` steps, keeps its
+/// results, resumes from the last checkpoint on 1 thread and compares.
+fn resume_from_last_checkpoint(scene: &str, every: u64, sets: &[&str]) {
+    let dir = scratch(scene);
+    let out = dir.join("run");
+    let path = common::scene(scene);
+    let checkpoint = format!("solver.checkpoint_every=Steps({every})");
+    let mut args = vec![
+        "run",
+        path.to_str().unwrap(),
+        "--quiet",
+        "--threads",
+        "2",
+        "--out",
+    ];
+    args.push(out.to_str().unwrap());
+    for s in sets.iter().chain([&checkpoint.as_str()]) {
+        args.extend(["--set", s]);
+    }
+    let o = kdmpm(&args);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let full = dir.join("full");
+    copy_dir(&out, &full);
+    let o = kdmpm(&["resume", out.to_str().unwrap(), "--quiet", "--threads", "1"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    same_results(&out, &full);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn the_bar_resumed_by_the_binary_writes_the_same_files() {
+    resume_from_last_checkpoint("bar.ron", 300, &[]);
+}
+
+#[test]
+fn a_3d_block_resumed_by_the_binary_writes_the_same_files() {
+    // It converges after 92 steps: the last checkpoint is at step 80.
+    resume_from_last_checkpoint("block_10k.ron", 40, &[]);
+}
+
+/// The paper's slope, checkpointed in the middle of its run (step 15 000 of 28 131).
+#[test]
+fn the_slope_resumed_from_the_middle_of_its_run_writes_the_same_files() {
+    resume_from_last_checkpoint("slope.ron", 15_000, &[]);
+}
+
+#[test]
+fn ctrl_c_checkpoints_and_a_resumed_run_writes_the_files_of_one_never_interrupted() {
+    let dir = scratch("ctrl-c");
+    let path = common::scene("slope.ron");
+    let scene = path.to_str().unwrap();
+    let (whole, cut) = (dir.join("whole"), dir.join("cut"));
+    let steps = "solver.max_steps=6000";
+    let o = kdmpm(&[
+        "run",
+        scene,
+        "--quiet",
+        "--set",
+        steps,
+        "--out",
+        whole.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let child = Command::new(env!("CARGO_BIN_EXE_kdmpm"))
+        .args(["run", scene, "--quiet", "--threads", "1", "--set", steps, "--out"])
+        .arg(&cut)
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Interrupt once the run is under way (its history has rows beyond the header).
+    let history = cut.join("history.csv");
+    while std::fs::read_to_string(&history).map_or(0, |t| t.lines().count()) < 3 {
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    let sent = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(sent.success());
+    let o = child.wait_with_output().unwrap();
+    assert_eq!(
+        o.status.code(),
+        Some(130),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let summary = summary_numbers(&cut);
+    assert_eq!(summary["outcome"], "interrupted");
+    assert!(summary["steps"].as_u64().unwrap() < 6000);
+    assert!(cut.join("checkpoint.kdc").exists());
+    let o = kdmpm(&["resume", cut.to_str().unwrap(), "--quiet", "--threads", "2"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    same_results(&cut, &whole);
+    let _ = std::fs::remove_dir_all(&dir);
+}
