@@ -395,10 +395,22 @@ impl LoadedScene {
                 ron::Error::MissingStructField { .. } => locate::enclosing_field(&text, line, column),
                 _ => locate::field_before(&text, line, column),
             }
-            .filter(|f| !message.contains(&format!("`{f}`")))
-            .map_or(String::new(), |f| format!("field `{f}`: "));
+            .filter(|f| !message.contains(&format!("`{f}`")));
             let at = locate::offset(&text, line, column);
-            let (line, column, from) = Self::place(original, &edits, at);
+            let (line, column, mut from) = Self::place(original, &edits, at);
+            // A parser often notices a bad value just before or after it: name the
+            // override that set a field of that name.
+            if let (true, Some(f)) = (from.is_empty(), &field) {
+                let leaf = |e: &&locate::Edit| {
+                    let path = e.assignment.split('=').next().unwrap_or("").trim();
+                    let last = path.rsplit('.').next().unwrap_or(path);
+                    last.split('[').next() == Some(f.as_str())
+                };
+                if let Some(e) = edits.iter().rev().find(leaf) {
+                    from = format!("(set by --set `{}`) ", e.assignment);
+                }
+            }
+            let field = field.map_or(String::new(), |f| format!("field `{f}`: "));
             SceneError::Syntax {
                 path: path.to_path_buf(),
                 line,
