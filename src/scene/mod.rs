@@ -9,7 +9,7 @@ mod validate;
 
 pub use build::build;
 use build::region_bounds;
-pub use validate::{Derived, Estimate};
+pub use validate::{check, Checked, Derived, Estimate};
 
 use crate::error::SceneError;
 use crate::grid::Face;
