@@ -385,7 +385,7 @@ fn balanced_cuts(sizes: &[usize], threads: usize) -> Vec<usize> {
 ///
 /// Which thread runs which slab changes no sum, so each phase is split statically: thread
 /// t takes the t-th of as many contiguous runs of slabs, cut so that each holds about as
-/// many points ([`balanced_cuts`]). Slabs differ in size wherever a body is not a box (the
+/// many points (`balanced_cuts`). Slabs differ in size wherever a body is not a box (the
 /// 2D slope's from 270 points to 891), which rayon's split by slab count left unbalanced;
 /// and a thread keeps the same part of the grid from phase to phase.
 ///

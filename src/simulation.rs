@@ -148,7 +148,7 @@ impl<D: Dim> Simulation<D> {
     }
 
     /// The first non-finite value of the point state that output would write (position,
-    /// displacement, stress, volume, plastic strain), as "<quantity> of point <id>".
+    /// displacement, stress, volume, plastic strain), as "stress of point 17".
     pub fn first_non_finite(&self) -> Option<String> {
         let w = &self.ctx.world;
         let finite = |v: &[f64]| v.iter().all(|c| c.is_finite());

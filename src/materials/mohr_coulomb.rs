@@ -128,8 +128,8 @@ impl MohrCoulomb {
 
     /// True when the stress is inside the yield surface and below the tension cut-off by a
     /// bound, so most elastic points skip the eigen-decomposition: the bound from the
-    /// invariants ([`MohrCoulomb::invariant_bound`]) or, for nearly planar states, the one
-    /// from the x-y block ([`MohrCoulomb::near_planar_bound`]). A stress it passes is one the
+    /// invariants (`MohrCoulomb::invariant_bound`) or, for nearly planar states, the one
+    /// from the x-y block (`MohrCoulomb::near_planar_bound`). A stress it passes is one the
     /// exact test on the eigen-decomposition's values passes too.
     #[inline(always)]
     pub fn surely_elastic(&self, stress: &Sym3) -> bool {
