@@ -29,6 +29,20 @@ struct Cli {
     command: Command,
 }
 
+/// How a run steps and what it prints, for `run` and `resume` alike.
+#[derive(clap::Args)]
+struct Stepping {
+    /// Print the per-system timing table at the end.
+    #[arg(long)]
+    profile: bool,
+    /// Print nothing but errors.
+    #[arg(long, short)]
+    quiet: bool,
+    /// Worker threads (default: all cores). Results are identical for any count.
+    #[arg(long)]
+    threads: Option<std::num::NonZeroUsize>,
+}
+
 #[derive(Subcommand)]
 enum Command {
     /// Run a scene to static equilibrium (or its step/time limit).
@@ -41,15 +55,8 @@ enum Command {
         /// Override a scene field, e.g. --set solver.tolerance=1e-4 (repeatable).
         #[arg(long = "set", value_name = "PATH=VALUE")]
         overrides: Vec<String>,
-        /// Print the per-system timing table at the end.
-        #[arg(long)]
-        profile: bool,
-        /// Print nothing but errors.
-        #[arg(long, short)]
-        quiet: bool,
-        /// Worker threads (default: all cores). Results are identical for any count.
-        #[arg(long)]
-        threads: Option<std::num::NonZeroUsize>,
+        #[command(flatten)]
+        stepping: Stepping,
         /// Write a Chrome trace (chrome://tracing, Perfetto) of every system call to FILE
         /// (needs a build with `--features trace`).
         #[arg(long, value_name = "FILE")]
@@ -60,15 +67,8 @@ enum Command {
     Resume {
         /// The run's output directory.
         dir: PathBuf,
-        /// Print the per-system timing table at the end.
-        #[arg(long)]
-        profile: bool,
-        /// Print nothing but errors.
-        #[arg(long, short)]
-        quiet: bool,
-        /// Worker threads (default: all cores). Results are identical for any count.
-        #[arg(long)]
-        threads: Option<std::num::NonZeroUsize>,
+        #[command(flatten)]
+        stepping: Stepping,
     },
     /// Parse and validate a scene without running it; print the derived figures.
     Check {
@@ -88,22 +88,15 @@ const RUN_FAILED: u8 = 1;
 fn main() -> ExitCode {
     match Cli::parse().command {
         Command::Check { scene, overrides } => check(&scene, &overrides),
-        Command::Resume {
-            dir,
-            profile,
-            quiet,
-            threads,
-        } => match start_threads(threads) {
-            Ok(()) => resume(&dir, profile, quiet),
+        Command::Resume { dir, stepping } => match start_threads(stepping.threads) {
+            Ok(()) => resume(&dir, stepping.profile, stepping.quiet),
             Err(code) => code,
         },
         Command::Run {
             scene,
             out,
             overrides,
-            profile,
-            quiet,
-            threads,
+            stepping,
             trace,
         } => {
             let _trace = match trace.map(start_trace).transpose() {
@@ -113,8 +106,8 @@ fn main() -> ExitCode {
                     return ExitCode::from(BAD_INPUT);
                 }
             };
-            match start_threads(threads) {
-                Ok(()) => run(&scene, out, &overrides, profile, quiet),
+            match start_threads(stepping.threads) {
+                Ok(()) => run(&scene, out, &overrides, stepping.profile, stepping.quiet),
                 Err(code) => code,
             }
         }

@@ -307,13 +307,17 @@ fn a_second_run_into_an_output_directory_in_use_is_refused() {
     while !out.join("history.csv").exists() {
         std::thread::sleep(std::time::Duration::from_millis(10));
     }
-    let o = kdmpm(&[
-        "run",
-        column().to_str().unwrap(),
-        "--quiet",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let c = column();
+    let second = || {
+        kdmpm(&[
+            "run",
+            c.to_str().unwrap(),
+            "--quiet",
+            "--out",
+            out.to_str().unwrap(),
+        ])
+    };
+    let o = second();
     let err = String::from_utf8_lossy(&o.stderr);
     first.kill().unwrap();
     first.wait().unwrap();
@@ -323,13 +327,7 @@ fn a_second_run_into_an_output_directory_in_use_is_refused() {
         "{err}"
     );
     // Once the holder is gone the directory is free again, whatever it left behind.
-    let o = kdmpm(&[
-        "run",
-        column().to_str().unwrap(),
-        "--quiet",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let o = second();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let _ = std::fs::remove_dir_all(&dir);
 }
