@@ -207,6 +207,15 @@ fn run(path: &Path, out: Option<PathBuf>, overrides: &[String], profile: bool, q
             return ExitCode::from(BAD_INPUT);
         }
     };
+    // A checkpoint left by an earlier run belongs to that run: resuming it would cut this
+    // run's history.csv at the old length and continue another problem.
+    match std::fs::remove_file(dir.file(checkpoint::FILE_NAME)) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+            eprintln!("error: cannot remove the earlier run's checkpoint: {e}");
+            return ExitCode::from(BAD_INPUT);
+        }
+        _ => {}
+    }
     let header = checkpoint::Header {
         scene_path: path.to_path_buf(),
         scene_text: loaded.text.clone(),

@@ -301,3 +301,34 @@ fn ctrl_c_checkpoints_and_a_resumed_run_writes_the_files_of_one_never_interrupte
     same_results(&cut, &whole);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn a_new_run_into_a_directory_drops_the_checkpoint_of_the_run_before() {
+    let dir = scratch("stale");
+    let out = dir.join("out");
+    let (bar, column) = (common::scene("bar.ron"), common::scene("soil_column.ron"));
+    let run = |scene: &Path, sets: &[&str]| {
+        let mut args = vec![
+            "run",
+            scene.to_str().unwrap(),
+            "--quiet",
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        for s in sets {
+            args.extend(["--set", s]);
+        }
+        let o = kdmpm(&args);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    };
+    run(&bar, &["solver.checkpoint_every=Steps(300)"]);
+    assert!(out.join("checkpoint.kdc").exists());
+    run(&column, &[]);
+    assert!(
+        !out.join("checkpoint.kdc").exists(),
+        "the bar's checkpoint outlived its run"
+    );
+    let o = kdmpm(&["resume", out.to_str().unwrap(), "--quiet"]);
+    assert_eq!(o.status.code(), Some(2), "{}", String::from_utf8_lossy(&o.stderr));
+    let _ = std::fs::remove_dir_all(&dir);
+}
