@@ -2,10 +2,10 @@
 
 use clap::{Parser, Subcommand};
 use kdmpm::checkpoint;
-use kdmpm::output::{History, OutputDir, Summary};
+use kdmpm::output::{History, Outcome, OutputDir, Summary};
 use kdmpm::scene::{build, CheckpointEvery, LoadedScene};
 use kdmpm::state::StopReason;
-use kdmpm::systems::convergence::is_defined;
+use kdmpm::systems::convergence::ratio_text;
 use kdmpm::{with_simulation, Dim, Simulation};
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -344,8 +344,8 @@ fn drive<D: Dim>(
                 "  step {:>8}  t = {:<10.4}  K_F = {}  K_E = {}  resets {}",
                 st.step,
                 st.time,
-                ratio(st.force_ratio_max),
-                ratio(st.energy_ratio),
+                ratio_text(st.force_ratio_max, 3),
+                ratio_text(st.energy_ratio, 3),
                 st.resets
             );
         }
@@ -405,37 +405,29 @@ fn drive<D: Dim>(
         }
         return ExitCode::from(RUN_FAILED);
     }
-    if !options.quiet || summary.outcome == "interrupted" {
+    let interrupted = summary.outcome == Outcome::Interrupted;
+    if !options.quiet || interrupted {
         eprintln!(
             "{} after {} steps, t = {:.4} s: K_F = {} (max) / {} (mean), K_E = {}, {} resets, {:.2} s wall → {}",
-            match summary.outcome.as_str() {
-                "converged" => "converged",
-                "interrupted" => "interrupted (kdmpm resume continues it)",
+            match summary.outcome {
+                Outcome::Converged => "converged",
+                Outcome::Interrupted => "interrupted (kdmpm resume continues it)",
                 _ => "stopped at its limit",
             },
             summary.steps,
             summary.time,
-            ratio(summary.force_ratio_max),
-            ratio(summary.force_ratio_mean),
-            ratio(summary.energy_ratio),
+            ratio_text(summary.force_ratio_max, 3),
+            ratio_text(summary.force_ratio_mean, 3),
+            ratio_text(summary.energy_ratio, 3),
             summary.kinetic_resets,
             wall,
             dir.path().display()
         );
     }
-    if summary.outcome == "interrupted" {
+    if interrupted {
         return ExitCode::from(INTERRUPTED_EXIT);
     }
     ExitCode::SUCCESS
-}
-
-/// A ratio for the terminal: its value, or `undefined` (zero denominator).
-fn ratio(r: f64) -> String {
-    if is_defined(r) {
-        format!("{r:.3e}")
-    } else {
-        "undefined".into()
-    }
 }
 
 fn print_profile(summary: &Summary) {

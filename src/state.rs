@@ -73,6 +73,12 @@ impl Gravity {
             1.0
         }
     }
+
+    /// The fraction of full gravity applied in the step that ends at `time` (s): the load
+    /// of a step acts over [t − Δt, t], so a ramp uses its start.
+    pub fn step_factor(&self, time: f64, dt: f64) -> f64 {
+        self.factor(time - dt)
+    }
 }
 
 /// A confirmation that a state meeting K_F and K_E is really static: the run goes on for

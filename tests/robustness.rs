@@ -377,7 +377,7 @@ fn a_non_finite_value_stops_the_run_with_the_last_finite_state() {
             !json.contains("null") && !json.to_lowercase().contains("nan"),
             "{json}"
         );
-        assert_eq!(summary.outcome, "failed");
+        assert_eq!(summary.outcome, kdmpm::output::Outcome::Failed);
         assert!(summary.kinetic_energy.is_finite() && summary.kinetic_energy > 0.0);
     }
 }

@@ -143,12 +143,17 @@ const ROW_BUFFER: usize = 64 * 1024;
 impl RowFile {
     /// Creates (or empties) `path`.
     pub fn create(path: &Path) -> std::io::Result<Self> {
-        Ok(RowFile {
-            file: File::create(path)?,
+        Ok(Self::at(File::create(path)?, 0))
+    }
+
+    /// Rows appended to `file`, which holds `committed` bytes of whole rows.
+    fn at(file: File, committed: u64) -> Self {
+        RowFile {
+            file,
             buffer: Vec::with_capacity(ROW_BUFFER),
             flushed: std::time::Instant::now(),
-            committed: 0,
-        })
+            committed,
+        }
     }
 
     /// Opens `path` to continue after its first `bytes` bytes; what follows them (rows of
@@ -166,12 +171,7 @@ impl RowFile {
         }
         file.set_len(bytes)?;
         file.seek(SeekFrom::Start(bytes))?;
-        Ok(RowFile {
-            file,
-            buffer: Vec::with_capacity(ROW_BUFFER),
-            flushed: std::time::Instant::now(),
-            committed: bytes,
-        })
+        Ok(Self::at(file, bytes))
     }
 
     /// Adds one row (its text must end with a newline).

@@ -5,7 +5,7 @@ use crate::error::StepError;
 use crate::output::dir::RowFile;
 use crate::schedule::System;
 use crate::simulation::{Context, TracedPoint};
-use crate::systems::convergence::is_defined;
+use crate::systems::convergence::ratio_text;
 use std::marker::PhantomData;
 use std::path::Path;
 use std::sync::{Arc, Mutex, MutexGuard};
@@ -25,7 +25,7 @@ pub struct History<D> {
 }
 
 /// The column names of `history.csv` for these traced points.
-pub fn header<D: Dim>(traced: &[TracedPoint]) -> Vec<String> {
+fn header<D: Dim>(traced: &[TracedPoint]) -> Vec<String> {
     let mut header: Vec<String> = [
         "step",
         "time",
@@ -96,15 +96,6 @@ pub fn lock(rows: &Mutex<RowFile>) -> MutexGuard<'_, RowFile> {
     rows.lock().unwrap_or_else(|e| e.into_inner())
 }
 
-/// A ratio K_F or K_E as written: `undefined` where its denominator was zero.
-fn ratio(r: f64) -> String {
-    if is_defined(r) {
-        format!("{r:.9e}")
-    } else {
-        "undefined".into()
-    }
-}
-
 impl<D: Dim> System<D> for History<D> {
     fn name(&self) -> &str {
         "history"
@@ -120,9 +111,9 @@ impl<D: Dim> System<D> for History<D> {
             format!("{:.9e}", s.time),
             format!("{:.9e}", s.kinetic_energy),
             format!("{:.9e}", s.external_work),
-            ratio(s.force_ratio_max),
-            ratio(s.force_ratio_mean),
-            ratio(s.energy_ratio),
+            ratio_text(s.force_ratio_max, 9),
+            ratio_text(s.force_ratio_mean, 9),
+            ratio_text(s.energy_ratio, 9),
             s.resets.to_string(),
         ];
         for t in &self.traced {

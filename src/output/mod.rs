@@ -7,4 +7,4 @@ pub mod vtk;
 
 pub use dir::{OutputDir, RowFile};
 pub use history::History;
-pub use summary::Summary;
+pub use summary::{Outcome, Summary};

@@ -17,9 +17,8 @@ pub struct Summary {
     pub scene: String,
     /// 2 or 3.
     pub dimension: usize,
-    /// How the run ended: `converged`, `max_steps`, `max_time`, `interrupted` (Ctrl-C;
-    /// `kdmpm resume` continues it) or `failed` (see `error`).
-    pub outcome: String,
+    /// How the run ended.
+    pub outcome: Outcome,
     /// True when K_F and K_E both reached the tolerance.
     pub converged: bool,
     /// Why the run stopped (absent after an error).
@@ -89,6 +88,22 @@ pub struct Summary {
     pub systems: Vec<Timing>,
 }
 
+/// How a run ended, as `summary.json` writes it (snake case).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Outcome {
+    /// K_F and K_E met the tolerance (and the static check, if any).
+    Converged,
+    /// The step limit came first.
+    MaxSteps,
+    /// The simulated-time limit came first.
+    MaxTime,
+    /// Stopped by Ctrl-C; `kdmpm resume` continues it from its checkpoint.
+    Interrupted,
+    /// Stopped by an error (see `error`).
+    Failed,
+}
+
 /// A ratio K_F or K_E: its value, or `"undefined"` where its denominator was zero.
 fn ratio<S: serde::Serializer>(r: &f64, s: S) -> Result<S::Ok, S::Error> {
     if is_defined(*r) {
@@ -114,11 +129,11 @@ impl Summary {
             scene: scene.to_string(),
             dimension: D::N,
             outcome: match (&error, s.stop) {
-                (Some(_), _) | (None, None) => "failed".into(),
-                (None, Some(stop)) => serde_json::to_value(stop)
-                    .ok()
-                    .and_then(|v| v.as_str().map(str::to_string))
-                    .unwrap_or_default(),
+                (Some(_), _) | (None, None) => Outcome::Failed,
+                (None, Some(StopReason::Converged)) => Outcome::Converged,
+                (None, Some(StopReason::MaxSteps)) => Outcome::MaxSteps,
+                (None, Some(StopReason::MaxTime)) => Outcome::MaxTime,
+                (None, Some(StopReason::Interrupted)) => Outcome::Interrupted,
             },
             converged: s.stop == Some(StopReason::Converged),
             stop_reason: if error.is_some() { None } else { s.stop },

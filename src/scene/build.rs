@@ -95,6 +95,14 @@ fn region_contains(region: &Region, x: [f64; 3], n: usize) -> bool {
     }
 }
 
+/// The cells `first..last` along one axis that the interval `lo..hi` (m) touches, clamped
+/// to the grid's `cells` (origin in m, `inv_h` = 1/h in 1/m).
+pub(super) fn cell_span(lo: f64, hi: f64, origin: f64, inv_h: f64, cells: usize) -> (usize, usize) {
+    let first = ((lo - origin) * inv_h).floor().max(0.0) as usize;
+    let last = (((hi - origin) * inv_h).ceil().max(0.0) as usize).min(cells);
+    (first, last)
+}
+
 /// Positions of the points filling `region`: centres of equal sub-cells of every grid cell,
 /// generated on demand (a body of a million points is never held twice in memory).
 fn fill_points<'a, D: Dim>(
@@ -106,10 +114,7 @@ fn fill_points<'a, D: Dim>(
     let (lo, hi) = region_bounds(region, n);
     let mut range = [(0usize, 1usize); 3];
     for a in 0..n {
-        let o = grid.origin.get(a);
-        let first = ((lo[a] - o) * grid.inv_h).floor().max(0.0) as usize;
-        let last = (((hi[a] - o) * grid.inv_h).ceil().max(0.0) as usize).min(grid.axes[a].cells);
-        range[a] = (first, last);
+        range[a] = cell_span(lo[a], hi[a], grid.origin.get(a), grid.inv_h, grid.axes[a].cells);
     }
     let sub = [ppc[0], ppc[1], if n == 3 { ppc[2] } else { 1 }];
     let o = D::vec_to3(grid.origin);

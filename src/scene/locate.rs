@@ -160,6 +160,18 @@ pub struct Edit {
     pub assignment: String,
 }
 
+impl Edit {
+    /// The dotted path the override set.
+    pub fn path(&self) -> &str {
+        self.assignment.split('=').next().unwrap_or("").trim()
+    }
+
+    /// " (set by --set `path=value`)", for messages about the value it set.
+    pub fn note(&self) -> String {
+        format!(" (set by --set `{}`)", self.assignment)
+    }
+}
+
 /// Where byte offset `at` of a text edited by `edits` (in the order applied) stood in the
 /// text before them, and the edit whose replacement holds it, if one does: messages point
 /// into the file the user wrote, not into the text the overrides made.

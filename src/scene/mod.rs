@@ -8,7 +8,7 @@ pub mod locate;
 mod validate;
 
 pub use build::build;
-use build::region_bounds;
+use build::{cell_span, region_bounds};
 pub use validate::{check, Checked, Derived, Estimate};
 
 use crate::error::SceneError;
@@ -397,25 +397,23 @@ impl LoadedScene {
             }
             .filter(|f| !message.contains(&format!("`{f}`")));
             let at = locate::offset(&text, line, column);
-            let (line, column, mut from) = Self::place(original, &edits, at);
+            let (line, column, inside) = Self::place(original, &edits, at);
             // A parser often notices a bad value just before or after it: name the
             // override that set a field of that name.
-            if let (true, Some(f)) = (from.is_empty(), &field) {
-                let leaf = |e: &&locate::Edit| {
-                    let path = e.assignment.split('=').next().unwrap_or("").trim();
-                    let last = path.rsplit('.').next().unwrap_or(path);
-                    last.split('[').next() == Some(f.as_str())
-                };
-                if let Some(e) = edits.iter().rev().find(leaf) {
-                    from = format!("(set by --set `{}`) ", e.assignment);
-                }
-            }
+            let leaf = |e: &&locate::Edit| {
+                let last = e.path().rsplit('.').next().unwrap_or_default();
+                field
+                    .as_deref()
+                    .is_some_and(|f| last.split('[').next() == Some(f))
+            };
+            let set_by = inside.or_else(|| edits.iter().rev().find(leaf));
+            let note = set_by.map_or(String::new(), |e| format!("{} ", e.note().trim_start()));
             let field = field.map_or(String::new(), |f| format!("field `{f}`: "));
             SceneError::Syntax {
                 path: path.to_path_buf(),
                 line,
                 column,
-                field: format!("{field}{from}"),
+                field: format!("{field}{note}"),
                 message,
             }
         })?;
@@ -429,34 +427,32 @@ impl LoadedScene {
     }
 
     /// 1-based (line, column) in the file as written of byte offset `at` of the edited
-    /// text, and a note naming the override when the offset lies in the value it set.
-    fn place(original: &str, edits: &[locate::Edit], at: usize) -> (usize, usize, String) {
+    /// text, and the override whose value holds the offset, if one does.
+    fn place<'a>(
+        original: &str,
+        edits: &'a [locate::Edit],
+        at: usize,
+    ) -> (usize, usize, Option<&'a locate::Edit>) {
         let (at, edit) = locate::original_offset(edits, at);
         let (line, column) = locate::line_column(original, at);
-        let note = edit.map_or(String::new(), |e| format!("(set by --set `{}`) ", e.assignment));
-        (line, column, note)
+        (line, column, edit)
     }
 
     /// An error for the field at dotted `field` path (e.g. `materials.soil.density`).
     pub fn invalid(&self, field: &str, rule: impl Into<String>) -> SceneError {
-        let (mut line, mut column, mut note) = (0, 0, String::new());
+        let (mut line, mut column, mut inside) = (0, 0, None);
         if let Some((l, c)) = locate::field_position(&self.text, field) {
             let at = locate::offset(&self.text, l, c);
-            let (l, c, set_by) = Self::place(&self.source, &self.edits, at);
-            (line, column) = (l, c);
-            if !set_by.is_empty() {
-                note = format!(" {}", set_by.trim_end());
-            }
+            (line, column, inside) = Self::place(&self.source, &self.edits, at);
         }
         // A value replaced whole by an override: its name stands in the file, its value
         // does not.
-        let set = self.edits.iter().rev().find(|e| {
-            let path = e.assignment.split('=').next().unwrap_or("").trim();
+        let replaced = |e: &&locate::Edit| {
+            let path = e.path();
             field == path || field.starts_with(&format!("{path}.")) || field.starts_with(&format!("{path}["))
-        });
-        if let (true, Some(e)) = (note.is_empty(), set) {
-            note = format!(" (set by --set `{}`)", e.assignment);
-        }
+        };
+        let set_by = inside.or_else(|| self.edits.iter().rev().find(replaced));
+        let note = set_by.map_or(String::new(), locate::Edit::note);
         SceneError::Invalid {
             path: self.path.clone(),
             line,

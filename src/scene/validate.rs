@@ -119,14 +119,10 @@ fn estimate(loaded: &LoadedScene, table: &[(String, MaterialModel)]) -> Result<E
         let (lo, hi) = super::region_bounds(&body.region, n);
         let mut count = 1u64;
         for a in 0..n {
-            // Cells of the bounding box along the axis, clamped to the grid.
-            let o = s.grid.origin[a];
-            let first = ((lo[a] - o) / s.grid.cell_size).floor().max(0.0);
-            let last = ((hi[a] - o) / s.grid.cell_size)
-                .ceil()
-                .clamp(0.0, s.grid.cells[a] as f64);
-            let cells = (last - first).max(0.0) as u64;
-            count = cells
+            // Cells of the bounding box along the axis, as set-up fills them.
+            let inv_h = 1.0 / s.grid.cell_size;
+            let (first, last) = super::cell_span(lo[a], hi[a], s.grid.origin[a], inv_h, s.grid.cells[a]);
+            count = (last.saturating_sub(first) as u64)
                 .checked_mul(body.points_per_cell[a] as u64)
                 .and_then(|c| count.checked_mul(c))
                 .ok_or_else(|| too_many(&field, "the point count"))?;
@@ -308,18 +304,6 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
         if !(0.0..0.5).contains(&nu) {
             return bad(&at("poisson_ratio"), format!("must be in [0, 0.5), found {nu}"));
         }
-        // The P-wave speed sets the time step: it must be a finite number > 0 (an E near
-        // the largest double overflows M, a density near the smallest overflows M/ρ).
-        let speed = (LinearElastic::new(rho, e, nu).p_wave_modulus() / rho).sqrt();
-        if !positive(speed) {
-            return bad(
-                &at("youngs_modulus"),
-                format!(
-                    "E = {e} Pa with ρ = {rho} kg/m³ and ν = {nu} gives a P-wave speed of {speed} m/s, \
-                     not a finite number > 0"
-                ),
-            );
-        }
         let model = match m {
             MaterialSpec::LinearElastic { .. } => {
                 MaterialModel::LinearElastic(LinearElastic::new(rho, e, nu))
@@ -364,6 +348,18 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
                 MaterialModel::MohrCoulomb(MohrCoulomb::new(rho, e, nu, c, phi, psi, *tension_cutoff))
             }
         };
+        // The P-wave speed sets the time step: it must be a finite number > 0 (an E near
+        // the largest double overflows M, a density near the smallest overflows M/ρ).
+        let speed = (model.p_wave_modulus() / model.density()).sqrt();
+        if !positive(speed) {
+            return bad(
+                &at("youngs_modulus"),
+                format!(
+                    "E = {e} Pa with ρ = {rho} kg/m³ and ν = {nu} gives a P-wave speed of {speed} m/s, \
+                     not a finite number > 0"
+                ),
+            );
+        }
         table.push((name.clone(), model));
     }
     if !positive(s.solver.tolerance) {

@@ -24,6 +24,15 @@ pub fn is_defined(ratio: f64) -> bool {
     !ratio.is_nan()
 }
 
+/// A ratio as text: in scientific notation with `digits` decimals, or `undefined`.
+pub fn ratio_text(ratio: f64, digits: usize) -> String {
+    if is_defined(ratio) {
+        format!("{ratio:.digits$e}")
+    } else {
+        "undefined".into()
+    }
+}
+
 /// Force-ratio sums over the free degrees of freedom of nodes that carry mass.
 ///
 /// Fixed components are left out (their reaction keeps K_F near 1 for ever), and so are
@@ -173,9 +182,11 @@ impl<D: Dim> System<D> for Convergence {
         }
         let tol = ctx.settings.tolerance;
         let (step, time) = (s.step, s.time);
-        // A load still ramping up is not a static state, however balanced this step is:
-        // the load of this step acted over [t − Δt, t] (see `systems::gravity`).
-        let loading = ctx.settings.gravity.is_some_and(|g| g.factor(time - s.dt) < 1.0);
+        // A load still ramping up is not a static state, however balanced this step is.
+        let loading = ctx
+            .settings
+            .gravity
+            .is_some_and(|g| g.step_factor(time, s.dt) < 1.0);
         // An undefined ratio (NaN) compares false: it never meets the tolerance.
         let met = !loading && s.force_ratio(ctx.settings.force_norm) <= tol && s.energy_ratio <= tol;
         let converged = match ctx.settings.static_check {

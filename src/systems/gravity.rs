@@ -28,8 +28,7 @@ impl<D: Dim> System<D> for Gravity {
         "gravity"
     }
     fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
-        // The load of this step acts over [t − Δt, t]; ramps use its start.
-        let g = self.spec.factor(ctx.state.time - ctx.state.dt);
+        let g = self.spec.step_factor(ctx.state.time, ctx.state.dt);
         let a = self.spec.acceleration;
         let gv = D::vec_from([a[0] * g, a[1] * g, a[2] * g]);
         let n = nodes(&ctx.world);
