@@ -384,20 +384,18 @@ fn a_non_finite_value_stops_the_run_with_the_last_finite_state() {
 
 #[test]
 fn a_failed_run_writes_neither_null_nor_nan() {
-    // USL at Courant 1 on the slope: a point leaves the grid (exit 1).
+    // The column without its fixed base falls through the bottom of the grid (exit 1).
     let dir = scratch("failed");
     let out = dir.join("out");
-    let slope = common::scene("slope.ron");
+    let column = common::scene("soil_column.ron");
     let o = kdmpm(&[
         "run",
-        slope.to_str().unwrap(),
+        column.to_str().unwrap(),
         "--quiet",
         "--out",
         out.to_str().unwrap(),
         "--set",
-        "solver.scheme=Usl",
-        "--set",
-        "solver.time_step=Courant(1.0)",
+        "boundaries=[(face: XMin, condition: Roller), (face: XMax, condition: Roller)]",
     ]);
     assert_eq!(o.status.code(), Some(1), "{}", String::from_utf8_lossy(&o.stderr));
     let summary = std::fs::read_to_string(out.join("summary.json")).unwrap();

@@ -5,7 +5,13 @@ use super::{LoadedScene, MaterialSpec, Region, TimeStep};
 use crate::error::SceneError;
 use crate::materials::{LinearElastic, Material, MaterialModel, MohrCoulomb};
 use crate::shape::ShapeKind;
+use crate::state::Scheme;
 use serde::Serialize;
+
+/// The largest Courant number accepted with the USL scheme. Measured on the self-weight
+/// column (`studies/courant.ron`): USL with linear shapes diverges from Courant 0.8 and with
+/// quadratic B-splines never settles at 1.0; on the 2D slope it loses a point at Courant 1.
+pub const USL_COURANT_LIMIT: f64 = 0.7;
 
 /// Figures derived from a valid scene (printed by `kdmpm check`).
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
@@ -376,6 +382,14 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
             );
         }
     }
+    if let crate::state::Damping::Local { alpha } = s.solver.damping {
+        if !(non_negative(alpha) && alpha < 1.0) {
+            return bad(
+                "solver.damping",
+                format!("local damping α must be in [0, 1), found {alpha}"),
+            );
+        }
+    }
     if let Some(c) = s.solver.static_check {
         if !positive(c.window) {
             return bad(
@@ -619,6 +633,15 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
             a * dt_crit
         }
     };
+    if s.solver.scheme == Scheme::Usl && dt > USL_COURANT_LIMIT * dt_crit * (1.0 + 1e-12) {
+        return bad(
+            "solver.time_step",
+            format!(
+                "Δt = {dt:.6e} s is Courant {:.3}; USL is unstable above Courant {USL_COURANT_LIMIT}                  (it diverges or never settles there, see docs/verification.md): use Courant({USL_COURANT_LIMIT})                  or less, or scheme Musl or Usf, which are stable up to 1",
+                dt / dt_crit
+            ),
+        );
+    }
     // A time step that rounds to zero or to a subnormal never advances the clock: the run
     // would write history rows for ever without getting anywhere.
     if !dt.is_normal() {
