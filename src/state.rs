@@ -29,6 +29,14 @@ pub enum Damping {
         /// Damping factor β (1/s).
         beta: f64,
     },
+    /// Local non-viscous damping (Cundall 1987, FLAC's default): each free nodal force
+    /// component is opposed by α |F| in the direction of the node's velocity,
+    /// F_damp = −α |F| sign(v), so a node speeding up and a node slowing down are both
+    /// held back in proportion to their unbalanced force, not their speed.
+    Local {
+        /// Damping fraction α, 0 ≤ α < 1 (FLAC: 0.8).
+        alpha: f64,
+    },
 }
 
 /// Which norm of the out-of-balance force the stopping rule reads (both are always reported).

@@ -9,8 +9,9 @@ use crate::schedule::System;
 use crate::simulation::Context;
 use crate::state::Damping;
 
-/// a_i = (f_i − 2β p_i)/max(m_i, m_floor) and v_i ← p_i/m_i + a_i Δt (explicit Euler on the
-/// grid). Viscous damping F_damp = 2β M v enters here; massless nodes get no motion.
+/// a_i = (f_i + f_damp)/max(m_i, m_floor) and v_i ← p_i/m_i + a_i Δt (explicit Euler on the
+/// grid). Viscous damping f_damp = −2β m_i v_i and local damping f_damp,a = −α |f_a| sign(v_a)
+/// enter here; massless nodes get no motion.
 ///
 /// m_floor ([`crate::state::Settings::virtual_mass_floor`]) is a virtual mass for nodes that
 /// only the far tail of a point's support reaches: such a node has almost no mass but takes
@@ -27,6 +28,10 @@ impl<D: Dim> System<D> for Integrate {
         let dt = ctx.state.dt;
         let beta2 = match ctx.settings.damping {
             Damping::Viscous { beta } => 2.0 * beta,
+            _ => 0.0,
+        };
+        let alpha = match ctx.settings.damping {
+            Damping::Local { alpha } => alpha,
             _ => 0.0,
         };
         let min_mass = ctx.settings.min_node_mass;
@@ -46,7 +51,17 @@ impl<D: Dim> System<D> for Integrate {
             if grid.carries(i, m, min_mass) {
                 // Dynamic relaxation's mass matrix is fictitious: a floor on the mass that
                 // accelerates a light node changes the path, never the static answer.
-                let a = (nf[i].0 - np[i].0 * beta2) * (1.0 / grid.inertia(i, m, floor));
+                let mut f = nf[i].0 - np[i].0 * beta2;
+                if alpha > 0.0 {
+                    // Local damping: −α |F_a| sign(v_a) per component; none at rest.
+                    for a in 0..D::N {
+                        let (fa, pa) = (f.get(a), np[i].0.get(a));
+                        if pa != 0.0 {
+                            f.set(a, fa - alpha * fa.abs() * pa.signum());
+                        }
+                    }
+                }
+                let a = f * (1.0 / grid.inertia(i, m, floor));
                 na[k].0 = a;
                 nv[k].0 = np[i].0 * (1.0 / m) + a * dt;
             } else {
