@@ -29,6 +29,7 @@ pub mod schedule;
 pub mod shape;
 pub mod simulation;
 pub mod state;
+pub mod study;
 pub mod systems;
 pub mod tensor;
 #[cfg(test)]

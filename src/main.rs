@@ -70,6 +70,22 @@ enum Command {
         #[command(flatten)]
         stepping: Stepping,
     },
+    /// Run a speed–accuracy study: a scene over axes of settings, each run compared with an
+    /// analytic value or a reference run; writes study.csv, pareto.svg (and convergence.csv
+    /// over a refinement axis) and prints the Pareto front.
+    Study {
+        /// Study file (RON; see docs/studies.md).
+        study: PathBuf,
+        /// Output directory (default: out/study-<study file stem>).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Worker threads of each run (default: all cores).
+        #[arg(long)]
+        threads: Option<std::num::NonZeroUsize>,
+        /// Print nothing but errors.
+        #[arg(long, short)]
+        quiet: bool,
+    },
     /// Parse and validate a scene without running it; print the derived figures.
     Check {
         /// Scene file (RON).
@@ -88,6 +104,12 @@ const RUN_FAILED: u8 = 1;
 fn main() -> ExitCode {
     match Cli::parse().command {
         Command::Check { scene, overrides } => check(&scene, &overrides),
+        Command::Study {
+            study,
+            out,
+            threads,
+            quiet,
+        } => run_study(&study, out, threads, quiet),
         Command::Resume { dir, stepping } => match start_threads(stepping.threads) {
             Ok(()) => resume(&dir, stepping.profile, stepping.quiet),
             Err(code) => code,
@@ -451,5 +473,160 @@ fn print_profile(summary: &Summary) {
             "{:<18} {:>10} {:>12.4} {:>12.2} {:>6.1}%",
             t.name, t.calls, t.seconds, mean, share
         );
+    }
+}
+
+/// `kdmpm study`: plans and checks every run, runs the reference then the rest (skipping
+/// those an earlier invocation completed), and writes the study's table and picture.
+fn run_study(
+    path: &Path,
+    out: Option<PathBuf>,
+    threads: Option<std::num::NonZeroUsize>,
+    quiet: bool,
+) -> ExitCode {
+    use kdmpm::study::{self, Launch, Study};
+    let study = match Study::from_file(path) {
+        Ok(s) => s,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(BAD_INPUT);
+        }
+    };
+    let stem = path
+        .file_stem()
+        .map_or("study".into(), |s| s.to_string_lossy().into_owned());
+    let out = out.unwrap_or_else(|| Path::new("out").join(format!("study-{stem}")));
+    let dir = match OutputDir::claim(&out) {
+        Ok(d) => d,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(BAD_INPUT);
+        }
+    };
+    let exe = match std::env::current_exe() {
+        Ok(e) => e,
+        Err(e) => {
+            eprintln!("error: cannot find the kdmpm executable to launch runs: {e}");
+            return ExitCode::from(RUN_FAILED);
+        }
+    };
+    let launch = Launch {
+        exe,
+        threads: threads.map(|n| n.get()),
+    };
+    let total = study.runs.len() + usize::from(study.reference.is_some());
+    let progress = Progress::new(total as u64, quiet);
+    let mut run = |planned: &study::Planned| {
+        progress.start(planned);
+        let r = study::run_one(&study, planned, &dir, &launch);
+        if let Ok(f) = &r {
+            progress.finish(f);
+        }
+        r
+    };
+    let reference = match study.reference.as_ref().map(&mut run).transpose() {
+        Ok(r) => r,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(RUN_FAILED);
+        }
+    };
+    let mut finished = Vec::with_capacity(study.runs.len());
+    for planned in &study.runs {
+        match run(planned) {
+            Ok(f) => finished.push(f),
+            Err(e) => {
+                eprintln!("error: {e}");
+                return ExitCode::from(RUN_FAILED);
+            }
+        }
+    }
+    progress.done();
+    match study::write_results(&study, &dir, reference.as_ref(), &finished) {
+        Ok(study::Results { rows, front, orders }) => {
+            if !quiet {
+                print!("{}", study::front_table(&study, &rows, &front));
+                if !orders.is_empty() {
+                    print!("{}", study::orders_table(&orders));
+                }
+                println!("→ {}", dir.path().display());
+            }
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(RUN_FAILED)
+        }
+    }
+}
+
+/// Progress over a study's runs: a bar on a terminal, a line a run otherwise, nothing
+/// with `--quiet`.
+struct Progress {
+    bar: Option<indicatif::ProgressBar>,
+    lines: bool,
+    total: u64,
+    done: std::cell::Cell<u64>,
+}
+
+impl Progress {
+    fn new(total: u64, quiet: bool) -> Self {
+        use std::io::IsTerminal;
+        let terminal = std::io::stderr().is_terminal();
+        let bar = (!quiet && terminal).then(|| {
+            let bar = indicatif::ProgressBar::new(total);
+            bar.set_style(
+                indicatif::ProgressStyle::with_template(
+                    "{bar:30} {pos}/{len} runs, {elapsed} elapsed, ~{eta} left  {msg}",
+                )
+                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+            );
+            bar
+        });
+        Progress {
+            bar,
+            lines: !quiet && !terminal,
+            total,
+            done: std::cell::Cell::new(0),
+        }
+    }
+
+    fn start(&self, run: &kdmpm::study::Planned) {
+        if let Some(bar) = &self.bar {
+            bar.set_message(format!("{} {}", run.id, run.values.join(", ")));
+        }
+    }
+
+    fn finish(&self, f: &kdmpm::study::Finished) {
+        self.done.set(self.done.get() + 1);
+        let text = format!(
+            "{} [{}] {}: {} in {:.1} s{}",
+            f.run.id,
+            if f.run.values.is_empty() {
+                "reference".into()
+            } else {
+                f.run.values.join(", ")
+            },
+            self.done.get(),
+            f.outcome,
+            f.wall_seconds,
+            if f.reused {
+                " (from an earlier invocation)"
+            } else {
+                ""
+            }
+        );
+        if let Some(bar) = &self.bar {
+            bar.println(text);
+            bar.inc(1);
+        } else if self.lines {
+            eprintln!("run {}/{}: {text}", self.done.get(), self.total);
+        }
+    }
+
+    fn done(&self) {
+        if let Some(bar) = &self.bar {
+            bar.finish_and_clear();
+        }
     }
 }

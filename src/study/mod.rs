@@ -1,0 +1,217 @@
+//! Speed against accuracy: a study runs one scene over axes of settings, each run a normal
+//! `kdmpm run` into its own directory, and tabulates outcome, cost and the signed relative
+//! error of each measured quantity; it marks the Pareto front of error against wall time
+//! and, over a `Refine` axis, the observed order of convergence.
+//!
+//! A run that fails, diverges or does not stop is a row with its outcome. A run whose
+//! directory holds a completion record for the same overrides is not run again, so an
+//! interrupted study started again continues where it stopped.
+
+mod plot;
+mod report;
+mod spec;
+
+pub use report::{convergence_orders, pareto_front, Order, Row};
+pub use spec::{
+    expected, read, relative_error, Axis, Combine, Compare, Planned, Quantity, QuantitySpec, Study, StudySpec,
+};
+
+use crate::output::{dir::write_atomic, OutputDir};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+/// The file in a run's directory that records a completed run: its overrides, exit status
+/// and wall time. Written last, atomically.
+pub const RECORD: &str = "study-run.txt";
+
+/// How the runs are launched.
+#[derive(Clone, Debug)]
+pub struct Launch {
+    /// The `kdmpm` executable.
+    pub exe: PathBuf,
+    /// `--threads` for each run.
+    pub threads: Option<usize>,
+}
+
+/// Why a study could not go on (its runs' own failures are rows, not errors).
+#[derive(Debug, thiserror::Error)]
+pub enum StudyError {
+    /// The study's output directory or a file in it could not be used.
+    #[error("{0}")]
+    Output(String),
+}
+
+/// What one finished (or reused) run left.
+#[derive(Clone, Debug)]
+pub struct Finished {
+    /// The planned run.
+    pub run: Planned,
+    /// Outcome: the summary's, or `crashed (exit N)` / `timeout` / `no summary`.
+    pub outcome: String,
+    /// Wall-clock seconds of the whole command (set-up, stepping, output).
+    pub wall_seconds: f64,
+    /// The run's `summary.json`, when it wrote one.
+    pub summary: Option<serde_json::Value>,
+    /// True when an earlier invocation ran it.
+    pub reused: bool,
+}
+
+/// Runs (or reuses) one planned run in `dir/<id>`.
+pub fn run_one(
+    study: &Study,
+    run: &Planned,
+    dir: &OutputDir,
+    launch: &Launch,
+) -> Result<Finished, StudyError> {
+    if let Some(rule) = &run.refused {
+        return Ok(Finished {
+            run: run.clone(),
+            outcome: format!("refused: {rule}"),
+            wall_seconds: 0.0,
+            summary: None,
+            reused: false,
+        });
+    }
+    let out = dir.file(&run.id);
+    let record_text = record_head(run);
+    if let Ok(text) = std::fs::read_to_string(out.join(RECORD)) {
+        if let Some(rest) = text.strip_prefix(&record_head(run)) {
+            let mut outcome = None;
+            let mut wall = None;
+            for line in rest.lines() {
+                if let Some(v) = line.strip_prefix("outcome=") {
+                    outcome = Some(v.to_string());
+                }
+                if let Some(v) = line.strip_prefix("wall_seconds=") {
+                    wall = v.parse().ok();
+                }
+            }
+            if let (Some(outcome), Some(wall_seconds)) = (outcome, wall) {
+                return Ok(Finished {
+                    run: run.clone(),
+                    outcome,
+                    wall_seconds,
+                    summary: read_summary(&out),
+                    reused: true,
+                });
+            }
+        }
+    }
+    let mut cmd = Command::new(&launch.exe);
+    cmd.arg("run")
+        .arg(&study.scene)
+        .arg("--out")
+        .arg(&out)
+        .arg("--quiet");
+    if let Some(n) = launch.threads {
+        cmd.arg("--threads").arg(n.to_string());
+    }
+    for o in &run.overrides {
+        cmd.arg("--set").arg(o);
+    }
+    std::fs::create_dir_all(&out)
+        .map_err(|e| StudyError::Output(format!("cannot create {}: {e}", out.display())))?;
+    let stderr = std::fs::File::create(out.join("stderr.txt"))
+        .map_err(|e| StudyError::Output(format!("cannot write {}: {e}", out.join("stderr.txt").display())))?;
+    cmd.stdout(Stdio::null()).stderr(stderr);
+    let start = Instant::now();
+    let mut child = cmd
+        .spawn()
+        .map_err(|e| StudyError::Output(format!("cannot start {}: {e}", launch.exe.display())))?;
+    let limit = study.spec.run_limit.map(Duration::from_secs_f64);
+    let status = loop {
+        match child.try_wait() {
+            Ok(Some(status)) => break Some(status),
+            Ok(None) => {}
+            Err(e) => return Err(StudyError::Output(format!("cannot wait for run {}: {e}", run.id))),
+        }
+        if limit.is_some_and(|l| start.elapsed() > l) {
+            // A run past its limit is stopped; it is a row with outcome `timeout`.
+            let _ = child.kill();
+            let _ = child.wait();
+            break None;
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    let wall_seconds = start.elapsed().as_secs_f64();
+    let summary = read_summary(&out);
+    let outcome = match (&status, &summary) {
+        (None, _) => "timeout".to_string(),
+        (Some(_), Some(s)) => s["outcome"].as_str().unwrap_or("unknown").to_string(),
+        (Some(st), None) => match st.code() {
+            Some(2) => "bad input (exit 2)".into(),
+            Some(c) => format!("crashed (exit {c})"),
+            None => "crashed (signal)".into(),
+        },
+    };
+    let record = format!("{record_text}outcome={outcome}\nwall_seconds={wall_seconds}\n");
+    write_atomic(&out.join(RECORD), |w| w.write_all(record.as_bytes()))
+        .map_err(|e| StudyError::Output(format!("cannot write {}: {e}", out.join(RECORD).display())))?;
+    Ok(Finished {
+        run: run.clone(),
+        outcome,
+        wall_seconds,
+        summary,
+        reused: false,
+    })
+}
+
+/// The part of a completion record that names the run: a record for other overrides is
+/// not this run's.
+fn record_head(run: &Planned) -> String {
+    let mut s = String::new();
+    for o in &run.overrides {
+        s.push_str("set ");
+        s.push_str(o);
+        s.push('\n');
+    }
+    s
+}
+
+fn read_summary(dir: &Path) -> Option<serde_json::Value> {
+    let text = std::fs::read_to_string(dir.join("summary.json")).ok()?;
+    serde_json::from_str(&text).ok()
+}
+
+/// A study's table, its Pareto front (row indices, fastest first) and the observed orders.
+#[derive(Clone, Debug)]
+pub struct Results {
+    /// One row a run.
+    pub rows: Vec<Row>,
+    /// Indices into `rows` of the Pareto-optimal runs.
+    pub front: Vec<usize>,
+    /// Orders of convergence over a `Refine` axis.
+    pub orders: Vec<Order>,
+}
+
+/// Everything a study writes: `study.csv`, `pareto.svg`, and `convergence.csv` over a
+/// `Refine` axis.
+pub fn write_results(
+    study: &Study,
+    dir: &OutputDir,
+    reference: Option<&Finished>,
+    finished: &[Finished],
+) -> Result<Results, StudyError> {
+    let rows: Vec<Row> = finished.iter().map(|f| Row::new(study, f, reference)).collect();
+    let io = |file: &str, e: std::io::Error| {
+        StudyError::Output(format!("cannot write {}: {e}", dir.file(file).display()))
+    };
+    let csv = report::csv(study, &rows);
+    dir.write_atomic("study.csv", |w| w.write_all(csv.as_bytes()))
+        .map_err(|e| io("study.csv", e))?;
+    let front = pareto_front(&rows);
+    let svg = plot::pareto_svg(study, &rows, &front);
+    dir.write_atomic("pareto.svg", |w| w.write_all(svg.as_bytes()))
+        .map_err(|e| io("pareto.svg", e))?;
+    let orders = convergence_orders(study, &rows);
+    if !orders.is_empty() {
+        let text = report::orders_csv(&orders);
+        dir.write_atomic("convergence.csv", |w| w.write_all(text.as_bytes()))
+            .map_err(|e| io("convergence.csv", e))?;
+    }
+    Ok(Results { rows, front, orders })
+}
+
+pub use report::{front_table, orders_table};
