@@ -6,7 +6,7 @@ use super::spec::Study;
 use plotters::prelude::*;
 
 /// The picture as SVG text. Runs that did not stop at a static state, or lack a quantity,
-/// are left out and counted in the caption.
+/// are left out and counted in the caption; a zero error sits on the axis' floor.
 pub fn pareto_svg(study: &Study, rows: &[Row], front: &[usize]) -> String {
     let mut svg = String::new();
     let points: Vec<(usize, f64, f64)> = rows
@@ -54,7 +54,7 @@ fn draw<'a>(
         let lo = v.iter().copied().fold(f64::INFINITY, f64::min);
         let hi = v.iter().copied().fold(0.0f64, f64::max);
         if lo.is_finite() && hi > 0.0 {
-            (lo / 2.0, hi * 2.0)
+            (lo / 1.5, hi * 1.5)
         } else {
             default
         }
@@ -77,7 +77,18 @@ fn draw<'a>(
         .x_desc("wall time of the run (s)")
         .y_desc("worst |relative error| over the quantities")
         .y_label_formatter(&|v| format!("{v:.0e}"))
-        .x_label_formatter(&|v| format!("{v:.3}"))
+        .x_labels(8)
+        .y_labels(8)
+        .light_line_style(WHITE)
+        .x_label_formatter(&|v| {
+            if *v >= 10.0 {
+                format!("{v:.0}")
+            } else if *v >= 1.0 {
+                format!("{v:.1}")
+            } else {
+                format!("{v:.2}")
+            }
+        })
         .label_style(("sans-serif", 15))
         .draw()?;
     chart
@@ -104,7 +115,7 @@ fn draw<'a>(
         .legend(|(x, y)| Circle::new((x, y), 6, RED.filled()));
     chart
         .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
+        .position(SeriesLabelPosition::LowerLeft)
         .border_style(BLACK)
         .background_style(WHITE.mix(0.9))
         .label_font(("sans-serif", 14))
