@@ -104,3 +104,45 @@ fn slope_steeper_friction_than_its_face_stands() {
     assert!((angle - 30.0).abs() <= 1.0, "angle {angle}");
     assert!(moved <= 0.01, "not static: {moved} m in 10 s");
 }
+
+/// The shipped slope.ron's resting state (2 threads or 1: the run is deterministic):
+/// `kdmpm run scenes/slope.ron` prints surface angle 18.994° and crest u_x 22.516 m.
+const REFERENCE_ANGLE: f64 = 18.994;
+const REFERENCE_CREST_UX: f64 = 22.516;
+
+#[test]
+fn the_fast_preset_comes_to_rest_where_the_paper_settings_do() {
+    // scenes/slope_fast.ron (USF, Courant 0.8, a 2 s static check): within 0.25° of the surface
+    // angle and 3 % of the crest's run-out of slope.ron, the target of the fast preset.
+    let mut sim = scene("slope_fast.ron", &[]);
+    with_simulation!(&mut sim, s => {
+        s.run(|_| {}).expect("runs");
+        assert_eq!(s.ctx.state.stop, Some(StopReason::Converged));
+        let angle = surface_angle(s).expect("a surface").degrees;
+        let crest = s.traced_results().into_iter().find(|t| t.name == "crest").unwrap();
+        println!("fast preset: {} steps, angle {angle:.3}°, crest u_x {:.3} m", s.ctx.state.step, crest.displacement[0]);
+        assert!((angle - REFERENCE_ANGLE).abs() <= 0.25, "angle {angle}");
+        assert!((crest.displacement[0] / REFERENCE_CREST_UX - 1.0).abs() <= 0.03, "crest u_x {}", crest.displacement[0]);
+    });
+}
+
+#[test]
+fn the_fast_preset_still_refuses_the_creeping_slope() {
+    // The creeping set-up of `a_creeping_slope_is_not_declared_static` with the preset's
+    // 2 s window: the slope moves centimetres in a window, so it must not stop.
+    let mut sim = scene(
+        "slope_fast.ron",
+        &[
+            "solver.max_time=30",
+            "solver.virtual_mass_floor=0",
+            "solver.node_mass_cutoff=1e-9",
+        ],
+    );
+    with_simulation!(&mut sim, s => {
+        s.run(|_| {}).expect("runs");
+        let st = &s.ctx.state;
+        assert_eq!(st.stop, Some(StopReason::MaxTime));
+        let moved = st.static_window_movement.expect("K_F and K_E were met and a window closed");
+        assert!(moved > 0.01, "a window moved only {moved} m");
+    });
+}
