@@ -121,7 +121,10 @@ fn displacements_are_kept_only_when_asked_for_and_traced_points_do_without() {
     };
     kept.run(|_| {}).unwrap();
     let with = kept.traced_results()[0].displacement;
-    assert!(with[0] != 0.0 && without == with, "{without:?} vs {with:?}");
+    // Without the column a traced point reports x − x₀, with it the accumulated Σ Δt v: the
+    // same displacement up to the positions' rounding (an ulp of 10 m is 1.8e-15 m a step).
+    let gap = (0..3).map(|a| (without[a] - with[a]).abs()).fold(0.0, f64::max);
+    assert!(with[0] != 0.0 && gap <= 50.0 * 1.8e-15, "{without:?} vs {with:?}");
     let (max_u, _) = max_displacements(&kept).expect("kept by default");
     assert!(max_u >= with[0].abs());
 }
