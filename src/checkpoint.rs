@@ -26,7 +26,7 @@ use thiserror::Error;
 /// The first bytes of a checkpoint file.
 const MAGIC: &[u8; 8] = b"KDMPMCK\0";
 /// Format version; a file of another version is refused.
-const VERSION: u32 = 1;
+const VERSION: u32 = 2;
 /// The file's name in an output directory.
 pub const FILE_NAME: &str = "checkpoint.kdc";
 
@@ -178,6 +178,8 @@ fn encode_state(w: &mut Writer, s: &SolverState) {
     w.f64(s.dt);
     w.f64(s.kinetic_energy);
     w.f64(s.previous_kinetic_energy);
+    w.f64(s.earlier_kinetic_energy);
+    w.f64(s.reset_fraction);
     w.f64(s.external_work);
     w.f64(s.force_ratio_max);
     w.f64(s.force_ratio_mean);
@@ -206,6 +208,8 @@ fn decode_state(r: &mut Reader) -> Result<SolverState, CheckpointError> {
         dt: r.f64()?,
         kinetic_energy: r.f64()?,
         previous_kinetic_energy: r.f64()?,
+        earlier_kinetic_energy: r.f64()?,
+        reset_fraction: r.f64()?,
         external_work: r.f64()?,
         force_ratio_max: r.f64()?,
         force_ratio_mean: r.f64()?,

@@ -127,6 +127,9 @@ pub struct Settings {
     pub volumetric_smoothing: bool,
     /// Put the points back in cell order every this many steps (0: never).
     pub sort_every: u64,
+    /// Kinetic damping places each reset at the peak of a parabola through the last three
+    /// kinetic energies instead of at the step where the drop was seen.
+    pub peak_interpolation: bool,
     /// Smallest mass that accelerates an interior node (kg): a_i = f_i / max(m_i, floor),
     /// scaled on the grid's faces by the node's share ([`crate::grid::Grid::inertia`]).
     pub virtual_mass_floor: f64,
@@ -160,6 +163,13 @@ pub struct SolverState {
     pub kinetic_energy: f64,
     /// Kinetic energy the peak watch compares against (J); 0 after a reset.
     pub previous_kinetic_energy: f64,
+    /// The kinetic energy of the step before that (J); 0 after a reset. With it the peak
+    /// watch fits a parabola through the last three energies.
+    pub earlier_kinetic_energy: f64,
+    /// At a reset step, the fraction of Δt the points still move: 0 (they stay where the
+    /// previous step left them) or, with `peak_interpolation`, the fitted peak's offset
+    /// from that step in (−½, ½).
+    pub reset_fraction: f64,
     /// Cumulative external work, eq. (6) (J).
     pub external_work: f64,
     /// K_F in the max-norm, eq. (3).
@@ -170,7 +180,8 @@ pub struct SolverState {
     pub energy_ratio: f64,
     /// Number of kinetic-damping resets so far.
     pub resets: u64,
-    /// True when this step's peak watch zeroed the velocities (points do not move).
+    /// True when this step's peak watch zeroed the velocities (points move only by
+    /// `reset_fraction`; see [`SolverState::motion_dt`]).
     pub reset_this_step: bool,
     /// True when this step's spatial sort moved point data between rows: holders of row
     /// indices or entities (traced points) must look their points up again by [`PointId`].
@@ -195,6 +206,17 @@ pub struct SolverState {
 }
 
 impl SolverState {
+    /// The time over which this step moves the points and integrates their strain (s): Δt,
+    /// or at a kinetic-damping reset the fitted peak's offset `reset_fraction`·Δt; `None`
+    /// when a reset leaves the points where they are.
+    pub fn motion_dt(&self) -> Option<f64> {
+        match (self.reset_this_step, self.reset_fraction) {
+            (false, _) => Some(self.dt),
+            (true, f) if f != 0.0 => Some(f * self.dt),
+            _ => None,
+        }
+    }
+
     /// K_F in the norm the stopping rule reads.
     pub fn force_ratio(&self, norm: ForceNorm) -> f64 {
         match norm {

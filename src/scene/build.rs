@@ -396,6 +396,7 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         static_check: s.solver.static_check,
         volumetric_smoothing: s.solver.volumetric_smoothing,
         sort_every: s.solver.sort_every,
+        peak_interpolation: s.solver.peak_interpolation,
         flip: s.solver.flip,
         gravity: s.gravity.as_ref().map(|g| Gravity {
             acceleration: pad3(&g.acceleration),

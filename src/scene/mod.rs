@@ -236,6 +236,10 @@ pub struct SolverSpec {
     /// stay neighbours in memory (default 100; 0 never sorts).
     #[serde(default = "default_sort_every")]
     pub sort_every: u64,
+    /// Kinetic damping only: reset at the peak of a parabola through the last three kinetic
+    /// energies, moving the points back (or on) to it, instead of where the drop was seen.
+    #[serde(default)]
+    pub peak_interpolation: bool,
     /// Confirm a converged state is static before stopping: `(window: s, max_displacement: m)`.
     #[serde(default)]
     pub static_check: Option<StaticCheck>,

@@ -382,6 +382,12 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
             );
         }
     }
+    if s.solver.peak_interpolation && s.solver.damping != crate::state::Damping::Kinetic {
+        return bad(
+            "solver.peak_interpolation",
+            "places kinetic-damping resets: it needs `damping: Kinetic`".to_string(),
+        );
+    }
     if let crate::state::Damping::Local { alpha } = s.solver.damping {
         if !(non_negative(alpha) && alpha < 1.0) {
             return bad(

@@ -144,9 +144,7 @@ impl<D: Dim> System<D> for Convergence {
     }
     fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
         let ratios = force_ratios(ctx);
-        let dw = if ctx.state.reset_this_step {
-            0.0
-        } else {
+        let dw = if let Some(dt) = ctx.state.motion_dt() {
             let n = nodes(&ctx.world);
             let ne = col::<NodeExternalForce<D::Vec>>(n);
             let nv = col::<NodeVelocity<D::Vec>>(n);
@@ -159,7 +157,9 @@ impl<D: Dim> System<D> for Convergence {
             })
             .iter()
             .sum();
-            power * ctx.state.dt
+            power * dt
+        } else {
+            0.0
         };
         let s = &mut ctx.state;
         s.external_work += dw;

@@ -430,6 +430,7 @@ mod tests {
             }),
             volumetric_smoothing: false,
             sort_every: 100,
+            peak_interpolation: false,
             flip: 1.0,
             min_node_mass: 0.0,
             virtual_mass_floor: 0.0,

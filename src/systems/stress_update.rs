@@ -28,10 +28,9 @@ impl<D: Dim> System<D> for StressUpdate {
         "stress_update"
     }
     fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
-        if ctx.state.reset_this_step {
+        let Some(dt) = ctx.state.motion_dt() else {
             return Ok(());
-        }
-        let dt = ctx.state.dt;
+        };
         let materials = &ctx.materials;
         let kernel = |stress: &mut [Stress<D::Stress>],
                       l: &[VelocityGradient<D::Mat>],

@@ -18,10 +18,9 @@ impl<D: Dim> System<D> for VolumeUpdate {
         "volume_update"
     }
     fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
-        if ctx.state.reset_this_step {
+        let Some(dt) = ctx.state.motion_dt() else {
             return Ok(());
-        }
-        let dt = ctx.state.dt;
+        };
         for arch in points_with::<Volume>(&ctx.world) {
             let lg = col::<VelocityGradient<D::Mat>>(arch);
             let mut vol = col_mut::<Volume>(arch);
