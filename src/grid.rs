@@ -325,6 +325,9 @@ pub struct Axis {
     pub last_cell: f64,
     /// 1 / h (1/m).
     pub inv_h: f64,
+    /// Half-width of a point's box along this axis (cell units) for uniform GIMP shape
+    /// functions: 1/(2n) for n points a cell side. Other shapes ignore it.
+    pub particle_half_width: f64,
 }
 
 impl Axis {
@@ -335,6 +338,7 @@ impl Axis {
             end: cells as f64,
             last_cell: cells as f64 - 1.0,
             inv_h,
+            particle_half_width: 0.25,
         }
     }
 

@@ -47,9 +47,14 @@ fn every_accepted_courant_number_settles_the_column_to_the_same_answer() {
     // Courant 0.05 to 1 for each scheme and shape. USL is refused above Courant 0.7
     // (measured: it diverges from 0.8 with linear shapes and never settles at 1 with
     // B-splines); every run accepted stops at the exact settlement within the shape's
-    // discretisation error (linear: cell-centre strain, 0.7 %; B-spline: 0.06 %).
+    // discretisation error (linear: cell-centre strain, 0.7 %; B-spline: 0.06 %; uniform
+    // GIMP: 0.1 %).
     for scheme in ["Usf", "Usl", "Musl"] {
-        for (shape, bound) in [("Linear", 1e-2), ("QuadraticBSpline", 1e-3)] {
+        for (shape, bound) in [
+            ("Linear", 1e-2),
+            ("QuadraticBSpline", 1e-3),
+            ("UniformGimp", 2e-3),
+        ] {
             for courant in [0.05, 0.2, 0.5, 0.7, 0.8, 1.0] {
                 let set = [
                     format!("solver.scheme={scheme}"),
@@ -443,4 +448,19 @@ fn tightening_the_tolerance_to_round_off_improves_the_bar_and_still_stops() {
         (errors[n - 1] - errors[n - 2]).abs() < 1e-6,
         "no floor reached: {errors:?}"
     );
+}
+
+#[test]
+fn uniform_gimp_needs_one_point_size_for_every_body() {
+    // uGIMP sizes each point's box from its points a cell side: two bodies with different
+    // counts would need two sizes, which the grid's weights cannot hold.
+    let e = refused(
+        "soil_column.ron",
+        &[
+            "shape=UniformGimp",
+            "bodies=[(material: \"soil\", region: Box(min: [0.0, 0.0], max: [2.0, 5.0]), points_per_cell: [2, 2]), (material: \"soil\", region: Box(min: [0.0, 5.0], max: [2.0, 10.0]), points_per_cell: [3, 3])]",
+        ],
+    )
+    .expect("refused");
+    assert!(e.to_string().contains("bodies[1].points_per_cell"), "{e}");
 }

@@ -10,7 +10,7 @@ use crate::error::SceneError;
 use crate::grid::Grid;
 use crate::materials::Material;
 use crate::parallel::SlabCache;
-use crate::shape::{for_each_node, Linear, QuadraticBSpline, ShapeKind};
+use crate::shape::{for_each_node, Linear, QuadraticBSpline, ShapeKind, UniformGimp};
 use crate::simulation::{AnySimulation, Context, Simulation, TracedPoint};
 use crate::state::{Gravity, Settings, SolverState};
 use crate::systems::spatial_sort::sort_points;
@@ -46,6 +46,7 @@ fn visit_support<D: Dim>(grid: &Grid<D>, shape: ShapeKind, x: D::Vec, mut f: imp
     match shape {
         ShapeKind::Linear => for_each_node::<D, Linear>(grid, x, |i, w, _| f(i, w)),
         ShapeKind::QuadraticBSpline => for_each_node::<D, QuadraticBSpline>(grid, x, |i, w, _| f(i, w)),
+        ShapeKind::UniformGimp => for_each_node::<D, UniformGimp>(grid, x, |i, w, _| f(i, w)),
     }
 }
 
@@ -169,7 +170,14 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
     let n = D::N;
     let mut cells = [0usize; 3];
     cells[..n].copy_from_slice(&s.grid.cells);
-    let grid = Grid::<D>::new(D::vec_from(pad3(&s.grid.origin)), s.grid.cell_size, cells);
+    let mut grid = Grid::<D>::new(D::vec_from(pad3(&s.grid.origin)), s.grid.cell_size, cells);
+    // Uniform GIMP: a point's box is its share of a cell, the same for every body
+    // (validation), 1/(2n) cell along an axis with n points a side.
+    if let Some(b) = s.bodies.first() {
+        for (axis, &per) in grid.axes.iter_mut().zip(&b.points_per_cell) {
+            axis.particle_half_width = 0.5 / per as f64;
+        }
+    }
     let mut world = World::new();
 
     // Grid nodes, one archetype, spawned in id order.

@@ -248,11 +248,19 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
             format!("must be > 0 m, found {}", s.grid.cell_size),
         );
     }
-    let min_cells = if s.shape == ShapeKind::QuadraticBSpline {
-        2
-    } else {
-        1
-    };
+    if s.shape == ShapeKind::UniformGimp {
+        if let Some(i) = s
+            .bodies
+            .iter()
+            .position(|b| b.points_per_cell != s.bodies[0].points_per_cell)
+        {
+            return bad(
+                &format!("bodies[{i}].points_per_cell"),
+                "UniformGimp sizes every point's box from its points a cell side: every body needs the same as bodies[0]".to_string(),
+            );
+        }
+    }
+    let min_cells = if s.shape.support() == 3 { 2 } else { 1 };
     // The grid's far corner and a cell's volume h^D must be finite numbers > 0: a cell
     // size of 1e-200 m would give cells of zero volume and points of zero mass.
     let cell_volume = s.grid.cell_size.powi(n as i32);

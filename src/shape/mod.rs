@@ -5,9 +5,11 @@
 //! (particle-to-grid, grid-to-particle, remap, kinematics) uses the same weights.
 
 mod bspline;
+mod gimp;
 mod linear;
 
 pub use bspline::QuadraticBSpline;
+pub use gimp::UniformGimp;
 pub use linear::Linear;
 
 use crate::dim::{Dim, Vector};
@@ -290,6 +292,10 @@ pub enum ShapeKind {
     Linear,
     /// Quadratic B-splines, modified at the grid boundary: 3 nodes per axis.
     QuadraticBSpline,
+    /// Uniform GIMP: the linear hat averaged over each point's initial box, modified at the
+    /// grid boundary as the B-spline: 3 nodes per axis. Every body needs the same points a
+    /// cell side.
+    UniformGimp,
 }
 
 impl ShapeKind {
@@ -298,6 +304,7 @@ impl ShapeKind {
         match self {
             ShapeKind::Linear => Linear::SUPPORT,
             ShapeKind::QuadraticBSpline => QuadraticBSpline::SUPPORT,
+            ShapeKind::UniformGimp => UniformGimp::SUPPORT,
         }
     }
 }
@@ -363,13 +370,14 @@ pub(crate) mod tests {
     }
 
     #[test]
-    fn bspline_is_a_partition_of_unity_and_reproduces_linear_fields_up_to_the_boundary() {
+    fn bspline_and_gimp_are_partitions_of_unity_and_reproduce_linear_fields_up_to_the_boundary() {
         let g2 = Grid::<Dim2>::new(DVec2::ZERO, 1.0, [5, 4, 0]);
         let g3 = Grid::<Dim3>::new(DVec3::ZERO, 0.5, [3, 4, 3]);
         // Includes points on the faces, in the boundary cells and in the interior.
         for &x in &sample_points(50, 0.0, 5.0) {
             for &y in &sample_points(16, 0.0, 4.0) {
                 check_consistency::<Dim2, QuadraticBSpline>(&g2, DVec2::new(x, y));
+                check_consistency::<Dim2, UniformGimp>(&g2, DVec2::new(x, y));
             }
         }
         for &x in &sample_points(12, 0.0, 1.5) {
@@ -595,7 +603,11 @@ pub(crate) mod tests {
         let axis = Axis::new(5, 1.0);
         for k in 0..=400 {
             let xi = 5.0 * k as f64 / 400.0;
-            for s in [Linear::eval_1d(xi, &axis), QuadraticBSpline::eval_1d(xi, &axis)] {
+            for s in [
+                Linear::eval_1d(xi, &axis),
+                QuadraticBSpline::eval_1d(xi, &axis),
+                UniformGimp::eval_1d(xi, &axis),
+            ] {
                 assert!(s.w.iter().all(|&w| w >= -1e-15), "{xi}: {s:?}");
             }
         }

@@ -60,7 +60,7 @@ pub use volumetric_smoothing::VolumetricSmoothing;
 
 use crate::dim::Dim;
 use crate::schedule::{Schedule, System};
-use crate::shape::{Linear, QuadraticBSpline, Shape, ShapeKind};
+use crate::shape::{Linear, QuadraticBSpline, Shape, ShapeKind, UniformGimp};
 use crate::state::{Damping, Scheme, Settings};
 
 /// What a scene contains that decides which optional systems it needs.
@@ -377,6 +377,7 @@ pub fn schedule_from_names<D: Dim>(names: &[String], settings: &Settings, shape:
         s.push_boxed(match shape {
             ShapeKind::Linear => make::<D, Linear>(n, settings),
             ShapeKind::QuadraticBSpline => make::<D, QuadraticBSpline>(n, settings),
+            ShapeKind::UniformGimp => make::<D, UniformGimp>(n, settings),
         });
     }
     s
