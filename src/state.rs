@@ -127,6 +127,9 @@ pub struct Settings {
     pub volumetric_smoothing: bool,
     /// Put the points back in cell order every this many steps (0: never).
     pub sort_every: u64,
+    /// Mass scaling's inertia factor s_m of each material, by
+    /// [`MaterialId`](crate::components::MaterialId); empty without mass scaling.
+    pub inertia_factors: Vec<f64>,
     /// Kinetic damping places each reset at the peak of a parabola through the last three
     /// kinetic energies instead of at the step where the drop was seen.
     pub peak_interpolation: bool,
@@ -203,6 +206,13 @@ pub struct SolverState {
     /// momentum, forces, acceleration, velocity), so grid passes skip it: a scatter adds the
     /// nodes it reaches, the grid reset zeroes the box and empties it.
     pub active_nodes: NodeBox,
+}
+
+impl Settings {
+    /// True when the scene asked for mass scaling (`solver.mass_scaling`).
+    pub fn mass_scaling(&self) -> bool {
+        !self.inertia_factors.is_empty()
+    }
 }
 
 impl SolverState {

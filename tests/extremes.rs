@@ -102,20 +102,44 @@ fn nearly_incompressible_columns_settle_as_the_oedometer() {
 fn a_stiffness_contrast_of_a_million_settles_the_soft_layer_on_a_nearly_rigid_one() {
     // The lower 5 m a million times stiffer: it sets the time step, the upper 5 m settles as
     // a 5 m column on a rigid base.
-    let s = run(
-        "soil_column.ron",
-        &[
+    let s = run("soil_column.ron", &CONTRAST);
+    check_contrast(&s);
+    // With mass scaling the soil sets the step and the rock gets (c_rock/c_soil)² = 1e6 times
+    // its inertia: the same static answer in a hundredth of the steps.
+    let mut set = CONTRAST.to_vec();
+    set.extend(["solver.mass_scaling=true", "solver.time_step=Courant(0.9)"]);
+    let scaled = run("soil_column.ron", &set);
+    check_contrast(&scaled);
+    let (a, b) = (
+        traced(&s, "top").displacement[1],
+        traced(&scaled, "top").displacement[1],
+    );
+    println!(
+        "mass scaling: {} steps against {}; top settles {b:.6e} m against {a:.6e} m",
+        scaled.steps, s.steps
+    );
+    assert!(
+        scaled.steps * 100 < s.steps,
+        "{} against {} steps",
+        scaled.steps,
+        s.steps
+    );
+    assert!((b / a - 1.0).abs() < 1e-3, "{b} against {a}");
+}
+
+const CONTRAST: [&str; 6] = [
             "shape=QuadraticBSpline",
             "materials={\"soil\": MohrCoulomb(density: 1800.0, youngs_modulus: 10.0e6, poisson_ratio: 0.3, cohesion: 0.0, friction_angle: 30.0, dilatancy_angle: 0.0), \"rock\": LinearElastic(density: 1800.0, youngs_modulus: 10.0e12, poisson_ratio: 0.3)}",
             "bodies=[(material: \"rock\", region: Box(min: [0.0, 0.0], max: [2.0, 5.0]), points_per_cell: [2, 2]), (material: \"soil\", region: Box(min: [0.0, 5.0], max: [2.0, 10.0]), points_per_cell: [2, 2])]",
             "traced=[(name: \"mid\", position: [0.875, 7.375]), (name: \"top\", position: [0.875, 9.875])]",
             "solver.max_steps=2000000",
             "solver.time_step=Courant(1.0)",
-        ],
-    );
+];
+
+fn check_contrast(s: &kdmpm::output::Summary) {
     assert_eq!(s.outcome, Outcome::Converged, "{s:?}");
     // The soft layer carries its weight exactly (σ_yy = −ρg(10 − Y) at its mid-height).
-    let mid = traced(&s, "mid");
+    let mid = traced(s, "mid");
     let weight = -1800.0 * G * (10.0 - mid.initial_position[1]);
     // (Measured 1.5 %: the rock's step leaves the soft points' stresses noisier than in the
     // one-material column, 1e-4.)
@@ -128,7 +152,7 @@ fn a_stiffness_contrast_of_a_million_settles_the_soft_layer_on_a_nearly_rigid_on
     // three-cell support lets the stiff points hold: soft nodes within 1.5 cells of the
     // interface are shared with rock points. Bounded by a rigid base at 5 m and at
     // 5 − 1.5 h = 4.25 m of soft soil.
-    let top = traced(&s, "top");
+    let top = traced(s, "top");
     let y = top.initial_position[1];
     let full = column_u(y - 5.0, 5.0, 1800.0, G, 10e6, 0.3);
     let held = column_u(y - 5.75, 4.25, 1800.0, G, 10e6, 0.3);
@@ -463,4 +487,19 @@ fn uniform_gimp_needs_one_point_size_for_every_body() {
     )
     .expect("refused");
     assert!(e.to_string().contains("bodies[1].points_per_cell"), "{e}");
+}
+
+#[test]
+fn mass_scaling_changes_nothing_in_one_material_and_is_refused_above_courant_0_9() {
+    // Every factor (c_m/c_ref)² is 1 when one material sets both: same steps, same bits.
+    let plain = run("soil_column.ron", &[]);
+    let scaled = run("soil_column.ron", &["solver.mass_scaling=true"]);
+    assert_eq!(plain.steps, scaled.steps);
+    let (a, b) = (traced(&plain, "top"), traced(&scaled, "top"));
+    assert_eq!(a.displacement[1].to_bits(), b.displacement[1].to_bits());
+    // Above Courant 0.9 the soil-on-rock contrast diverges (step 59 at Courant 1): refused.
+    let mut set = CONTRAST.to_vec();
+    set.push("solver.mass_scaling=true");
+    let e = refused("soil_column.ron", &set).expect("Courant 1 with mass scaling is refused");
+    assert!(e.to_string().contains("Courant(0.9)"), "{e}");
 }

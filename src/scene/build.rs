@@ -405,6 +405,14 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         volumetric_smoothing: s.solver.volumetric_smoothing,
         sort_every: s.solver.sort_every,
         peak_interpolation: s.solver.peak_interpolation,
+        inertia_factors: if s.solver.mass_scaling {
+            table
+                .iter()
+                .map(|(_, m)| ((m.p_wave_modulus() / m.density()) / (c_p * c_p)).max(1.0))
+                .collect()
+        } else {
+            Vec::new()
+        },
         flip: s.solver.flip,
         gravity: s.gravity.as_ref().map(|g| Gravity {
             acceleration: pad3(&g.acceleration),

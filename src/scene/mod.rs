@@ -240,6 +240,12 @@ pub struct SolverSpec {
     /// energies, moving the points back (or on) to it, instead of where the drop was seen.
     #[serde(default)]
     pub peak_interpolation: bool,
+    /// Take the time step from the slowest P-wave speed of the materials in use and give
+    /// stiffer materials a fictitious inertia (c_m/c_ref)² times their mass, for the
+    /// acceleration only: dynamic relaxation's mass matrix is free, the static answer is not
+    /// changed, the path may be.
+    #[serde(default)]
+    pub mass_scaling: bool,
     /// Confirm a converged state is static before stopping: `(window: s, max_displacement: m)`.
     #[serde(default)]
     pub static_check: Option<StaticCheck>,

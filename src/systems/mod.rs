@@ -11,6 +11,7 @@
 //! | `point_loads`   | `point_loads.rs`     | concentrated loads (only with loads)            |
 //! | `boundary`      | `boundary.rs`        | fixed components of momentum and force to zero  |
 //! | `integrate`     | `integrate.rs`       | nodal acceleration and velocity (+ viscous)     |
+//! | `mass_scaling`  | `mass_scaling.rs`    | fictitious inertia (only with mass scaling)     |
 //! | `g2p`           | `g2p.rs`             | point velocities, kinetic energy                |
 //! | `peak_watch`    | `peak_watch.rs`      | kinetic damping reset (only kinetic damping)    |
 //! | `remap`         | `remap.rs`           | MUSL: point velocities back to the grid         |
@@ -31,6 +32,7 @@ pub mod gravity;
 pub mod grid_reset;
 pub mod integrate;
 pub mod kinematics;
+pub mod mass_scaling;
 pub mod nodal_velocity;
 pub mod p2g;
 pub mod peak_watch;
@@ -48,6 +50,7 @@ pub use gravity::Gravity;
 pub use grid_reset::GridReset;
 pub use integrate::Integrate;
 pub use kinematics::Kinematics;
+pub use mass_scaling::MassScaling;
 pub use nodal_velocity::NodalVelocity;
 pub use p2g::{P2g, P2gPart};
 pub use peak_watch::PeakWatch;
@@ -83,6 +86,7 @@ pub const SYSTEM_NAMES: &[&str] = &[
     "point_loads",
     "boundary",
     "integrate",
+    "mass_scaling",
     "g2p",
     "peak_watch",
     "remap",
@@ -190,6 +194,16 @@ const ORDER: &[(&str, &str, &str)] = &[
     ),
     ("integrate", "g2p", "g2p interpolates the nodal accelerations"),
     (
+        "integrate",
+        "mass_scaling",
+        "mass scaling rescales the integrated accelerations",
+    ),
+    (
+        "mass_scaling",
+        "g2p",
+        "g2p interpolates the rescaled accelerations",
+    ),
+    (
         "g2p",
         "peak_watch",
         "the peak watch reads the kinetic energy g2p computes",
@@ -236,7 +250,11 @@ pub fn default_names(settings: &Settings, needs: Needs) -> Vec<&'static str> {
         if needs.point_loads {
             n.push("point_loads");
         }
-        n.extend(["boundary", "integrate", "g2p"]);
+        n.extend(["boundary", "integrate"]);
+        if settings.mass_scaling() {
+            n.push("mass_scaling");
+        }
+        n.push("g2p");
         if settings.damping == Damping::Kinetic {
             n.push("peak_watch");
         }
@@ -332,6 +350,11 @@ pub fn check_names(names: &[String], settings: &Settings, needs: Needs) -> Resul
         ("gravity", settings.gravity.is_some(), "the scene has gravity"),
         ("point_loads", needs.point_loads, "the scene has point loads"),
         (
+            "mass_scaling",
+            settings.mass_scaling(),
+            "solver.mass_scaling is true",
+        ),
+        (
             "peak_watch",
             settings.damping == Damping::Kinetic,
             "solver.damping is Kinetic",
@@ -400,6 +423,7 @@ fn make<D: Dim, S: Shape>(name: &str, settings: &Settings) -> Box<dyn System<D>>
         "point_loads" => Box::new(PointLoads::<D, S>::default()),
         "boundary" => Box::new(Boundary),
         "integrate" => Box::new(Integrate),
+        "mass_scaling" => Box::new(MassScaling::<D, S>::default()),
         "g2p" => Box::new(G2p::<D, S>::default()),
         "peak_watch" => Box::new(PeakWatch),
         "remap" => Box::new(Remap::<D, S>::default()),
@@ -432,6 +456,7 @@ mod tests {
             volumetric_smoothing: false,
             sort_every: 100,
             peak_interpolation: false,
+            inertia_factors: Vec::new(),
             flip: 1.0,
             min_node_mass: 0.0,
             virtual_mass_floor: 0.0,
