@@ -2,7 +2,7 @@
 
 use clap::{Parser, Subcommand};
 use kdmpm::checkpoint;
-use kdmpm::output::{History, Outcome, OutputDir, Summary};
+use kdmpm::output::{History, Outcome, OutputDir, SnapshotWriter, Snapshots, Summary};
 use kdmpm::scene::{build, CheckpointEvery, LoadedScene};
 use kdmpm::state::StopReason;
 use kdmpm::systems::convergence::ratio_text;
@@ -324,6 +324,22 @@ fn drive<D: Dim>(
     let scene = &header.scene_path.clone();
     let rows = history.rows();
     sim.schedule.push(history);
+    let writer = match loaded.scene.output.snapshots {
+        Some(spec) => {
+            let resumed = (sim.ctx.state.step > 0).then_some(sim.ctx.state.time);
+            match Snapshots::<D>::start(dir.path(), spec, resumed) {
+                Ok((system, writer)) => {
+                    sim.schedule.push(system);
+                    Some(writer)
+                }
+                Err(e) => {
+                    eprintln!("error: cannot start the snapshot writer in {}: {e}", dir.path().display());
+                    return ExitCode::from(BAD_INPUT);
+                }
+            }
+        }
+        None => None,
+    };
     // A second Ctrl-C while the first is being honoured ends the process at once; every
     // file is written whole or not at all, so nothing torn is left.
     let _ = ctrlc::set_handler(|| {
@@ -408,8 +424,19 @@ fn drive<D: Dim>(
             }
         )),
     }
+    let snapshots = match writer.map(SnapshotWriter::finish).transpose() {
+        Ok(r) => r,
+        Err(e) => {
+            eprintln!("error: cannot write the snapshots: {e}");
+            return ExitCode::from(RUN_FAILED);
+        }
+    };
     // After the output, so that the peak memory covers the whole run.
-    let summary = Summary::collect(&scene.display().to_string(), sim, wall, error);
+    let mut summary = Summary::collect(&scene.display().to_string(), sim, wall, error);
+    if let Some(r) = snapshots {
+        summary.snapshots = Some(r.written);
+        summary.output_wait_seconds = Some(r.wait_seconds);
+    }
     let written = dir.write_atomic("summary.json", |out| {
         serde_json::to_writer_pretty(&mut *out, &summary).map_err(std::io::Error::other)
     });

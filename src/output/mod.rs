@@ -1,10 +1,13 @@
-//! Results on disk: `history.csv` (one row per output step) and `summary.json`.
+//! Results on disk: `history.csv` (one row per output step), point snapshots as a
+//! ParaView series (`points.pvd`), `points.vtu` and `summary.json`.
 
 pub mod dir;
 pub mod history;
+pub mod snapshots;
 pub mod summary;
 pub mod vtk;
 
 pub use dir::{OutputDir, RowFile};
 pub use history::History;
+pub use snapshots::{SnapshotSpec, SnapshotWriter, Snapshots};
 pub use summary::{Outcome, Summary};

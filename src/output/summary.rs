@@ -86,6 +86,12 @@ pub struct Summary {
     pub traced: Vec<TracedResult>,
     /// Per-system cost.
     pub systems: Vec<Timing>,
+    /// Snapshot files written (`output.snapshots`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub snapshots: Option<usize>,
+    /// Wall-clock seconds stepping waited for the snapshot writer (s).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub output_wait_seconds: Option<f64>,
 }
 
 /// How a run ended, as `summary.json` writes it (snake case).
@@ -170,6 +176,8 @@ impl Summary {
             peak_memory_bytes: peak_memory_bytes(),
             traced: sim.traced_results(),
             systems: sim.schedule.timings(),
+            snapshots: None,
+            output_wait_seconds: None,
         }
     }
 }

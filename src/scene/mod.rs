@@ -336,6 +336,10 @@ pub struct OutputSpec {
     /// of `points.vtu` need it. Traced points do not.
     #[serde(default = "default_true")]
     pub displacements: bool,
+    /// Point snapshots during the run, as a ParaView series (`points.pvd`): every N steps,
+    /// every T seconds of simulated time and/or at each kinetic-damping reset.
+    #[serde(default)]
+    pub snapshots: Option<crate::output::SnapshotSpec>,
 }
 
 fn default_true() -> bool {
@@ -352,6 +356,7 @@ impl Default for OutputSpec {
             history_every: 1,
             surface_angle: false,
             displacements: true,
+            snapshots: None,
         }
     }
 }

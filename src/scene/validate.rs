@@ -395,6 +395,22 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
             );
         }
     }
+    if let Some(snap) = s.output.snapshots {
+        if snap.every_steps == Some(0) {
+            return bad("output.snapshots.every_steps", "must be ≥ 1 step".to_string());
+        }
+        if let Some(t) = snap.every_time {
+            if !positive(t) {
+                return bad("output.snapshots.every_time", format!("must be > 0 s, found {t}"));
+            }
+        }
+        if snap.every_steps.is_none() && snap.every_time.is_none() && !snap.at_resets {
+            return bad(
+                "output.snapshots",
+                "takes no snapshot but the last: set every_steps, every_time or at_resets".to_string(),
+            );
+        }
+    }
     if s.solver.peak_interpolation && s.solver.damping != crate::state::Damping::Kinetic {
         return bad(
             "solver.peak_interpolation",

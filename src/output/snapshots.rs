@@ -1,0 +1,217 @@
+//! Point snapshots during a run: a ParaView time series (`points.pvd` and one `.vtu` a
+//! snapshot under `snapshots/`), written by a thread of its own so that stepping does not
+//! wait on the disk.
+
+use crate::dim::Dim;
+use crate::error::StepError;
+use crate::output::dir::write_atomic;
+use crate::output::vtk::{write_frame, Frame};
+use crate::schedule::System;
+use crate::simulation::Context;
+use crossbeam::channel::{bounded, Sender};
+use serde::{Deserialize, Serialize};
+use std::io::Write;
+use std::marker::PhantomData;
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
+use std::thread::JoinHandle;
+use std::time::Instant;
+
+/// When snapshots are taken (`output.snapshots`); any combination, and always at the last
+/// step.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SnapshotSpec {
+    /// Every this many steps (≥ 1).
+    #[serde(default)]
+    pub every_steps: Option<u64>,
+    /// Every this much simulated time (s, > 0).
+    #[serde(default)]
+    pub every_time: Option<f64>,
+    /// At each kinetic-damping reset (the static states the paper's figures show).
+    #[serde(default)]
+    pub at_resets: bool,
+}
+
+/// The collection file ParaView opens.
+pub const PVD: &str = "points.pvd";
+/// The folder of the snapshot files.
+pub const FOLDER: &str = "snapshots";
+/// Frames in flight between the step loop and the writer: a third waits (back-pressure)
+/// rather than holding more copies of the points in memory.
+const IN_FLIGHT: usize = 2;
+
+/// What the writer thread reports when it is done.
+#[derive(Clone, Debug, Default)]
+pub struct SnapshotReport {
+    /// Snapshot files written.
+    pub written: usize,
+    /// Wall-clock seconds stepping waited for the writer (s).
+    pub wait_seconds: f64,
+}
+
+/// The step-loop side: a system that copies the points when a snapshot is due and hands
+/// the copy to the writer thread.
+pub struct Snapshots<D> {
+    spec: SnapshotSpec,
+    sender: Arc<Mutex<Option<Sender<Frame>>>>,
+    last_time_slot: Option<u64>,
+    wait: Arc<Mutex<f64>>,
+    _marker: PhantomData<fn() -> D>,
+}
+
+/// The writer side: join it with [`SnapshotWriter::finish`] after the run.
+pub struct SnapshotWriter {
+    thread: Option<JoinHandle<std::io::Result<usize>>>,
+    sender: Arc<Mutex<Option<Sender<Frame>>>>,
+    wait: Arc<Mutex<f64>>,
+}
+
+/// A collection entry: simulated time and the file, relative to the output directory.
+type Entry = (f64, String);
+
+impl<D: Dim> Snapshots<D> {
+    /// Starts the writer thread for output directory `dir`. `resume_time` (s) keeps the
+    /// entries of an earlier run's `points.pvd` up to that time (a resumed run).
+    pub fn start(dir: &Path, spec: SnapshotSpec, resume_time: Option<f64>) -> std::io::Result<(Self, SnapshotWriter)> {
+        let folder = dir.join(FOLDER);
+        std::fs::create_dir_all(&folder)?;
+        if resume_time.is_none() {
+            // A new run: an earlier run's snapshots are not part of this series.
+            for e in std::fs::read_dir(&folder)?.flatten() {
+                let name = e.file_name().to_string_lossy().into_owned();
+                if name.starts_with("points_") && name.ends_with(".vtu") {
+                    std::fs::remove_file(e.path())?;
+                }
+            }
+            let _ = std::fs::remove_file(dir.join(PVD));
+        }
+        let mut entries: Vec<Entry> = match resume_time {
+            Some(t) => read_pvd(&dir.join(PVD))
+                .into_iter()
+                .filter(|e| e.0 <= t * (1.0 + 1e-12))
+                .collect(),
+            None => Vec::new(),
+        };
+        let (tx, rx) = bounded::<Frame>(IN_FLIGHT);
+        let dir = dir.to_path_buf();
+        let thread = std::thread::Builder::new()
+            .name("snapshots".into())
+            .spawn(move || -> std::io::Result<usize> {
+                let mut written = 0;
+                for frame in rx {
+                    let name = format!("{FOLDER}/points_{:09}.vtu", frame.step);
+                    write_frame(&frame, &dir.join(&name))?;
+                    entries.push((frame.time, name));
+                    write_pvd(&dir.join(PVD), &entries)?;
+                    written += 1;
+                }
+                Ok(written)
+            })?;
+        let wait = Arc::new(Mutex::new(0.0));
+        let sender = Arc::new(Mutex::new(Some(tx)));
+        Ok((
+            Snapshots {
+                spec,
+                sender: sender.clone(),
+                last_time_slot: None,
+                wait: wait.clone(),
+                _marker: PhantomData,
+            },
+            SnapshotWriter {
+                thread: Some(thread),
+                sender,
+                wait,
+            },
+        ))
+    }
+
+    fn due(&mut self, ctx: &Context<D>) -> bool {
+        let st = &ctx.state;
+        let by_steps = self.spec.every_steps.is_some_and(|n| st.step.is_multiple_of(n));
+        let by_time = self.spec.every_time.is_some_and(|t| {
+            // The slot of simulated time this step ends in; a snapshot at each new slot.
+            let slot = (st.time / t).floor() as u64;
+            let new = self.last_time_slot.is_some_and(|s| slot > s);
+            self.last_time_slot = Some(slot);
+            new
+        });
+        by_steps || by_time || (self.spec.at_resets && st.reset_this_step) || st.stop.is_some()
+    }
+}
+
+impl<D: Dim> System<D> for Snapshots<D> {
+    fn name(&self) -> &str {
+        "snapshots"
+    }
+    fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
+        if !self.due(ctx) {
+            return Ok(());
+        }
+        let mut sender = lock(&self.sender);
+        let Some(tx) = sender.as_ref() else { return Ok(()) };
+        let frame = Frame::capture::<D>(&ctx.world, ctx.state.step, ctx.state.time);
+        let start = Instant::now();
+        if tx.send(frame).is_err() {
+            // The writer stopped on an error; finish() reports it. Stepping goes on.
+            *sender = None;
+        }
+        *lock(&self.wait) += start.elapsed().as_secs_f64();
+        Ok(())
+    }
+}
+
+impl SnapshotWriter {
+    /// Closes the channel, waits for every snapshot in it to be written and reports what
+    /// was written and how long stepping waited. Snapshots due after this are not taken.
+    pub fn finish(mut self) -> std::io::Result<SnapshotReport> {
+        lock(&self.sender).take();
+        let written = match self.thread.take().map(JoinHandle::join) {
+            Some(Ok(r)) => r?,
+            Some(Err(_)) => return Err(std::io::Error::other("the snapshot writer thread panicked")),
+            None => 0,
+        };
+        let wait_seconds = *lock(&self.wait);
+        Ok(SnapshotReport { written, wait_seconds })
+    }
+}
+
+fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
+    m.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Writes the collection: every snapshot with its simulated time (s).
+fn write_pvd(path: &Path, entries: &[Entry]) -> std::io::Result<()> {
+    write_atomic(path, |out| {
+        out.write_all(b"<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"1.0\" byte_order=\"LittleEndian\">\n<Collection>\n")?;
+        for (t, file) in entries {
+            // Shortest decimal that reads back to the same f64.
+            writeln!(out, "<DataSet timestep=\"{t:?}\" part=\"0\" file=\"{file}\"/>")?;
+        }
+        out.write_all(b"</Collection>\n</VTKFile>\n")
+    })
+}
+
+/// The entries of a collection this module wrote (empty when there is none).
+fn read_pvd(path: &Path) -> Vec<Entry> {
+    let Ok(text) = std::fs::read_to_string(path) else {
+        return Vec::new();
+    };
+    let attr = |line: &str, name: &str| -> Option<String> {
+        let start = line.find(&format!("{name}=\""))? + name.len() + 2;
+        let end = start + line[start..].find('"')?;
+        Some(line[start..end].to_string())
+    };
+    text.lines()
+        .filter(|l| l.trim_start().starts_with("<DataSet"))
+        .filter_map(|l| Some((attr(l, "timestep")?.parse().ok()?, attr(l, "file")?)))
+        .collect()
+}
+
+/// The snapshot files of a collection, for readers: (time, path) in time order.
+pub fn collection(dir: &Path) -> Vec<(f64, PathBuf)> {
+    read_pvd(&dir.join(PVD))
+        .into_iter()
+        .map(|(t, f)| (t, dir.join(f)))
+        .collect()
+}
