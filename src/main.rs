@@ -333,7 +333,10 @@ fn drive<D: Dim>(
                     Some(writer)
                 }
                 Err(e) => {
-                    eprintln!("error: cannot start the snapshot writer in {}: {e}", dir.path().display());
+                    eprintln!(
+                        "error: cannot start the snapshot writer in {}: {e}",
+                        dir.path().display()
+                    );
                     return ExitCode::from(BAD_INPUT);
                 }
             }

@@ -175,15 +175,25 @@ fn summary_numbers(dir: &Path) -> serde_json::Value {
         "particle_steps_per_second",
         "peak_memory_bytes",
         "systems",
+        "output_wait_seconds",
     ] {
         v.as_object_mut().unwrap().remove(key);
     }
     v
 }
 
-/// Every output of run directory `a` equals that of `b`.
+/// Every output of run directory `a` equals that of `b`, snapshot series included.
 fn same_results(a: &Path, b: &Path) {
-    for file in ["points.vtu", "history.csv"] {
+    let mut files = vec!["points.vtu".to_string(), "history.csv".to_string()];
+    if a.join("points.pvd").exists() {
+        files.push("points.pvd".into());
+        for e in std::fs::read_dir(a.join("snapshots")).unwrap().flatten() {
+            files.push(format!("snapshots/{}", e.file_name().to_string_lossy()));
+        }
+        let count = |d: &Path| std::fs::read_dir(d.join("snapshots")).unwrap().count();
+        assert_eq!(count(a), count(b), "snapshot files");
+    }
+    for file in &files {
         let (x, y) = (
             std::fs::read(a.join(file)).unwrap(),
             std::fs::read(b.join(file)).unwrap(),
@@ -202,7 +212,11 @@ fn copy_dir(from: &Path, to: &Path) {
     std::fs::create_dir_all(to).unwrap();
     for e in std::fs::read_dir(from).unwrap() {
         let e = e.unwrap();
-        std::fs::copy(e.path(), to.join(e.file_name())).unwrap();
+        if e.file_type().unwrap().is_dir() {
+            copy_dir(&e.path(), &to.join(e.file_name()));
+        } else {
+            std::fs::copy(e.path(), to.join(e.file_name())).unwrap();
+        }
     }
 }
 

@@ -11,7 +11,10 @@ use std::process::Command;
 mod common;
 
 fn kdmpm(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_kdmpm")).args(args).output().expect("kdmpm runs")
+    Command::new(env!("CARGO_BIN_EXE_kdmpm"))
+        .args(args)
+        .output()
+        .expect("kdmpm runs")
 }
 
 fn scratch(name: &str) -> PathBuf {
@@ -43,7 +46,10 @@ fn read_pvd(path: &Path) -> Vec<(f64, String)> {
 fn read_vtu(path: &Path) -> BTreeMap<String, (usize, Vec<f64>)> {
     let bytes = std::fs::read(path).expect("snapshot file");
     let open = b"<AppendedData encoding=\"raw\">";
-    let at = bytes.windows(open.len()).position(|w| w == open).expect("raw appended data");
+    let at = bytes
+        .windows(open.len())
+        .position(|w| w == open)
+        .expect("raw appended data");
     let head = format!("{}</VTKFile>", std::str::from_utf8(&bytes[..at]).unwrap());
     let doc = roxmltree::Document::parse(&head).expect("the head is well-formed XML");
     let root = doc.root_element();
@@ -54,14 +60,25 @@ fn read_vtu(path: &Path) -> BTreeMap<String, (usize, Vec<f64>)> {
     let mut out = BTreeMap::new();
     for a in doc.descendants().filter(|n| n.has_tag_name("DataArray")) {
         let name = a.attribute("Name").unwrap_or("Points").to_string();
-        let comps: usize = a.attribute("NumberOfComponents").map_or(1, |c| c.parse().unwrap());
+        let comps: usize = a
+            .attribute("NumberOfComponents")
+            .map_or(1, |c| c.parse().unwrap());
         let offset: usize = a.attribute("offset").unwrap().parse().unwrap();
         let len = u64::from_le_bytes(data[offset..offset + 8].try_into().unwrap()) as usize;
         let raw = &data[offset + 8..offset + 8 + len];
         let values: Vec<f64> = match a.attribute("type").unwrap() {
-            "Float64" => raw.chunks(8).map(|c| f64::from_le_bytes(c.try_into().unwrap())).collect(),
-            "Int64" => raw.chunks(8).map(|c| i64::from_le_bytes(c.try_into().unwrap()) as f64).collect(),
-            "UInt32" => raw.chunks(4).map(|c| u32::from_le_bytes(c.try_into().unwrap()) as f64).collect(),
+            "Float64" => raw
+                .chunks(8)
+                .map(|c| f64::from_le_bytes(c.try_into().unwrap()))
+                .collect(),
+            "Int64" => raw
+                .chunks(8)
+                .map(|c| i64::from_le_bytes(c.try_into().unwrap()) as f64)
+                .collect(),
+            "UInt32" => raw
+                .chunks(4)
+                .map(|c| u32::from_le_bytes(c.try_into().unwrap()) as f64)
+                .collect(),
             "UInt8" => raw.iter().map(|&b| b as f64).collect(),
             t => panic!("unexpected type {t}"),
         };
@@ -77,7 +94,10 @@ fn history_times(dir: &Path) -> BTreeMap<u64, f64> {
         .skip(1)
         .map(|l| {
             let mut f = l.split(',');
-            (f.next().unwrap().parse().unwrap(), f.next().unwrap().parse().unwrap())
+            (
+                f.next().unwrap().parse().unwrap(),
+                f.next().unwrap().parse().unwrap(),
+            )
         })
         .collect()
 }
@@ -106,7 +126,11 @@ fn the_series_reads_back_with_history_times_and_summary_values() {
     let dt = summary["time_step"].as_f64().unwrap();
     let mut previous = 0.0;
     for (t, file) in &series {
-        let step: u64 = file.trim_start_matches("snapshots/points_").trim_end_matches(".vtu").parse().unwrap();
+        let step: u64 = file
+            .trim_start_matches("snapshots/points_")
+            .trim_end_matches(".vtu")
+            .parse()
+            .unwrap();
         // Simulated time n Δt; the history (every 10 steps) has the same time at its rows.
         assert!((t / (step as f64 * dt) - 1.0).abs() < 1e-12, "{file}: {t}");
         if let Some(h) = history.get(&step) {
@@ -117,7 +141,11 @@ fn the_series_reads_back_with_history_times_and_summary_values() {
         assert!(out.join(file).exists());
     }
     let last = &series.last().unwrap().1;
-    assert_eq!(last, &format!("snapshots/points_{steps:09}.vtu"), "the last step is a snapshot");
+    assert_eq!(
+        last,
+        &format!("snapshots/points_{steps:09}.vtu"),
+        "the last step is a snapshot"
+    );
 
     // The final snapshot holds every point, and the traced points' values of summary.json.
     let arrays = read_vtu(&out.join(last));
@@ -126,22 +154,46 @@ fn the_series_reads_back_with_history_times_and_summary_values() {
     let (_, x) = &arrays["Points"];
     let (_, u) = &arrays["displacement"];
     let (_, s) = &arrays["stress"];
-    for name in ["velocity", "mean_stress", "deviatoric_stress", "material", "plastic_strain", "volume"] {
+    for name in [
+        "velocity",
+        "mean_stress",
+        "deviatoric_stress",
+        "material",
+        "plastic_strain",
+        "volume",
+    ] {
         assert!(arrays.contains_key(name), "{name}");
     }
     for traced in summary["traced"].as_array().unwrap() {
-        let x0: Vec<f64> = traced["initial_position"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
+        let x0: Vec<f64> = traced["initial_position"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect();
         let k = (0..ids.len())
             .min_by(|&a, &b| {
-                let d = |k: usize| (0..3).map(|c| (x[3 * k + c] - u[3 * k + c] - x0[c]).powi(2)).sum::<f64>();
+                let d = |k: usize| {
+                    (0..3)
+                        .map(|c| (x[3 * k + c] - u[3 * k + c] - x0[c]).powi(2))
+                        .sum::<f64>()
+                };
                 d(a).total_cmp(&d(b))
             })
             .unwrap();
         for c in 0..3 {
-            assert_eq!(u[3 * k + c], traced["displacement"][c].as_f64().unwrap(), "{traced}");
+            assert_eq!(
+                u[3 * k + c],
+                traced["displacement"][c].as_f64().unwrap(),
+                "{traced}"
+            );
         }
         for (c, name) in ["xx", "yy", "zz", "xy", "yz", "zx"].iter().enumerate() {
-            assert_eq!(s[6 * k + c], traced["stress"][*name].as_f64().unwrap(), "{traced}");
+            assert_eq!(
+                s[6 * k + c],
+                traced["stress"][*name].as_f64().unwrap(),
+                "{traced}"
+            );
         }
     }
     let _ = std::fs::remove_dir_all(&out);
@@ -167,13 +219,26 @@ fn a_resumed_run_continues_the_series_of_the_run_it_resumes() {
         "--set",
         "solver.max_steps=700",
     ]);
-    assert!(first.status.success(), "{}", String::from_utf8_lossy(&first.stderr));
+    assert!(
+        first.status.success(),
+        "{}",
+        String::from_utf8_lossy(&first.stderr)
+    );
     // Resume from the checkpoint at step 600 as if the run had stopped there.
     let resumed = kdmpm(&["resume", out.to_str().unwrap(), "--quiet"]);
-    assert!(resumed.status.success(), "{}", String::from_utf8_lossy(&resumed.stderr));
+    assert!(
+        resumed.status.success(),
+        "{}",
+        String::from_utf8_lossy(&resumed.stderr)
+    );
     let steps: Vec<u64> = read_pvd(&out.join("points.pvd"))
         .iter()
-        .map(|(_, f)| f.trim_start_matches("snapshots/points_").trim_end_matches(".vtu").parse().unwrap())
+        .map(|(_, f)| {
+            f.trim_start_matches("snapshots/points_")
+                .trim_end_matches(".vtu")
+                .parse()
+                .unwrap()
+        })
         .collect();
     let mut sorted = steps.clone();
     sorted.dedup();

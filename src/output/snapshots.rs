@@ -44,7 +44,7 @@ const IN_FLIGHT: usize = 2;
 /// What the writer thread reports when it is done.
 #[derive(Clone, Debug, Default)]
 pub struct SnapshotReport {
-    /// Snapshot files written.
+    /// Snapshots in the series (`points.pvd`), a resumed run's earlier ones included.
     pub written: usize,
     /// Wall-clock seconds stepping waited for the writer (s).
     pub wait_seconds: f64,
@@ -55,7 +55,6 @@ pub struct SnapshotReport {
 pub struct Snapshots<D> {
     spec: SnapshotSpec,
     sender: Arc<Mutex<Option<Sender<Frame>>>>,
-    last_time_slot: Option<u64>,
     wait: Arc<Mutex<f64>>,
     _marker: PhantomData<fn() -> D>,
 }
@@ -73,7 +72,11 @@ type Entry = (f64, String);
 impl<D: Dim> Snapshots<D> {
     /// Starts the writer thread for output directory `dir`. `resume_time` (s) keeps the
     /// entries of an earlier run's `points.pvd` up to that time (a resumed run).
-    pub fn start(dir: &Path, spec: SnapshotSpec, resume_time: Option<f64>) -> std::io::Result<(Self, SnapshotWriter)> {
+    pub fn start(
+        dir: &Path,
+        spec: SnapshotSpec,
+        resume_time: Option<f64>,
+    ) -> std::io::Result<(Self, SnapshotWriter)> {
         let folder = dir.join(FOLDER);
         std::fs::create_dir_all(&folder)?;
         if resume_time.is_none() {
@@ -95,26 +98,23 @@ impl<D: Dim> Snapshots<D> {
         };
         let (tx, rx) = bounded::<Frame>(IN_FLIGHT);
         let dir = dir.to_path_buf();
-        let thread = std::thread::Builder::new()
-            .name("snapshots".into())
-            .spawn(move || -> std::io::Result<usize> {
-                let mut written = 0;
+        let thread = std::thread::Builder::new().name("snapshots".into()).spawn(
+            move || -> std::io::Result<usize> {
                 for frame in rx {
                     let name = format!("{FOLDER}/points_{:09}.vtu", frame.step);
                     write_frame(&frame, &dir.join(&name))?;
                     entries.push((frame.time, name));
                     write_pvd(&dir.join(PVD), &entries)?;
-                    written += 1;
                 }
-                Ok(written)
-            })?;
+                Ok(entries.len())
+            },
+        )?;
         let wait = Arc::new(Mutex::new(0.0));
         let sender = Arc::new(Mutex::new(Some(tx)));
         Ok((
             Snapshots {
                 spec,
                 sender: sender.clone(),
-                last_time_slot: None,
                 wait: wait.clone(),
                 _marker: PhantomData,
             },
@@ -126,16 +126,15 @@ impl<D: Dim> Snapshots<D> {
         ))
     }
 
-    fn due(&mut self, ctx: &Context<D>) -> bool {
+    fn due(&self, ctx: &Context<D>) -> bool {
         let st = &ctx.state;
         let by_steps = self.spec.every_steps.is_some_and(|n| st.step.is_multiple_of(n));
-        let by_time = self.spec.every_time.is_some_and(|t| {
-            // The slot of simulated time this step ends in; a snapshot at each new slot.
-            let slot = (st.time / t).floor() as u64;
-            let new = self.last_time_slot.is_some_and(|s| slot > s);
-            self.last_time_slot = Some(slot);
-            new
-        });
+        // A snapshot in each step that crosses a multiple of T: decided from this step
+        // alone, so a resumed run takes the snapshots the uninterrupted one takes.
+        let by_time = self
+            .spec
+            .every_time
+            .is_some_and(|t| (st.time / t).floor() > ((st.time - st.dt) / t).floor());
         by_steps || by_time || (self.spec.at_resets && st.reset_this_step) || st.stop.is_some()
     }
 }
@@ -172,7 +171,10 @@ impl SnapshotWriter {
             None => 0,
         };
         let wait_seconds = *lock(&self.wait);
-        Ok(SnapshotReport { written, wait_seconds })
+        Ok(SnapshotReport {
+            written,
+            wait_seconds,
+        })
     }
 }
 

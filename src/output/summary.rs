@@ -86,7 +86,7 @@ pub struct Summary {
     pub traced: Vec<TracedResult>,
     /// Per-system cost.
     pub systems: Vec<Timing>,
-    /// Snapshot files written (`output.snapshots`).
+    /// Snapshots in the series, `points.pvd` (`output.snapshots`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub snapshots: Option<usize>,
     /// Wall-clock seconds stepping waited for the snapshot writer (s).

@@ -52,7 +52,14 @@ fn arrays<S: Source>(src: &S) -> Vec<Array<'_>> {
     let n = src.len();
     let field = |f: Field| move |out: &mut BufWriter<File>| src.write(f, out);
     let mut arrays = vec![
-        Array::new(Part::Points, "Points", Kind::Float64, 3, n, field(Field::Position)),
+        Array::new(
+            Part::Points,
+            "Points",
+            Kind::Float64,
+            3,
+            n,
+            field(Field::Position),
+        ),
         // One vertex cell per point.
         Array::new(Part::Cells, "connectivity", Kind::Int64, 1, n, move |out| {
             (0..n as i64).try_for_each(|i| out.write_all(&i.to_le_bytes()))
@@ -64,19 +71,75 @@ fn arrays<S: Source>(src: &S) -> Vec<Array<'_>> {
             (0..n).try_for_each(|_| out.write_all(&[VTK_VERTEX]))
         }),
         Array::new(Part::PointData, "id", Kind::UInt32, 1, n, field(Field::Id)),
-        Array::new(Part::PointData, "material", Kind::UInt32, 1, n, field(Field::Material)),
+        Array::new(
+            Part::PointData,
+            "material",
+            Kind::UInt32,
+            1,
+            n,
+            field(Field::Material),
+        ),
     ];
     if src.has_displacement() {
-        arrays.push(Array::new(Part::PointData, "displacement", Kind::Float64, 3, n, field(Field::Displacement)));
+        arrays.push(Array::new(
+            Part::PointData,
+            "displacement",
+            Kind::Float64,
+            3,
+            n,
+            field(Field::Displacement),
+        ));
     }
     arrays.extend([
-        Array::new(Part::PointData, "velocity", Kind::Float64, 3, n, field(Field::Velocity)),
-        Array::new(Part::PointData, "stress", Kind::Float64, 6, n, field(Field::Stress)),
-        Array::new(Part::PointData, "mean_stress", Kind::Float64, 1, n, field(Field::MeanStress)),
-        Array::new(Part::PointData, "deviatoric_stress", Kind::Float64, 1, n, field(Field::DeviatoricStress)),
-        Array::new(Part::PointData, "volume", Kind::Float64, 1, n, field(Field::Volume)),
+        Array::new(
+            Part::PointData,
+            "velocity",
+            Kind::Float64,
+            3,
+            n,
+            field(Field::Velocity),
+        ),
+        Array::new(
+            Part::PointData,
+            "stress",
+            Kind::Float64,
+            6,
+            n,
+            field(Field::Stress),
+        ),
+        Array::new(
+            Part::PointData,
+            "mean_stress",
+            Kind::Float64,
+            1,
+            n,
+            field(Field::MeanStress),
+        ),
+        Array::new(
+            Part::PointData,
+            "deviatoric_stress",
+            Kind::Float64,
+            1,
+            n,
+            field(Field::DeviatoricStress),
+        ),
+        Array::new(
+            Part::PointData,
+            "volume",
+            Kind::Float64,
+            1,
+            n,
+            field(Field::Volume),
+        ),
         // Bodies without plastic state (elastic) write zero.
-        Array::new(Part::PointData, "plastic_strain", Kind::Float64, 1, n, field(Field::PlasticStrain)),
+        Array::new(
+            Part::PointData,
+            "plastic_strain",
+            Kind::Float64,
+            1,
+            n,
+            field(Field::PlasticStrain),
+        ),
     ]);
     let mut offset = 0;
     for array in &mut arrays {
@@ -161,17 +224,25 @@ impl<D: Dim> Source for Columns<'_, D> {
             [s.xx, s.yy, s.zz, s.xy, s.yz, s.zx]
         };
         match field {
-            Field::Position => each::<Position<D::Vec>>(archs, order, out, |out, x| f64s(out, &D::vec_to3(x.0))),
+            Field::Position => {
+                each::<Position<D::Vec>>(archs, order, out, |out, x| f64s(out, &D::vec_to3(x.0)))
+            }
             Field::Id => order
                 .points()
                 .try_for_each(|(id, _, _)| out.write_all(&(id as u32).to_le_bytes())),
-            Field::Material => each::<MaterialId>(archs, order, out, |out, m| out.write_all(&u32::from(m.0).to_le_bytes())),
+            Field::Material => each::<MaterialId>(archs, order, out, |out, m| {
+                out.write_all(&u32::from(m.0).to_le_bytes())
+            }),
             Field::Displacement => {
                 each::<Displacement<D::Vec>>(archs, order, out, |out, u| f64s(out, &D::vec_to3(u.0)))
             }
-            Field::Velocity => each::<Velocity<D::Vec>>(archs, order, out, |out, v| f64s(out, &D::vec_to3(v.0))),
+            Field::Velocity => {
+                each::<Velocity<D::Vec>>(archs, order, out, |out, v| f64s(out, &D::vec_to3(v.0)))
+            }
             Field::Stress => each::<Stress<D::Stress>>(archs, order, out, |out, s| f64s(out, &sym(s))),
-            Field::MeanStress => each::<Stress<D::Stress>>(archs, order, out, |out, s| f64s(out, &[invariants(&sym(s)).0])),
+            Field::MeanStress => {
+                each::<Stress<D::Stress>>(archs, order, out, |out, s| f64s(out, &[invariants(&sym(s)).0]))
+            }
             Field::DeviatoricStress => {
                 each::<Stress<D::Stress>>(archs, order, out, |out, s| f64s(out, &[invariants(&sym(s)).1]))
             }
@@ -265,7 +336,10 @@ impl Source for Frame {
         match field {
             Field::Position => self.position.iter().try_for_each(|x| f64s(out, x)),
             Field::Id => self.id.iter().try_for_each(|i| out.write_all(&i.to_le_bytes())),
-            Field::Material => self.material.iter().try_for_each(|m| out.write_all(&u32::from(*m).to_le_bytes())),
+            Field::Material => self
+                .material
+                .iter()
+                .try_for_each(|m| out.write_all(&u32::from(*m).to_le_bytes())),
             Field::Displacement => self.displacement.iter().flatten().try_for_each(|u| f64s(out, u)),
             Field::Velocity => self.velocity.iter().try_for_each(|v| f64s(out, v)),
             Field::Stress => self.stress.iter().try_for_each(|s| f64s(out, s)),
