@@ -2,7 +2,7 @@
 
 use clap::{Parser, Subcommand};
 use kdmpm::checkpoint;
-use kdmpm::output::{History, Outcome, OutputDir, SnapshotWriter, Snapshots, Summary};
+use kdmpm::output::{Outcome, OutputDir, Recorder, Summary};
 use kdmpm::scene::{build, CheckpointEvery, LoadedScene};
 use kdmpm::state::StopReason;
 use kdmpm::systems::convergence::ratio_text;
@@ -245,16 +245,7 @@ fn run(path: &Path, out: Option<PathBuf>, overrides: &[String], profile: bool, q
         wall_seconds: 0.0,
     };
     let options = Options { profile, quiet };
-    with_simulation!(&mut sim, s => {
-        let every = loaded.scene.output.history_every;
-        match History::create(&dir.file("history.csv"), every, &s.traced) {
-            Ok(h) => drive(s, &loaded, &dir, h, header, options),
-            Err(e) => {
-                eprintln!("error: cannot write {}: {e}", dir.file("history.csv").display());
-                ExitCode::from(BAD_INPUT)
-            }
-        }
-    })
+    with_simulation!(&mut sim, s => drive(s, &loaded, &dir, None, header, options))
 }
 
 /// Continues the run whose checkpoint is in `dir`.
@@ -290,11 +281,8 @@ fn resume(dir_path: &Path, profile: bool, quiet: bool) -> ExitCode {
         if let Err(e) = checkpoint::restore(s, &bytes, &file) {
             return fail(&e);
         }
-        let every = loaded.scene.output.history_every;
-        match History::resume(&dir.file("history.csv"), header.history_bytes, every, &s.traced) {
-            Ok(h) => drive(s, &loaded, &dir, h, header, options),
-            Err(e) => fail(&format!("cannot continue {}: {e}", dir.file("history.csv").display())),
-        }
+        let bytes = Some(header.history_bytes);
+        drive(s, &loaded, &dir, bytes, header, options)
     })
 }
 
@@ -317,32 +305,20 @@ fn drive<D: Dim>(
     sim: &mut Simulation<D>,
     loaded: &LoadedScene,
     dir: &OutputDir,
-    history: History<D>,
+    history_bytes: Option<u64>,
     mut header: checkpoint::Header,
     options: Options,
 ) -> ExitCode {
     let scene = &header.scene_path.clone();
-    let rows = history.rows();
-    sim.schedule.push(history);
-    let writer = match loaded.scene.output.snapshots {
-        Some(spec) => {
-            let resumed = (sim.ctx.state.step > 0).then_some(sim.ctx.state.time);
-            match Snapshots::<D>::start(dir.path(), spec, resumed) {
-                Ok((system, writer)) => {
-                    sim.schedule.push(system);
-                    Some(writer)
-                }
-                Err(e) => {
-                    eprintln!(
-                        "error: cannot start the snapshot writer in {}: {e}",
-                        dir.path().display()
-                    );
-                    return ExitCode::from(BAD_INPUT);
-                }
-            }
+    let output = &loaded.scene.output;
+    let recorder = match Recorder::attach(sim, dir, output.history_every, output.snapshots, history_bytes) {
+        Ok(r) => r,
+        Err(e) => {
+            eprintln!("error: cannot write into {}: {e}", dir.path().display());
+            return ExitCode::from(BAD_INPUT);
         }
-        None => None,
     };
+    let rows = recorder.rows().clone();
     // A second Ctrl-C while the first is being honoured ends the process at once; every
     // file is written whole or not at all, so nothing torn is left.
     let _ = ctrlc::set_handler(|| {
@@ -408,51 +384,22 @@ fn drive<D: Dim>(
     });
     let wall = before + start.elapsed().as_secs_f64();
     let error = result.as_ref().err().map(|e| e.to_string());
-    // The last step's state is written unless it holds a non-finite value (a failure
-    // caught after a point moved with it): nothing is ever written as NaN.
-    let mut notes = Vec::new();
-    match sim.first_non_finite() {
-        None => {
-            if let Err(e) = kdmpm::output::vtk::write_points(sim, &dir.file("points.vtu")) {
-                eprintln!("error: cannot write points.vtu: {e}");
-                return ExitCode::from(RUN_FAILED);
-            }
-        }
-        Some(what) => notes.push(format!(
-            "points.vtu not written: the state holds a non-finite {what}{}",
-            if dir.file(checkpoint::FILE_NAME).exists() {
-                "; the last checkpoint holds a finite state (kdmpm resume)"
-            } else {
-                ""
-            }
-        )),
-    }
-    let snapshots = match writer.map(SnapshotWriter::finish).transpose() {
-        Ok(r) => r,
+    let (summary, notes) = match recorder.finish(sim, dir, &scene.display().to_string(), wall, error) {
+        Ok(v) => v,
         Err(e) => {
-            eprintln!("error: cannot write the snapshots: {e}");
+            eprintln!(
+                "error: cannot write the results into {}: {e}",
+                dir.path().display()
+            );
             return ExitCode::from(RUN_FAILED);
         }
     };
-    // After the output, so that the peak memory covers the whole run.
-    let mut summary = Summary::collect(&scene.display().to_string(), sim, wall, error);
-    if let Some(r) = snapshots {
-        summary.snapshots = Some(r.written);
-        summary.output_wait_seconds = Some(r.wait_seconds);
-    }
-    let written = dir.write_atomic("summary.json", |out| {
-        serde_json::to_writer_pretty(&mut *out, &summary).map_err(std::io::Error::other)
-    });
-    if let Err(e) = written {
-        eprintln!("error: cannot write summary.json: {e}");
-        return ExitCode::from(RUN_FAILED);
-    }
     if options.profile {
         print_profile(&summary);
     }
     if let Err(e) = result {
         eprintln!("error: {e}");
-        for n in notes {
+        for n in notes.0 {
             eprintln!("  {n}");
         }
         return ExitCode::from(RUN_FAILED);

@@ -3,11 +3,13 @@
 
 pub mod dir;
 pub mod history;
+pub mod recorder;
 pub mod snapshots;
 pub mod summary;
 pub mod vtk;
 
 pub use dir::{OutputDir, RowFile};
 pub use history::History;
+pub use recorder::Recorder;
 pub use snapshots::{SnapshotSpec, SnapshotWriter, Snapshots};
 pub use summary::{Outcome, Summary};

@@ -1,0 +1,102 @@
+//! Everything a run writes, for any [`Simulation`]: attach a [`Recorder`] before stepping
+//! and finish it after. The `kdmpm` binary does exactly this; a library user gets the same
+//! files (`examples/write_results.rs`).
+
+use crate::dim::Dim;
+use crate::output::dir::OutputDir;
+use crate::output::history::{self, History};
+use crate::output::snapshots::{SnapshotSpec, SnapshotWriter, Snapshots};
+use crate::output::summary::Summary;
+use crate::output::vtk::write_points;
+use crate::output::RowFile;
+use crate::simulation::Simulation;
+use std::io::Write;
+use std::sync::{Arc, Mutex};
+
+/// The outputs a run writes into its directory: `history.csv` every `history_every` steps,
+/// the snapshot series when `snapshots` is set, and at the end `points.vtu` and
+/// `summary.json`.
+pub struct Recorder {
+    rows: Arc<Mutex<RowFile>>,
+    snapshots: Option<SnapshotWriter>,
+}
+
+/// What [`Recorder::finish`] left out, for the run's report (never an error: the files it
+/// did write are whole).
+#[derive(Clone, Debug, Default)]
+pub struct Notes(pub Vec<String>);
+
+impl Recorder {
+    /// Adds the history and (with `snapshots`) the snapshot systems to the end of `sim`'s
+    /// schedule, writing into `dir`. A run resumed from a checkpoint passes the history
+    /// file's committed length in `history_bytes`; a new run passes `None`.
+    pub fn attach<D: Dim>(
+        sim: &mut Simulation<D>,
+        dir: &OutputDir,
+        history_every: u64,
+        snapshots: Option<SnapshotSpec>,
+        history_bytes: Option<u64>,
+    ) -> std::io::Result<Recorder> {
+        let file = dir.file("history.csv");
+        let history = match history_bytes {
+            None => History::<D>::create(&file, history_every, &sim.traced)?,
+            Some(bytes) => History::<D>::resume(&file, bytes, history_every, &sim.traced)?,
+        };
+        let rows = history.rows();
+        sim.schedule.push(history);
+        let snapshots = match snapshots {
+            Some(spec) => {
+                let resumed = history_bytes.map(|_| sim.ctx.state.time);
+                let (system, writer) = Snapshots::<D>::start(dir.path(), spec, resumed)?;
+                sim.schedule.push(system);
+                Some(writer)
+            }
+            None => None,
+        };
+        Ok(Recorder { rows, snapshots })
+    }
+
+    /// The history rows, shared with a checkpoint writer (it flushes them and notes their
+    /// length).
+    pub fn rows(&self) -> &Arc<Mutex<RowFile>> {
+        &self.rows
+    }
+
+    /// Flushes the history, waits for the snapshot writer, writes `points.vtu` (unless the
+    /// state holds a non-finite value: nothing is ever written as NaN) and `summary.json`,
+    /// and returns the summary with what was left out.
+    pub fn finish<D: Dim>(
+        self,
+        sim: &Simulation<D>,
+        dir: &OutputDir,
+        scene: &str,
+        wall_seconds: f64,
+        error: Option<String>,
+    ) -> std::io::Result<(Summary, Notes)> {
+        history::lock(&self.rows).flush()?;
+        let series = self.snapshots.map(SnapshotWriter::finish).transpose()?;
+        let mut notes = Notes::default();
+        match sim.first_non_finite() {
+            None => write_points(sim, &dir.file("points.vtu"))?,
+            Some(what) => notes.0.push(format!(
+                "points.vtu not written: the state holds a non-finite {what}{}",
+                if dir.file(crate::checkpoint::FILE_NAME).exists() {
+                    "; the last checkpoint holds a finite state (kdmpm resume)"
+                } else {
+                    ""
+                }
+            )),
+        }
+        // After the output, so that the peak memory covers the whole run.
+        let mut summary = Summary::collect(scene, sim, wall_seconds, error);
+        if let Some(r) = series {
+            summary.snapshots = Some(r.written);
+            summary.output_wait_seconds = Some(r.wait_seconds);
+        }
+        dir.write_atomic("summary.json", |out| {
+            serde_json::to_writer_pretty(&mut *out, &summary).map_err(std::io::Error::other)?;
+            out.write_all(b"\n")
+        })?;
+        Ok((summary, notes))
+    }
+}
