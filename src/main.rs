@@ -2,7 +2,7 @@
 
 use clap::{Parser, Subcommand};
 use kdmpm::checkpoint;
-use kdmpm::output::{Outcome, OutputDir, Recorder, Summary};
+use kdmpm::output::{Outcome, OutputDir, Progress, Recorder, Summary};
 use kdmpm::scene::{build, CheckpointEvery, LoadedScene};
 use kdmpm::state::StopReason;
 use kdmpm::systems::convergence::ratio_text;
@@ -342,7 +342,7 @@ fn drive<D: Dim>(
     }
     let before = header.wall_seconds;
     let start = Instant::now();
-    let mut last_report = Instant::now();
+    let mut progress = Progress::new(options.quiet, loaded.scene.solver.tolerance, sim.ctx.state.step);
     let mut last_checkpoint = Instant::now();
     let every = loaded.scene.solver.checkpoint_every;
     let save = |sim: &Simulation<D>, header: &mut checkpoint::Header| -> std::io::Result<()> {
@@ -355,17 +355,7 @@ fn drive<D: Dim>(
     };
     let result = sim.run_with(|s| {
         let st = &s.ctx.state;
-        if !options.quiet && last_report.elapsed().as_secs_f64() > 2.0 {
-            last_report = Instant::now();
-            eprintln!(
-                "  step {:>8}  t = {:<10.4}  K_F = {}  K_E = {}  resets {}",
-                st.step,
-                st.time,
-                ratio_text(st.force_ratio_max, 3),
-                ratio_text(st.energy_ratio, 3),
-                st.resets
-            );
-        }
+        progress.update(st);
         let interrupted = INTERRUPTED.load(Ordering::SeqCst);
         let due = st.stop.is_none()
             && match every {
@@ -382,6 +372,7 @@ fn drive<D: Dim>(
         }
         Ok(())
     });
+    progress.finish();
     let wall = before + start.elapsed().as_secs_f64();
     let error = result.as_ref().err().map(|e| e.to_string());
     let (summary, notes) = match recorder.finish(sim, dir, &scene.display().to_string(), wall, error) {
@@ -492,7 +483,7 @@ fn run_study(
         threads: threads.map(|n| n.get()),
     };
     let total = study.runs.len() + usize::from(study.reference.is_some());
-    let progress = Progress::new(total as u64, quiet);
+    let progress = StudyProgress::new(total as u64, quiet);
     let mut run = |planned: &study::Planned| {
         progress.start(planned);
         let r = study::run_one(&study, planned, &dir, &launch);
@@ -539,14 +530,14 @@ fn run_study(
 
 /// Progress over a study's runs: a bar on a terminal, a line a run otherwise, nothing
 /// with `--quiet`.
-struct Progress {
+struct StudyProgress {
     bar: Option<indicatif::ProgressBar>,
     lines: bool,
     total: u64,
     done: std::cell::Cell<u64>,
 }
 
-impl Progress {
+impl StudyProgress {
     fn new(total: u64, quiet: bool) -> Self {
         use std::io::IsTerminal;
         let terminal = std::io::stderr().is_terminal();
@@ -560,7 +551,7 @@ impl Progress {
             );
             bar
         });
-        Progress {
+        StudyProgress {
             bar,
             lines: !quiet && !terminal,
             total,

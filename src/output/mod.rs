@@ -3,6 +3,7 @@
 
 pub mod dir;
 pub mod history;
+pub mod progress;
 pub mod recorder;
 pub mod snapshots;
 pub mod summary;
@@ -10,6 +11,7 @@ pub mod vtk;
 
 pub use dir::{OutputDir, RowFile};
 pub use history::History;
+pub use progress::Progress;
 pub use recorder::Recorder;
 pub use snapshots::{SnapshotSpec, SnapshotWriter, Snapshots};
 pub use summary::{Outcome, Summary};
