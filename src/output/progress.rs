@@ -110,7 +110,7 @@ impl Progress {
             (a + (x - mx) * (y - my), b + (x - mx) * (x - mx))
         });
         let slope = sxy / sxx;
-        if !(slope < 0.0) {
+        if slope.is_nan() || slope >= 0.0 {
             return None;
         }
         let steps = (self.tolerance.ln() - kf.ln()) / slope;
