@@ -86,6 +86,12 @@ enum Command {
         #[arg(long, short)]
         quiet: bool,
     },
+    /// Draw (again) the plots of a run from its output directory, finished or running:
+    /// kinetic energy, K_F and K_E, traced displacements, displacement field (SVG).
+    Plot {
+        /// The run's output directory.
+        dir: PathBuf,
+    },
     /// Parse and validate a scene without running it; print the derived figures.
     Check {
         /// Scene file (RON).
@@ -104,6 +110,21 @@ const RUN_FAILED: u8 = 1;
 fn main() -> ExitCode {
     match Cli::parse().command {
         Command::Check { scene, overrides } => check(&scene, &overrides),
+        Command::Plot { dir } => match kdmpm::output::plots::draw(&dir) {
+            Ok((written, skipped)) => {
+                for w in written {
+                    println!("{}", dir.join(w).display());
+                }
+                for s in skipped {
+                    eprintln!("  not drawn: {s}");
+                }
+                ExitCode::SUCCESS
+            }
+            Err(e) => {
+                eprintln!("error: cannot plot {}: {e}", dir.display());
+                ExitCode::from(BAD_INPUT)
+            }
+        },
         Command::Study {
             study,
             out,

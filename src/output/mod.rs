@@ -3,6 +3,7 @@
 
 pub mod dir;
 pub mod history;
+pub mod plots;
 pub mod progress;
 pub mod recorder;
 pub mod snapshots;

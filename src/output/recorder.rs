@@ -14,8 +14,8 @@ use std::io::Write;
 use std::sync::{Arc, Mutex};
 
 /// The outputs a run writes into its directory: `history.csv` every `history_every` steps,
-/// the snapshot series when `snapshots` is set, and at the end `points.vtu` and
-/// `summary.json`.
+/// the snapshot series when `snapshots` is set, and at the end `points.vtu`,
+/// `summary.json` and the plots ([`crate::output::plots`]).
 pub struct Recorder {
     rows: Arc<Mutex<RowFile>>,
     snapshots: Option<SnapshotWriter>,
@@ -97,6 +97,8 @@ impl Recorder {
             serde_json::to_writer_pretty(&mut *out, &summary).map_err(std::io::Error::other)?;
             out.write_all(b"\n")
         })?;
+        let (_, skipped) = crate::output::plots::draw(dir.path())?;
+        notes.0.extend(skipped);
         Ok((summary, notes))
     }
 }

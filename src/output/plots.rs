@@ -1,0 +1,402 @@
+//! The paper's figures of a run, drawn from its files (SVG, plotters; no font files and no
+//! external program): kinetic energy with its resets (Figs. 3 and 6), the force and energy
+//! ratios against the tolerance, the traced displacements (Fig. 4) and the displacement
+//! field over the deformed points (Fig. 7). `kdmpm plot DIR` redraws them from a finished
+//! or a running output directory.
+
+use crate::output::dir::write_atomic;
+use plotters::prelude::*;
+use std::io::Write;
+use std::path::Path;
+
+/// The files [`draw`] writes.
+pub const FILES: [&str; 4] = [
+    "kinetic_energy.svg",
+    "convergence.svg",
+    "traced_displacement.svg",
+    "displacement_field.svg",
+];
+
+/// `history.csv` as columns of numbers (a value written `undefined` is NaN here, and
+/// left out of every plot).
+struct History {
+    names: Vec<String>,
+    rows: Vec<Vec<f64>>,
+}
+
+impl History {
+    fn read(path: &Path) -> std::io::Result<History> {
+        let text = std::fs::read_to_string(path)?;
+        let mut lines = text.lines();
+        let names: Vec<String> = lines
+            .next()
+            .unwrap_or("")
+            .split(',')
+            .map(str::to_string)
+            .collect();
+        let rows = lines
+            .map(|l| {
+                l.split(',')
+                    .map(|v| v.parse().unwrap_or(f64::NAN))
+                    .collect::<Vec<f64>>()
+            })
+            .filter(|r| r.len() == names.len())
+            .collect();
+        Ok(History { names, rows })
+    }
+
+    fn column(&self, name: &str) -> Option<Vec<f64>> {
+        let k = self.names.iter().position(|n| n == name)?;
+        Some(self.rows.iter().map(|r| r[k]).collect())
+    }
+}
+
+/// Positions and displacements of the points of a `.vtu` this crate wrote.
+fn read_field(path: &Path) -> std::io::Result<(Vec<[f64; 3]>, Vec<[f64; 3]>)> {
+    let bytes = std::fs::read(path)?;
+    let bad = || {
+        std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            format!("{} is not a points file of kdmpm", path.display()),
+        )
+    };
+    let open = b"<AppendedData encoding=\"raw\">";
+    let at = bytes
+        .windows(open.len())
+        .position(|w| w == open)
+        .ok_or_else(bad)?;
+    let head = std::str::from_utf8(&bytes[..at]).map_err(|_| bad())?;
+    let data_start = at
+        + open.len()
+        + bytes[at + open.len()..]
+            .iter()
+            .position(|&b| b == b'_')
+            .ok_or_else(bad)?
+        + 1;
+    let data = &bytes[data_start..];
+    let offset_of = |name: Option<&str>| -> Option<usize> {
+        let line = head.lines().find(|l| {
+            l.contains("<DataArray")
+                && match name {
+                    Some(n) => l.contains(&format!("Name=\"{n}\"")),
+                    None => !l.contains("Name="),
+                }
+        })?;
+        let start = line.find("offset=\"")? + 8;
+        line[start..start + line[start..].find('"')?].parse().ok()
+    };
+    let vectors = |offset: usize| -> Option<Vec<[f64; 3]>> {
+        let len = u64::from_le_bytes(data.get(offset..offset + 8)?.try_into().ok()?) as usize;
+        let raw = data.get(offset + 8..offset + 8 + len)?;
+        Some(
+            raw.chunks_exact(24)
+                .map(|c| {
+                    std::array::from_fn(|k| {
+                        f64::from_le_bytes(c[8 * k..8 * k + 8].try_into().unwrap_or([0; 8]))
+                    })
+                })
+                .collect(),
+        )
+    };
+    let x = offset_of(None).and_then(vectors).ok_or_else(bad)?;
+    let u = offset_of(Some("displacement"))
+        .and_then(vectors)
+        .unwrap_or_default();
+    Ok((x, u))
+}
+
+/// Draws the four figures of the run in `dir` next to its results. Returns the names
+/// written and, for a figure that could not be drawn, why (a run without `points.vtu` yet
+/// has no displacement field).
+pub fn draw(dir: &Path) -> std::io::Result<(Vec<&'static str>, Vec<String>)> {
+    let history = History::read(&dir.join("history.csv"))?;
+    let summary: serde_json::Value = std::fs::read_to_string(dir.join("summary.json"))
+        .ok()
+        .and_then(|t| serde_json::from_str(&t).ok())
+        .unwrap_or_default();
+    let tolerance = summary["tolerance"].as_f64();
+    let mut written = Vec::new();
+    let mut skipped = Vec::new();
+    let t = history.column("time").unwrap_or_default();
+    let save = |name: &str, svg: String| write_atomic(&dir.join(name), |out| out.write_all(svg.as_bytes()));
+
+    if let (Some(ke), Some(resets)) = (history.column("kinetic_energy"), history.column("resets")) {
+        save(FILES[0], kinetic_energy(&t, &ke, &resets))?;
+        written.push(FILES[0]);
+    }
+    if let (Some(kf), Some(ke)) = (history.column("force_ratio_max"), history.column("energy_ratio")) {
+        save(FILES[1], ratios(&t, &kf, &ke, tolerance))?;
+        written.push(FILES[1]);
+    }
+    let traced: Vec<(String, Vec<f64>)> = history
+        .names
+        .iter()
+        .filter(|n| n.contains("_u"))
+        .filter_map(|n| Some((n.clone(), history.column(n)?)))
+        .collect();
+    if traced.is_empty() {
+        skipped.push(format!("{}: the scene traces no point", FILES[2]));
+    } else {
+        save(FILES[2], traced_plot(&t, &traced))?;
+        written.push(FILES[2]);
+    }
+    match read_field(&dir.join("points.vtu")) {
+        Ok((x, u)) if !u.is_empty() => {
+            save(FILES[3], field(&x, &u))?;
+            written.push(FILES[3]);
+        }
+        Ok(_) => skipped.push(format!("{}: the run keeps no displacements", FILES[3])),
+        Err(e) => skipped.push(format!("{}: {e}", FILES[3])),
+    }
+    Ok((written, skipped))
+}
+
+/// The lower and upper ends of a log axis through the positive finite values of `v`.
+fn log_range(v: impl Iterator<Item = f64>) -> (f64, f64) {
+    let (lo, hi) = v
+        .filter(|x| x.is_finite() && *x > 0.0)
+        .fold((f64::INFINITY, 0.0f64), |(a, b), x| (a.min(x), b.max(x)));
+    if lo.is_finite() {
+        (lo / 2.0, hi * 2.0)
+    } else {
+        (1e-12, 1.0)
+    }
+}
+
+fn time_range(t: &[f64]) -> (f64, f64) {
+    let hi = t.iter().copied().filter(|x| x.is_finite()).fold(0.0f64, f64::max);
+    (0.0, if hi > 0.0 { hi } else { 1.0 })
+}
+
+type Result<T> = std::result::Result<T, Box<dyn std::error::Error>>;
+
+/// Runs a drawing into an SVG string; a drawing error leaves what was drawn.
+fn svg(
+    size: (u32, u32),
+    f: impl FnOnce(DrawingArea<SVGBackend, plotters::coord::Shift>) -> Result<()>,
+) -> String {
+    let mut s = String::new();
+    {
+        let root = SVGBackend::with_string(&mut s, size).into_drawing_area();
+        let _ = root.fill(&WHITE);
+        let _ = f(root);
+    }
+    s
+}
+
+/// Kinetic energy against time on a log scale, each reset marked where the count rises.
+fn kinetic_energy(t: &[f64], ke: &[f64], resets: &[f64]) -> String {
+    svg((960, 600), |root| {
+        let (y0, y1) = log_range(ke.iter().copied());
+        let (x0, x1) = time_range(t);
+        let mut c = ChartBuilder::on(&root)
+            .caption(
+                "Kinetic energy (velocities reset at each peak)",
+                ("sans-serif", 22),
+            )
+            .margin(20)
+            .x_label_area_size(50)
+            .y_label_area_size(80)
+            .build_cartesian_2d(x0..x1, (y0..y1).log_scale())?;
+        c.configure_mesh()
+            .x_desc("simulated time t (s)")
+            .y_desc("kinetic energy E_k (J)")
+            .y_label_formatter(&|v| format!("{v:.0e}"))
+            .label_style(("sans-serif", 15))
+            .draw()?;
+        let pts: Vec<(f64, f64)> = t
+            .iter()
+            .zip(ke)
+            .filter(|p| *p.1 > 0.0 && p.1.is_finite())
+            .map(|(a, b)| (*a, *b))
+            .collect();
+        c.draw_series(LineSeries::new(pts, BLUE.stroke_width(2)))?
+            .label("E_k")
+            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLUE.stroke_width(2)));
+        let marks: Vec<f64> = (1..resets.len())
+            .filter(|&k| resets[k] > resets[k - 1])
+            .map(|k| t[k])
+            .collect();
+        c.draw_series(
+            marks
+                .iter()
+                .map(|&x| PathElement::new(vec![(x, y0), (x, y1)], RED.mix(0.35))),
+        )?
+        .label(format!("reset ({} rows with one)", marks.len()))
+        .legend(|(x, y)| PathElement::new(vec![(x, y - 8), (x, y + 8)], RED));
+        c.configure_series_labels()
+            .border_style(BLACK)
+            .background_style(WHITE.mix(0.9))
+            .label_font(("sans-serif", 14))
+            .draw()?;
+        Ok(())
+    })
+}
+
+/// K_F and K_E against time on a log scale, with the tolerance.
+fn ratios(t: &[f64], kf: &[f64], ke: &[f64], tolerance: Option<f64>) -> String {
+    svg((960, 600), |root| {
+        let (y0, y1) = log_range(kf.iter().chain(ke).copied().chain(tolerance));
+        let (x0, x1) = time_range(t);
+        let mut c = ChartBuilder::on(&root)
+            .caption(
+                "Convergence: force ratio K_F and energy ratio K_E",
+                ("sans-serif", 22),
+            )
+            .margin(20)
+            .x_label_area_size(50)
+            .y_label_area_size(80)
+            .build_cartesian_2d(x0..x1, (y0..y1).log_scale())?;
+        c.configure_mesh()
+            .x_desc("simulated time t (s)")
+            .y_desc("ratio (dimensionless)")
+            .y_label_formatter(&|v| format!("{v:.0e}"))
+            .label_style(("sans-serif", 15))
+            .draw()?;
+        let series = |v: &[f64]| -> Vec<(f64, f64)> {
+            t.iter()
+                .zip(v)
+                .filter(|p| *p.1 > 0.0 && p.1.is_finite())
+                .map(|(a, b)| (*a, *b))
+                .collect()
+        };
+        c.draw_series(LineSeries::new(series(kf), BLUE.stroke_width(2)))?
+            .label("K_F (max norm, eq. 3)")
+            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLUE.stroke_width(2)));
+        c.draw_series(LineSeries::new(series(ke), GREEN.stroke_width(2)))?
+            .label("K_E (eq. 4)")
+            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], GREEN.stroke_width(2)));
+        if let Some(tol) = tolerance {
+            c.draw_series(LineSeries::new(vec![(x0, tol), (x1, tol)], RED.stroke_width(2)))?
+                .label(format!("tolerance {tol:e}"))
+                .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED.stroke_width(2)));
+        }
+        c.configure_series_labels()
+            .border_style(BLACK)
+            .background_style(WHITE.mix(0.9))
+            .label_font(("sans-serif", 14))
+            .draw()?;
+        Ok(())
+    })
+}
+
+/// Each traced point's displacement components against time.
+fn traced_plot(t: &[f64], traced: &[(String, Vec<f64>)]) -> String {
+    svg((960, 600), |root| {
+        let all = traced
+            .iter()
+            .flat_map(|(_, v)| v.iter().copied())
+            .filter(|v| v.is_finite());
+        let (lo, hi) = all.fold((0.0f64, 0.0f64), |(a, b), v| (a.min(v), b.max(v)));
+        let pad = 0.05 * (hi - lo).max(1e-30);
+        let (x0, x1) = time_range(t);
+        let mut c = ChartBuilder::on(&root)
+            .caption("Traced points: displacement against time", ("sans-serif", 22))
+            .margin(20)
+            .x_label_area_size(50)
+            .y_label_area_size(90)
+            .build_cartesian_2d(x0..x1, (lo - pad)..(hi + pad))?;
+        c.configure_mesh()
+            .x_desc("simulated time t (s)")
+            .y_desc("displacement (m)")
+            .y_label_formatter(&|v| format!("{v:.3e}"))
+            .label_style(("sans-serif", 15))
+            .draw()?;
+        for (k, (name, v)) in traced.iter().enumerate() {
+            let colour = Palette99::pick(k).to_rgba();
+            let pts: Vec<(f64, f64)> = t
+                .iter()
+                .zip(v)
+                .filter(|p| p.1.is_finite())
+                .map(|(a, b)| (*a, *b))
+                .collect();
+            c.draw_series(LineSeries::new(pts, colour.stroke_width(2)))?
+                .label(name.replace("_u", " u_"))
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2)));
+        }
+        c.configure_series_labels()
+            .border_style(BLACK)
+            .background_style(WHITE.mix(0.9))
+            .label_font(("sans-serif", 14))
+            .draw()?;
+        Ok(())
+    })
+}
+
+/// A colour for a value in [0, 1]: dark blue through green to yellow.
+fn colour(s: f64) -> RGBColor {
+    let s = s.clamp(0.0, 1.0);
+    let stops = [
+        (68.0, 1.0, 84.0),
+        (59.0, 82.0, 139.0),
+        (33.0, 145.0, 140.0),
+        (94.0, 201.0, 98.0),
+        (253.0, 231.0, 37.0),
+    ];
+    let x = s * (stops.len() - 1) as f64;
+    let k = (x.floor() as usize).min(stops.len() - 2);
+    let f = x - k as f64;
+    let (a, b) = (stops[k], stops[k + 1]);
+    let m = |p: f64, q: f64| (p + f * (q - p)).round() as u8;
+    RGBColor(m(a.0, b.0), m(a.1, b.1), m(a.2, b.2))
+}
+
+/// The final points at their deformed positions (x, y), coloured by |u|, with a colour bar.
+fn field(x: &[[f64; 3]], u: &[[f64; 3]]) -> String {
+    svg((1100, 620), |root| {
+        let (main, bar) = root.split_horizontally(980);
+        let mag: Vec<f64> = u
+            .iter()
+            .map(|u| (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt())
+            .collect();
+        let top = mag.iter().copied().fold(0.0f64, f64::max).max(1e-300);
+        let (mut xl, mut xh, mut yl, mut yh) =
+            (f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY);
+        for p in x {
+            xl = xl.min(p[0]);
+            xh = xh.max(p[0]);
+            yl = yl.min(p[1]);
+            yh = yh.max(p[1]);
+        }
+        let pad = 0.03 * (xh - xl).max(yh - yl).max(1e-9);
+        let mut c = ChartBuilder::on(&main)
+            .caption(
+                "Displacement magnitude |u| on the deformed points",
+                ("sans-serif", 22),
+            )
+            .margin(20)
+            .x_label_area_size(50)
+            .y_label_area_size(70)
+            .build_cartesian_2d((xl - pad)..(xh + pad), (yl - pad)..(yh + pad))?;
+        c.configure_mesh()
+            .x_desc("x (m)")
+            .y_desc("y (m)")
+            .label_style(("sans-serif", 15))
+            .disable_mesh()
+            .draw()?;
+        c.draw_series(
+            x.iter()
+                .zip(&mag)
+                .map(|(p, m)| Circle::new((p[0], p[1]), 2, colour(m / top).filled())),
+        )?;
+        // The colour bar: |u| from 0 to its maximum.
+        let mut b = ChartBuilder::on(&bar)
+            .margin_top(60)
+            .margin_bottom(70)
+            .y_label_area_size(70)
+            .build_cartesian_2d(0.0..1.0, 0.0..top)?;
+        b.configure_mesh()
+            .disable_x_axis()
+            .disable_mesh()
+            .y_desc("|u| (m)")
+            .y_label_formatter(&|v| format!("{v:.2}"))
+            .label_style(("sans-serif", 13))
+            .draw()?;
+        let n = 100;
+        b.draw_series((0..n).map(|k| {
+            let (a, z) = (top * k as f64 / n as f64, top * (k + 1) as f64 / n as f64);
+            Rectangle::new([(0.0, a), (1.0, z)], colour((k as f64 + 0.5) / n as f64).filled())
+        }))?;
+        Ok(())
+    })
+}
