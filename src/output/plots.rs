@@ -51,8 +51,11 @@ impl History {
     }
 }
 
+/// Positions (m) and displacements (m) of every point, in file order.
+type PointField = (Vec<[f64; 3]>, Vec<[f64; 3]>);
+
 /// Positions and displacements of the points of a `.vtu` this crate wrote.
-fn read_field(path: &Path) -> std::io::Result<(Vec<[f64; 3]>, Vec<[f64; 3]>)> {
+fn read_field(path: &Path) -> std::io::Result<PointField> {
     let bytes = std::fs::read(path)?;
     let bad = || {
         std::io::Error::new(
