@@ -140,6 +140,12 @@ fn the_series_reads_back_with_history_times_and_summary_values() {
         previous = *t;
         assert!(out.join(file).exists());
     }
+    // The four figures are written next to the results, as well-formed SVG.
+    for plot in kdmpm::output::plots::FILES {
+        let text = std::fs::read_to_string(out.join(plot)).unwrap_or_else(|e| panic!("{plot}: {e}"));
+        let doc = roxmltree::Document::parse(&text).unwrap_or_else(|e| panic!("{plot}: {e}"));
+        assert_eq!(doc.root_element().tag_name().name(), "svg", "{plot}");
+    }
     let last = &series.last().unwrap().1;
     assert_eq!(
         last,
