@@ -100,6 +100,7 @@ impl<D: Dim> Snapshots<D> {
         let dir = dir.to_path_buf();
         let thread = std::thread::Builder::new().name("snapshots".into()).spawn(
             move || -> std::io::Result<usize> {
+                lower_priority();
                 for frame in rx {
                     let name = format!("{FOLDER}/points_{:09}.vtu", frame.step);
                     write_frame(&frame, &dir.join(&name))?;
@@ -175,6 +176,19 @@ impl SnapshotWriter {
             written,
             wait_seconds,
         })
+    }
+}
+
+/// Gives the calling thread the lowest scheduling priority (nice 19), so that writing
+/// snapshots takes a core mostly when the stepping threads leave it idle; back-pressure
+/// (two frames in flight) keeps the writer from falling behind without bound.
+fn lower_priority() {
+    #[cfg(target_os = "linux")]
+    // SAFETY: setpriority reads and writes no memory of ours; on Linux, PRIO_PROCESS with
+    // who = 0 names the calling thread only. A failure leaves the priority as it was, which
+    // is harmless, so the result is ignored.
+    unsafe {
+        libc::setpriority(libc::PRIO_PROCESS, 0, 19);
     }
 }
 
