@@ -1,6 +1,6 @@
 //! Quadratic B-splines with a boundary modification.
 
-use super::{for_each_row, from_lanes, in_lanes, GradientSum, Shape, Stencil1, StressColumns};
+use super::{fold_ghosts, for_each_row, from_lanes, in_lanes, GradientSum, Shape, Stencil1, StressColumns};
 use crate::dim::Dim;
 use crate::grid::{cell_index, index_to_f64, Axis, Grid};
 use crate::lanes::{F64x4, Lanes};
@@ -37,28 +37,7 @@ impl Shape for QuadraticBSpline {
         let g0 = -(0.5 - d) * inv_h;
         let g1 = -2.0 * d * inv_h;
         let g2 = (0.5 + d) * inv_h;
-        if t < 0.0 {
-            // Ghost node at −1: nodes 0, 1, 2.
-            Stencil1 {
-                base: 0,
-                w: [w1 + 2.0 * w0, w2 - w0, 0.0],
-                dw: [g1 + 2.0 * g0, g2 - g0, 0.0],
-            }
-        } else if k + 2 > cells {
-            // Ghost node at cells + 1: nodes cells − 2, cells − 1, cells.
-            let base = cells - 2;
-            Stencil1 {
-                base,
-                w: [0.0, w0 - w2, w1 + 2.0 * w2],
-                dw: [0.0, g0 - g2, g1 + 2.0 * g2],
-            }
-        } else {
-            Stencil1 {
-                base: k,
-                w: [w0, w1, w2],
-                dw: [g0, g1, g2],
-            }
-        }
+        fold_ghosts(t, k, cells, [w0, w1, w2], [g0, g1, g2])
     }
 
     /// Row by row along x: with v̄ = Σ_i w_i v_i and v' = Σ_i w_i' v_i over a row's three

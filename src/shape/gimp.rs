@@ -2,7 +2,7 @@
 //! cell) and its weights are the linear hat averaged over the box (Bardenhagen and Kober
 //! 2004), modified at grid faces like the B-spline.
 
-use super::{Shape, Stencil1};
+use super::{fold_ghosts, Shape, Stencil1};
 use crate::grid::{cell_index, index_to_f64, Axis};
 
 /// The generalised-interpolation weight of a node at distance `r` (cell units) from a point
@@ -56,25 +56,7 @@ impl Shape for UniformGimp {
         let (w2, g2) = weight(xi - b - 2.0, l);
         // With r = xi − node, dS/dx = S'(r)/h.
         let (g0, g1, g2) = (g0 * inv_h, g1 * inv_h, g2 * inv_h);
-        if t < 0.0 {
-            Stencil1 {
-                base: 0,
-                w: [w1 + 2.0 * w0, w2 - w0, 0.0],
-                dw: [g1 + 2.0 * g0, g2 - g0, 0.0],
-            }
-        } else if k + 2 > cells {
-            Stencil1 {
-                base: cells - 2,
-                w: [0.0, w0 - w2, w1 + 2.0 * w2],
-                dw: [0.0, g0 - g2, g1 + 2.0 * g2],
-            }
-        } else {
-            Stencil1 {
-                base: k,
-                w: [w0, w1, w2],
-                dw: [g0, g1, g2],
-            }
-        }
+        fold_ghosts(t, k, cells, [w0, w1, w2], [g0, g1, g2])
     }
 }
 

@@ -28,6 +28,34 @@ pub struct Stencil1 {
     pub dw: [f64; 3],
 }
 
+/// The stencil of three-node weights `w`, `dw` on nodes `k`, `k + 1`, `k + 2` (with
+/// `t = xi − ½`, `k` its cell index), moved inside the grid at its faces: a ghost node
+/// beyond a face takes the linear extrapolation of the two nodes inside
+/// (v_ghost = 2v_0 − v_1), which folds its weight onto them, N_0 += 2N_ghost and
+/// N_1 −= N_ghost. Partition of unity and linear reproduction are kept. Shared by the
+/// quadratic B-spline and uniform GIMP.
+#[inline(always)]
+pub(crate) fn fold_ghosts(t: f64, k: usize, cells: usize, w: [f64; 3], dw: [f64; 3]) -> Stencil1 {
+    let ([w0, w1, w2], [g0, g1, g2]) = (w, dw);
+    if t < 0.0 {
+        // Ghost node at −1: nodes 0, 1, 2.
+        Stencil1 {
+            base: 0,
+            w: [w1 + 2.0 * w0, w2 - w0, 0.0],
+            dw: [g1 + 2.0 * g0, g2 - g0, 0.0],
+        }
+    } else if k + 2 > cells {
+        // Ghost node at cells + 1: nodes cells − 2, cells − 1, cells.
+        Stencil1 {
+            base: cells - 2,
+            w: [0.0, w0 - w2, w1 + 2.0 * w2],
+            dw: [0.0, g0 - g2, g1 + 2.0 * g2],
+        }
+    } else {
+        Stencil1 { base: k, w, dw }
+    }
+}
+
 /// A 1D shape function family, extended to 2D/3D by tensor product.
 pub trait Shape: Copy + Send + Sync + Default + std::fmt::Debug + 'static {
     /// Name used in scenes and reports.
