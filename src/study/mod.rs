@@ -77,7 +77,7 @@ pub fn run_one(
     let out = dir.file(&run.id);
     let record_text = record_head(run);
     if let Ok(text) = std::fs::read_to_string(out.join(RECORD)) {
-        if let Some(rest) = text.strip_prefix(&record_head(run)) {
+        if let Some(rest) = text.strip_prefix(&record_text) {
             let mut outcome = None;
             let mut wall = None;
             for line in rest.lines() {
