@@ -153,17 +153,8 @@ fn a_checkpoint_of_another_scene_is_refused() {
 
 // ---- The binary: files on disk -------------------------------------------------------
 
-fn kdmpm(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_kdmpm"))
-        .args(args)
-        .output()
-        .unwrap()
-}
-
 fn scratch(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("kdmpm-resume-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    d
+    common::scratch("resume", name)
 }
 
 /// summary.json without the figures of wall time, memory and per-system cost.
@@ -239,11 +230,11 @@ fn resume_from_last_checkpoint(scene: &str, every: u64, sets: &[&str]) {
     for s in sets.iter().chain([&checkpoint.as_str()]) {
         args.extend(["--set", s]);
     }
-    let o = kdmpm(&args);
+    let o = common::kdmpm(&args);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let full = dir.join("full");
     copy_dir(&out, &full);
-    let o = kdmpm(&["resume", out.to_str().unwrap(), "--quiet", "--threads", "1"]);
+    let o = common::kdmpm(&["resume", out.to_str().unwrap(), "--quiet", "--threads", "1"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     same_results(&out, &full);
     let _ = std::fs::remove_dir_all(&dir);
@@ -273,7 +264,7 @@ fn ctrl_c_checkpoints_and_a_resumed_run_writes_the_files_of_one_never_interrupte
     let scene = path.to_str().unwrap();
     let (whole, cut) = (dir.join("whole"), dir.join("cut"));
     let steps = "solver.max_steps=6000";
-    let o = kdmpm(&[
+    let o = common::kdmpm(&[
         "run",
         scene,
         "--quiet",
@@ -310,7 +301,7 @@ fn ctrl_c_checkpoints_and_a_resumed_run_writes_the_files_of_one_never_interrupte
     assert_eq!(summary["outcome"], "interrupted");
     assert!(summary["steps"].as_u64().unwrap() < 6000);
     assert!(cut.join("checkpoint.kdc").exists());
-    let o = kdmpm(&["resume", cut.to_str().unwrap(), "--quiet", "--threads", "2"]);
+    let o = common::kdmpm(&["resume", cut.to_str().unwrap(), "--quiet", "--threads", "2"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     same_results(&cut, &whole);
     let _ = std::fs::remove_dir_all(&dir);
@@ -332,7 +323,7 @@ fn a_new_run_into_a_directory_drops_the_checkpoint_of_the_run_before() {
         for s in sets {
             args.extend(["--set", s]);
         }
-        let o = kdmpm(&args);
+        let o = common::kdmpm(&args);
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     };
     run(&bar, &["solver.checkpoint_every=Steps(300)"]);
@@ -342,7 +333,7 @@ fn a_new_run_into_a_directory_drops_the_checkpoint_of_the_run_before() {
         !out.join("checkpoint.kdc").exists(),
         "the bar's checkpoint outlived its run"
     );
-    let o = kdmpm(&["resume", out.to_str().unwrap(), "--quiet"]);
+    let o = common::kdmpm(&["resume", out.to_str().unwrap(), "--quiet"]);
     assert_eq!(o.status.code(), Some(2), "{}", String::from_utf8_lossy(&o.stderr));
     let _ = std::fs::remove_dir_all(&dir);
 }

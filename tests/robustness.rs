@@ -9,20 +9,10 @@ use kdmpm::components::NodeAcceleration;
 use kdmpm::scene::{build, LoadedScene};
 use kdmpm::{AnySimulation, Dim2, FnSystem, StepError};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Command;
 
 fn scratch(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("kdmpm-robust-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn kdmpm(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_kdmpm"))
-        .args(args)
-        .output()
-        .unwrap()
+    common::scratch("robust", name)
 }
 
 /// `kdmpm check` of `scene` with `sets` exits 2 with one message holding every `expect`.
@@ -31,7 +21,7 @@ fn refused(scene: &Path, sets: &[&str], expect: &[&str]) {
     for s in sets {
         args.extend(["--set", s]);
     }
-    let o = kdmpm(&args);
+    let o = common::kdmpm(&args);
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{sets:?}: {err}");
     assert!(err.starts_with("error: "), "{sets:?}: {err}");
@@ -91,7 +81,7 @@ fn an_undefined_ratio_is_written_as_undefined_never_met_and_never_nan() {
         out.to_str().unwrap(),
     ];
     args.extend(sets);
-    let o = kdmpm(&args);
+    let o = common::kdmpm(&args);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let history = std::fs::read_to_string(out.join("history.csv")).unwrap();
     let first = history.lines().nth(1).unwrap();
@@ -276,7 +266,7 @@ fn an_override_on_a_file_with_an_unterminated_string_is_an_error_not_a_panic() {
         "\"",
     ] {
         std::fs::write(&scene, text).unwrap();
-        let o = kdmpm(&["check", scene.to_str().unwrap(), "--set", "solver.tolerance=1"]);
+        let o = common::kdmpm(&["check", scene.to_str().unwrap(), "--set", "solver.tolerance=1"]);
         assert_eq!(
             o.status.code(),
             Some(2),
@@ -309,7 +299,7 @@ fn a_second_run_into_an_output_directory_in_use_is_refused() {
     }
     let c = column();
     let second = || {
-        kdmpm(&[
+        common::kdmpm(&[
             "run",
             c.to_str().unwrap(),
             "--quiet",
@@ -388,7 +378,7 @@ fn a_failed_run_writes_neither_null_nor_nan() {
     let dir = scratch("failed");
     let out = dir.join("out");
     let column = common::scene("soil_column.ron");
-    let o = kdmpm(&[
+    let o = common::kdmpm(&[
         "run",
         column.to_str().unwrap(),
         "--quiet",

@@ -6,21 +6,11 @@
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 mod common;
 
-fn kdmpm(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_kdmpm"))
-        .args(args)
-        .output()
-        .expect("kdmpm runs")
-}
-
 fn scratch(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("kdmpm-snapshots-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    d
+    common::scratch("snapshots", name)
 }
 
 /// (time, file) of every DataSet of a collection, parsed as XML.
@@ -106,7 +96,7 @@ fn history_times(dir: &Path) -> BTreeMap<u64, f64> {
 fn the_series_reads_back_with_history_times_and_summary_values() {
     let out = scratch("series");
     let column = common::scene("soil_column.ron");
-    let o = kdmpm(&[
+    let o = common::kdmpm(&[
         "run",
         column.to_str().unwrap(),
         "--quiet",
@@ -212,7 +202,7 @@ fn a_resumed_run_continues_the_series_of_the_run_it_resumes() {
     // (step 600) and the resumed run's after it, each once.
     let out = scratch("resume");
     let bar = common::scene("bar.ron");
-    let first = kdmpm(&[
+    let first = common::kdmpm(&[
         "run",
         bar.to_str().unwrap(),
         "--quiet",
@@ -231,7 +221,7 @@ fn a_resumed_run_continues_the_series_of_the_run_it_resumes() {
         String::from_utf8_lossy(&first.stderr)
     );
     // Resume from the checkpoint at step 600 as if the run had stopped there.
-    let resumed = kdmpm(&["resume", out.to_str().unwrap(), "--quiet"]);
+    let resumed = common::kdmpm(&["resume", out.to_str().unwrap(), "--quiet"]);
     assert!(
         resumed.status.success(),
         "{}",

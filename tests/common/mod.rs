@@ -23,6 +23,22 @@ pub fn run(name: &str, overrides: &[&str]) -> Summary {
     })
 }
 
+/// Runs the `kdmpm` binary with `args` and waits for it.
+pub fn kdmpm(args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_kdmpm"))
+        .args(args)
+        .output()
+        .expect("kdmpm starts")
+}
+
+/// An empty scratch directory for test group `group`, case `name`, unique to this process.
+pub fn scratch(group: &str, name: &str) -> std::path::PathBuf {
+    let d = std::env::temp_dir().join(format!("kdmpm-{group}-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).expect("scratch directory");
+    d
+}
+
 /// Relative difference a/b − 1.
 pub fn rel(a: f64, b: f64) -> f64 {
     a / b - 1.0
