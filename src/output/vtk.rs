@@ -37,6 +37,12 @@ trait Source {
     fn write(&self, field: Field, out: &mut BufWriter<File>) -> std::io::Result<()>;
 }
 
+/// A point's stress as written: xx yy zz xy yz zx (Pa).
+fn voigt<D: Dim>(s: &Stress<D::Stress>) -> [f64; 6] {
+    let s = s.0.to_sym3();
+    [s.xx, s.yy, s.zz, s.xy, s.yz, s.zx]
+}
+
 /// The mean stress p = tr σ / 3 and the deviatoric stress q = √(3 J₂) (Pa) of a stress
 /// (xx yy zz xy yz zx).
 fn invariants(s: &[f64; 6]) -> (f64, f64) {
@@ -90,57 +96,24 @@ fn arrays<S: Source>(src: &S) -> Vec<Array<'_>> {
             field(Field::Displacement),
         ));
     }
-    arrays.extend([
-        Array::new(
+    // Bodies without plastic state (elastic) write a plastic strain of zero.
+    for (name, components, f) in [
+        ("velocity", 3, Field::Velocity),
+        ("stress", 6, Field::Stress),
+        ("mean_stress", 1, Field::MeanStress),
+        ("deviatoric_stress", 1, Field::DeviatoricStress),
+        ("volume", 1, Field::Volume),
+        ("plastic_strain", 1, Field::PlasticStrain),
+    ] {
+        arrays.push(Array::new(
             Part::PointData,
-            "velocity",
+            name,
             Kind::Float64,
-            3,
+            components,
             n,
-            field(Field::Velocity),
-        ),
-        Array::new(
-            Part::PointData,
-            "stress",
-            Kind::Float64,
-            6,
-            n,
-            field(Field::Stress),
-        ),
-        Array::new(
-            Part::PointData,
-            "mean_stress",
-            Kind::Float64,
-            1,
-            n,
-            field(Field::MeanStress),
-        ),
-        Array::new(
-            Part::PointData,
-            "deviatoric_stress",
-            Kind::Float64,
-            1,
-            n,
-            field(Field::DeviatoricStress),
-        ),
-        Array::new(
-            Part::PointData,
-            "volume",
-            Kind::Float64,
-            1,
-            n,
-            field(Field::Volume),
-        ),
-        // Bodies without plastic state (elastic) write zero.
-        Array::new(
-            Part::PointData,
-            "plastic_strain",
-            Kind::Float64,
-            1,
-            n,
-            field(Field::PlasticStrain),
-        ),
-    ]);
+            field(f),
+        ));
+    }
     let mut offset = 0;
     for array in &mut arrays {
         array.offset = offset;
@@ -219,10 +192,6 @@ impl<D: Dim> Source for Columns<'_, D> {
     }
     fn write(&self, field: Field, out: &mut BufWriter<File>) -> std::io::Result<()> {
         let (archs, order) = (&self.archs[..], &self.order);
-        let sym = |s: &Stress<D::Stress>| {
-            let s = s.0.to_sym3();
-            [s.xx, s.yy, s.zz, s.xy, s.yz, s.zx]
-        };
         match field {
             Field::Position => {
                 each::<Position<D::Vec>>(archs, order, out, |out, x| f64s(out, &D::vec_to3(x.0)))
@@ -239,13 +208,13 @@ impl<D: Dim> Source for Columns<'_, D> {
             Field::Velocity => {
                 each::<Velocity<D::Vec>>(archs, order, out, |out, v| f64s(out, &D::vec_to3(v.0)))
             }
-            Field::Stress => each::<Stress<D::Stress>>(archs, order, out, |out, s| f64s(out, &sym(s))),
-            Field::MeanStress => {
-                each::<Stress<D::Stress>>(archs, order, out, |out, s| f64s(out, &[invariants(&sym(s)).0]))
-            }
-            Field::DeviatoricStress => {
-                each::<Stress<D::Stress>>(archs, order, out, |out, s| f64s(out, &[invariants(&sym(s)).1]))
-            }
+            Field::Stress => each::<Stress<D::Stress>>(archs, order, out, |out, s| f64s(out, &voigt::<D>(s))),
+            Field::MeanStress => each::<Stress<D::Stress>>(archs, order, out, |out, s| {
+                f64s(out, &[invariants(&voigt::<D>(s)).0])
+            }),
+            Field::DeviatoricStress => each::<Stress<D::Stress>>(archs, order, out, |out, s| {
+                f64s(out, &[invariants(&voigt::<D>(s)).1])
+            }),
             Field::Volume => each::<Volume>(archs, order, out, |out, v| f64s(out, &[v.0])),
             Field::PlasticStrain => {
                 let plastic: Vec<_> = archs.iter().map(|a| a.get::<&PlasticStrain>()).collect();
@@ -305,10 +274,7 @@ impl Frame {
             f.displacement = Some(u);
         }
         gather::<Velocity<D::Vec>, _>(archs, order, &mut f.velocity, |v| D::vec_to3(v.0));
-        gather::<Stress<D::Stress>, _>(archs, order, &mut f.stress, |s| {
-            let s = s.0.to_sym3();
-            [s.xx, s.yy, s.zz, s.xy, s.yz, s.zx]
-        });
+        gather::<Stress<D::Stress>, _>(archs, order, &mut f.stress, voigt::<D>);
         gather::<Volume, _>(archs, order, &mut f.volume, |v| v.0);
         let plastic: Vec<_> = archs.iter().map(|a| a.get::<&PlasticStrain>()).collect();
         f.plastic_strain = order
