@@ -2,13 +2,13 @@
 //! snapshot under `snapshots/`), written by a thread of its own so that stepping does not
 //! wait on the disk.
 
+use crate::simulation::Context;
 use crate::dim::Dim;
 use crate::error::StepError;
 use crate::output::dir::write_atomic;
 use crate::output::vtk::{write_frame, Frame};
 use crate::schedule::System;
-use crate::simulation::Context;
-use crossbeam::channel::{bounded, Sender};
+use crossbeam::channel::{bounded, Receiver, Sender};
 use serde::{Deserialize, Serialize};
 use std::io::Write;
 use std::marker::PhantomData;
@@ -55,6 +55,8 @@ pub struct SnapshotReport {
 pub struct Snapshots<D> {
     spec: SnapshotSpec,
     sender: Arc<Mutex<Option<Sender<Frame>>>>,
+    /// Frames the writer is done with, to be filled again.
+    written: Receiver<Frame>,
     wait: Arc<Mutex<f64>>,
     _marker: PhantomData<fn() -> D>,
 }
@@ -97,14 +99,20 @@ impl<D: Dim> Snapshots<D> {
             None => Vec::new(),
         };
         let (tx, rx) = bounded::<Frame>(IN_FLIGHT);
+        let (back, written) = bounded::<Frame>(IN_FLIGHT + 1);
         let dir = dir.to_path_buf();
         let thread = std::thread::Builder::new().name("snapshots".into()).spawn(
             move || -> std::io::Result<usize> {
                 lower_priority();
+                let mut sorted = Frame::default();
                 for frame in rx {
-                    let name = format!("{FOLDER}/points_{:09}.vtu", frame.step);
-                    write_frame(&frame, &dir.join(&name))?;
-                    entries.push((frame.time, name));
+                    frame.sort_into(&mut sorted);
+                    // Hand the buffers back for the next snapshot; never blocks (a full
+                    // return channel drops them).
+                    let _ = back.try_send(frame);
+                    let name = format!("{FOLDER}/points_{:09}.vtu", sorted.step);
+                    write_frame(&sorted, &dir.join(&name))?;
+                    entries.push((sorted.time, name));
                     write_pvd(&dir.join(PVD), &entries)?;
                 }
                 Ok(entries.len())
@@ -116,6 +124,7 @@ impl<D: Dim> Snapshots<D> {
             Snapshots {
                 spec,
                 sender: sender.clone(),
+                written,
                 wait: wait.clone(),
                 _marker: PhantomData,
             },
@@ -150,7 +159,8 @@ impl<D: Dim> System<D> for Snapshots<D> {
         }
         let mut sender = lock(&self.sender);
         let Some(tx) = sender.as_ref() else { return Ok(()) };
-        let frame = Frame::capture::<D>(&ctx.world, ctx.state.step, ctx.state.time);
+        let mut frame = self.written.try_recv().unwrap_or_default();
+        frame.refill::<D>(&ctx.world, ctx.state.step, ctx.state.time);
         let start = Instant::now();
         if tx.send(frame).is_err() {
             // The writer stopped on an error; finish() reports it. Stepping goes on.

@@ -252,43 +252,95 @@ pub struct Frame {
 }
 
 impl Frame {
-    /// Copies the points of `world` at `step` and `time` (about 140 bytes a point).
+    /// Copies the points of `world` at `step` and `time` (about 140 bytes a point) in
+    /// storage order: column by column, so the stepping thread only streams memory.
+    /// [`Frame::in_id_order`] puts them in id order on the thread that writes them.
     pub fn capture<D: Dim>(world: &World, step: u64, time: f64) -> Frame {
-        let c = Columns::<D>::of(world);
-        let (archs, order) = (&c.archs[..], &c.order);
-        let mut f = Frame {
-            step,
-            time,
-            ..Frame::default()
-        };
-        let n = c.n;
-        f.id.reserve(n);
-        for (id, _, _) in order.points() {
-            f.id.push(id as u32);
-        }
-        gather::<MaterialId, _>(archs, order, &mut f.material, |m| m.0);
-        gather::<Position<D::Vec>, _>(archs, order, &mut f.position, |x| D::vec_to3(x.0));
-        if c.displacements {
-            let mut u = Vec::with_capacity(n);
-            gather::<Displacement<D::Vec>, _>(archs, order, &mut u, |u| D::vec_to3(u.0));
-            f.displacement = Some(u);
-        }
-        gather::<Velocity<D::Vec>, _>(archs, order, &mut f.velocity, |v| D::vec_to3(v.0));
-        gather::<Stress<D::Stress>, _>(archs, order, &mut f.stress, voigt::<D>);
-        gather::<Volume, _>(archs, order, &mut f.volume, |v| v.0);
-        let plastic: Vec<_> = archs.iter().map(|a| a.get::<&PlasticStrain>()).collect();
-        f.plastic_strain = order
-            .points()
-            .map(|(_, a, r)| plastic[a].as_ref().map_or(0.0, |e| e[r].0))
-            .collect();
+        let mut f = Frame::default();
+        f.refill::<D>(world, step, time);
         f
+    }
+
+    /// [`Frame::capture`] into this frame's buffers, which keep their capacity: a frame
+    /// handed back by the writer is filled again without touching fresh memory.
+    pub fn refill<D: Dim>(&mut self, world: &World, step: u64, time: f64) {
+        let archs: Vec<&Archetype> = points_with::<Stress<D::Stress>>(world).collect();
+        let n = archs.iter().map(|a| a.len() as usize).sum::<usize>();
+        let displacements = n > 0 && archs.iter().all(|a| a.has::<Displacement<D::Vec>>());
+        let mut u = self.displacement.take().unwrap_or_default();
+        u.clear();
+        (self.step, self.time) = (step, time);
+        self.id.clear();
+        self.material.clear();
+        self.position.clear();
+        self.velocity.clear();
+        self.stress.clear();
+        self.volume.clear();
+        self.plastic_strain.clear();
+        for arch in archs {
+            copy::<PointId, _>(arch, &mut self.id, |i| i.0);
+            copy::<MaterialId, _>(arch, &mut self.material, |m| m.0);
+            copy::<Position<D::Vec>, _>(arch, &mut self.position, |x| D::vec_to3(x.0));
+            if displacements {
+                copy::<Displacement<D::Vec>, _>(arch, &mut u, |u| D::vec_to3(u.0));
+            }
+            copy::<Velocity<D::Vec>, _>(arch, &mut self.velocity, |v| D::vec_to3(v.0));
+            copy::<Stress<D::Stress>, _>(arch, &mut self.stress, voigt::<D>);
+            copy::<Volume, _>(arch, &mut self.volume, |v| v.0);
+            let rows = arch.len() as usize;
+            match arch.get::<&PlasticStrain>() {
+                Some(e) => self.plastic_strain.extend(e.iter().map(|e| e.0)),
+                None => self.plastic_strain.resize(self.plastic_strain.len() + rows, 0.0),
+            }
+        }
+        self.displacement = displacements.then_some(u);
+    }
+
+    /// The same points sorted by id, as the written files hold them.
+    pub fn in_id_order(&self) -> Frame {
+        let mut sorted = Frame::default();
+        self.sort_into(&mut sorted);
+        sorted
+    }
+
+    /// [`Frame::in_id_order`] into `sorted`'s buffers, which keep their capacity (fresh
+    /// memory would cost a page fault every 4 KiB).
+    pub fn sort_into(&self, sorted: &mut Frame) {
+        // Ids are dense (spawn order, load carriers' ids left out): place each row at its
+        // id, then drop the gaps.
+        let mut order = std::mem::take(&mut sorted.id);
+        order.clear();
+        for (row, &id) in self.id.iter().enumerate() {
+            PointId(id).place(&mut order, row as u32, u32::MAX);
+        }
+        order.retain(|&r| r != u32::MAX);
+        (sorted.step, sorted.time) = (self.step, self.time);
+        permute(&self.material, &order, &mut sorted.material);
+        permute(&self.position, &order, &mut sorted.position);
+        match &self.displacement {
+            Some(u) => permute(u, &order, sorted.displacement.get_or_insert_with(Vec::new)),
+            None => sorted.displacement = None,
+        }
+        permute(&self.velocity, &order, &mut sorted.velocity);
+        permute(&self.stress, &order, &mut sorted.stress);
+        permute(&self.volume, &order, &mut sorted.volume);
+        permute(&self.plastic_strain, &order, &mut sorted.plastic_strain);
+        for r in order.iter_mut() {
+            *r = self.id[*r as usize];
+        }
+        sorted.id = order;
     }
 }
 
-/// Appends `value(T)` of every point, in id order.
-fn gather<T: Component, V>(archs: &[&Archetype], order: &Order, into: &mut Vec<V>, value: impl Fn(&T) -> V) {
-    let columns: Vec<_> = archs.iter().map(|a| col::<T>(a)).collect();
-    into.extend(order.points().map(|(_, a, r)| value(&columns[a][r])));
+/// `into` becomes `v[order[0]], v[order[1]], ...`
+fn permute<T: Copy>(v: &[T], order: &[u32], into: &mut Vec<T>) {
+    into.clear();
+    into.extend(order.iter().map(|&i| v[i as usize]));
+}
+
+/// Appends `value(T)` of every row of `arch`, in storage order.
+fn copy<T: Component, V>(arch: &Archetype, into: &mut Vec<V>, value: impl Fn(&T) -> V) {
+    into.extend(col::<T>(arch).iter().map(value));
 }
 
 impl Source for Frame {
@@ -299,21 +351,50 @@ impl Source for Frame {
         self.displacement.is_some()
     }
     fn write(&self, field: Field, out: &mut BufWriter<File>) -> std::io::Result<()> {
+        // Whole columns at a time: a frame is written on the writer thread, which shares
+        // the cores with stepping, so it costs what a copy costs.
         match field {
-            Field::Position => self.position.iter().try_for_each(|x| f64s(out, x)),
-            Field::Id => self.id.iter().try_for_each(|i| out.write_all(&i.to_le_bytes())),
-            Field::Material => self
-                .material
-                .iter()
-                .try_for_each(|m| out.write_all(&u32::from(*m).to_le_bytes())),
-            Field::Displacement => self.displacement.iter().flatten().try_for_each(|u| f64s(out, u)),
-            Field::Velocity => self.velocity.iter().try_for_each(|v| f64s(out, v)),
-            Field::Stress => self.stress.iter().try_for_each(|s| f64s(out, s)),
-            Field::MeanStress => self.stress.iter().try_for_each(|s| f64s(out, &[invariants(s).0])),
-            Field::DeviatoricStress => self.stress.iter().try_for_each(|s| f64s(out, &[invariants(s).1])),
-            Field::Volume => self.volume.iter().try_for_each(|v| f64s(out, &[*v])),
-            Field::PlasticStrain => self.plastic_strain.iter().try_for_each(|e| f64s(out, &[*e])),
+            Field::Position => f64_block(out, flat3(&self.position)),
+            Field::Id => {
+                let ids: Vec<u8> = self.id.iter().flat_map(|i| i.to_le_bytes()).collect();
+                out.write_all(&ids)
+            }
+            Field::Material => {
+                let m: Vec<u8> = self
+                    .material
+                    .iter()
+                    .flat_map(|&m| u32::from(m).to_le_bytes())
+                    .collect();
+                out.write_all(&m)
+            }
+            Field::Displacement => f64_block(out, self.displacement.as_deref().map_or(&[], flat3)),
+            Field::Velocity => f64_block(out, flat3(&self.velocity)),
+            Field::Stress => f64_block(out, bytemuck::cast_slice(&self.stress)),
+            Field::MeanStress => f64_block(
+                out,
+                &self.stress.iter().map(|s| invariants(s).0).collect::<Vec<_>>(),
+            ),
+            Field::DeviatoricStress => f64_block(
+                out,
+                &self.stress.iter().map(|s| invariants(s).1).collect::<Vec<_>>(),
+            ),
+            Field::Volume => f64_block(out, &self.volume),
+            Field::PlasticStrain => f64_block(out, &self.plastic_strain),
         }
+    }
+}
+
+/// The components of a list of vectors, one after the other.
+fn flat3(v: &[[f64; 3]]) -> &[f64] {
+    bytemuck::cast_slice(v)
+}
+
+/// Writes `values` as little-endian f64, in one piece where the machine is little-endian.
+fn f64_block(out: &mut BufWriter<File>, values: &[f64]) -> std::io::Result<()> {
+    if cfg!(target_endian = "little") {
+        out.write_all(bytemuck::cast_slice(values))
+    } else {
+        f64s(out, values)
     }
 }
 
