@@ -5,7 +5,7 @@
 //! nodes per point with linear shape functions and never touches a third axis; the only
 //! 3D quantity it keeps is the out-of-plane normal stress, which plane strain requires.
 
-use crate::lanes::Lanes;
+use crate::lanes::{madd, Lanes};
 use crate::tensor::{PlanarSym3, StoredSym, Sym, Sym3};
 use glam::{DMat2, DMat3, DVec2, DVec3};
 use std::fmt::Debug;
@@ -37,22 +37,8 @@ pub trait Vector:
     /// True when every component is finite.
     fn is_finite(self) -> bool;
     /// `self·k + acc`, each component rounded once where the CPU fuses a multiply and an add
-    /// (see [`madd`]).
+    /// (see [`crate::lanes::madd`]).
     fn madd(self, k: f64, acc: Self) -> Self;
-}
-
-/// `a·b + c`: rounded once where the build targets a CPU with fused multiply-add (the
-/// host CPU, `.cargo/config.toml`), which took the 3D block's stepping loop from 1 385 to
-/// 1 283 instructions a particle-step; rounded twice, as written, where it does not (a software
-/// fused multiply-add would cost more than it saves). Either way the same for every thread
-/// count.
-#[inline(always)]
-pub fn madd(a: f64, b: f64, c: f64) -> f64 {
-    if cfg!(target_feature = "fma") {
-        a.mul_add(b, c)
-    } else {
-        a * b + c
-    }
 }
 
 /// The same glam methods serve both vector types.

@@ -8,7 +8,6 @@
 //! In 2D the third count is zero, so a 2D grid has one layer of nodes.
 
 use crate::dim::{Dim, Vector};
-use crate::parallel::{grid_pass, Disjoint};
 
 /// A face of the grid's bounding box.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
@@ -75,15 +74,6 @@ impl NodeBox {
     /// Number of nodes in the box.
     pub fn len(&self) -> usize {
         (0..3).map(|a| self.hi[a].saturating_sub(self.lo[a])).product()
-    }
-
-    /// Sets `column`'s entries for every node of the box to `value`.
-    pub fn fill<D: Dim, T: Copy + Send + Sync + 'static>(self, grid: &Grid<D>, column: &mut [T], value: T) {
-        grid_pass(grid, self, &Disjoint::new(column), |b, part, first| {
-            for r in b.rows(grid) {
-                part[r.start - first..r.end - first].fill(value);
-            }
-        });
     }
 
     /// The box's nodes as runs of consecutive node ids (one run per row along x), in

@@ -8,8 +8,20 @@
 //! take about the time of one. Every operation is done lane by lane with the same rounding as
 //! the scalar one, so a point's result does not depend on which lane, or which path, it took.
 
-use crate::dim::madd;
 use std::ops::{Add, Div, Mul, Sub};
+
+/// `a·b + c`: rounded once where the build targets a CPU with fused multiply-add (the
+/// host CPU, `.cargo/config.toml`; fewer instructions a particle-step, see
+/// docs/performance.md); rounded twice, as written, where it does not (a software fused
+/// multiply-add would cost more than it saves). Either way the same for every thread count.
+#[inline(always)]
+pub fn madd(a: f64, b: f64, c: f64) -> f64 {
+    if cfg!(target_feature = "fma") {
+        a.mul_add(b, c)
+    } else {
+        a * b + c
+    }
+}
 
 /// Four f64 lanes (one 256-bit AVX register where the build targets AVX).
 pub type F64x4 = wide::f64x4;
@@ -100,7 +112,7 @@ mod tests {
     fn a_lane_multiply_add_rounds_like_the_scalar_one() {
         // 1 + 2⁻⁵² squared: the exact product 1 + 2⁻⁵¹ + 2⁻¹⁰⁴ loses its last term when
         // rounded before the add, so fused and unfused differ in the last bit; the lanes must
-        // take the same choice as `dim::madd`.
+        // take the same choice as `madd`.
         let a = 1.0 + f64::EPSILON;
         let c = -(1.0 + 2.0 * f64::EPSILON);
         let lane = <F64x4 as Lanes>::madd(F64x4::splat(a), F64x4::splat(a), F64x4::splat(c));

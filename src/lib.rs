@@ -16,6 +16,7 @@ pub mod alloc;
 pub mod checkpoint;
 pub mod columns;
 pub mod components;
+pub mod context;
 pub mod dim;
 pub mod error;
 pub mod grid;
@@ -35,7 +36,8 @@ pub mod tensor;
 #[cfg(test)]
 mod testing;
 
+pub use context::Context;
 pub use dim::{Dim, Dim2, Dim3};
 pub use error::{SceneError, StepError};
 pub use schedule::{FnSystem, Schedule, System};
-pub use simulation::{AnySimulation, Context, Simulation};
+pub use simulation::{AnySimulation, Simulation};

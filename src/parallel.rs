@@ -229,6 +229,21 @@ impl<A: NodeTarget, B: NodeTarget, C: NodeTarget> NodeTarget for (A, B, C) {
 /// this many, so a small box runs as one task and a big one splits into many.
 pub const NODES_PER_TASK: usize = 8192;
 
+/// Sets `column`'s entries for every node of box `b` to `value`, a group of node layers a
+/// task.
+pub fn fill_box<D: Dim, T: Copy + Send + Sync + 'static>(
+    grid: &Grid<D>,
+    b: NodeBox,
+    column: &mut [T],
+    value: T,
+) {
+    grid_pass(grid, b, &Disjoint::new(column), |b, part, first| {
+        for r in b.rows(grid) {
+            part[r.start - first..r.end - first].fill(value);
+        }
+    });
+}
+
 /// Runs `kernel(part_box, part, first_node)` over the node box `b` in parallel and returns
 /// the results in node order.
 ///

@@ -3,9 +3,9 @@
 //! Reading a default schedule (see [`crate::systems::default_schedule`]) gives the whole
 //! algorithm in order; every name leads to one file under `src/systems/`.
 
+use crate::context::Context;
 use crate::dim::Dim;
 use crate::error::StepError;
-use crate::simulation::Context;
 use std::time::{Duration, Instant};
 
 /// One stage of the explicit step.

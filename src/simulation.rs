@@ -2,32 +2,13 @@
 
 use crate::columns::{col, points_with};
 use crate::components::*;
+use crate::context::Context;
 use crate::dim::{Dim, Dim2, Dim3};
 use crate::error::StepError;
-use crate::grid::Grid;
-use crate::materials::MaterialModel;
-use crate::parallel::SlabCache;
 use crate::schedule::Schedule;
-use crate::state::{Settings, SolverState};
+use crate::state::SolverState;
 use crate::tensor::{StoredSym, Sym3};
 use hecs::{Entity, World};
-
-/// Everything the systems read and write: the world (points and nodes), the grid, the
-/// material table and the solver-wide state.
-pub struct Context<D: Dim> {
-    /// Points and nodes.
-    pub world: World,
-    /// Background grid geometry.
-    pub grid: Grid<D>,
-    /// Materials, indexed by [`MaterialId`].
-    pub materials: Vec<MaterialModel>,
-    /// Fixed settings.
-    pub settings: Settings,
-    /// Quantities updated every step.
-    pub state: SolverState,
-    /// Points grouped by slab of cells for the scatters, kept until points move.
-    pub slabs: SlabCache,
-}
 
 /// A point whose history is recorded.
 #[derive(Clone, Debug)]

@@ -1,10 +1,11 @@
 //! The `history` output system: one CSV row per output interval.
 
+use crate::context::Context;
 use crate::dim::Dim;
 use crate::error::StepError;
 use crate::output::dir::RowFile;
 use crate::schedule::System;
-use crate::simulation::{Context, TracedPoint};
+use crate::simulation::TracedPoint;
 use crate::systems::convergence::ratio_text;
 use std::marker::PhantomData;
 use std::path::Path;

@@ -2,7 +2,7 @@
 //! snapshot under `snapshots/`), written by a thread of its own so that stepping does not
 //! wait on the disk.
 
-use crate::simulation::Context;
+use crate::context::Context;
 use crate::dim::Dim;
 use crate::error::StepError;
 use crate::output::dir::write_atomic;

@@ -2,11 +2,11 @@
 
 use crate::columns::{col, col_mut, nodes};
 use crate::components::*;
+use crate::context::Context;
 use crate::dim::{Dim, Vector};
 use crate::error::StepError;
 use crate::parallel::{for_each_box_node, Disjoint};
 use crate::schedule::System;
-use crate::simulation::Context;
 
 /// Zeroes the fixed components of nodal momentum and force, so that fixed nodes neither
 /// move nor accelerate.

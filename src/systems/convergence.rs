@@ -3,12 +3,12 @@
 
 use crate::columns::{col, nodes};
 use crate::components::*;
+use crate::context::Context;
 use crate::dim::{Dim, Vector};
 use crate::error::StepError;
 use crate::measure::{max_movement, positions};
 use crate::parallel::grid_pass;
 use crate::schedule::System;
-use crate::simulation::Context;
 use crate::state::{StaticCheck, StopReason};
 
 /// K_E above which a run is declared unstable (a sound run stays at or below 1).

@@ -2,12 +2,12 @@
 
 use crate::columns::{col, col_mut, nodes, points_with};
 use crate::components::*;
+use crate::context::Context;
 use crate::dim::{Dim, Vector};
 use crate::error::StepError;
 use crate::parallel::CHUNK;
 use crate::schedule::System;
 use crate::shape::{for_each_node, Shape};
-use crate::simulation::Context;
 use rayon::prelude::*;
 use std::marker::PhantomData;
 

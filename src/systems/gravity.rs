@@ -2,11 +2,11 @@
 
 use crate::columns::{col, col_mut, nodes};
 use crate::components::*;
+use crate::context::Context;
 use crate::dim::Dim;
 use crate::error::StepError;
 use crate::parallel::{for_each_box_node, Disjoint};
 use crate::schedule::System;
-use crate::simulation::Context;
 use crate::state::Gravity as GravitySpec;
 
 /// Adds m_i·g to every node. Since Σ_p w_ip m_p = m_i, this equals mapping each point's

@@ -2,11 +2,12 @@
 
 use crate::columns::{col_mut, nodes};
 use crate::components::*;
+use crate::context::Context;
 use crate::dim::{Dim, Vector};
 use crate::error::StepError;
 use crate::grid::NodeBox;
+use crate::parallel::fill_box;
 use crate::schedule::System;
-use crate::simulation::Context;
 
 /// Zeroes the nodes of last step's box (see `SolverState::active_nodes`).
 #[derive(Debug, Default)]
@@ -20,20 +21,22 @@ impl<D: Dim> System<D> for GridReset {
         let n = nodes(&ctx.world);
         let (b, grid, z) = (ctx.state.active_nodes, &ctx.grid, D::Vec::ZERO);
         // Only last step's box can hold anything (see `SolverState::active_nodes`).
-        b.fill(grid, &mut col_mut::<NodeMass>(n), NodeMass(0.0));
-        b.fill(grid, &mut col_mut::<NodeMomentum<D::Vec>>(n), NodeMomentum(z));
-        b.fill(grid, &mut col_mut::<NodeForce<D::Vec>>(n), NodeForce(z));
-        b.fill(
+        fill_box(grid, b, &mut col_mut::<NodeMass>(n), NodeMass(0.0));
+        fill_box(grid, b, &mut col_mut::<NodeMomentum<D::Vec>>(n), NodeMomentum(z));
+        fill_box(grid, b, &mut col_mut::<NodeForce<D::Vec>>(n), NodeForce(z));
+        fill_box(
             grid,
+            b,
             &mut col_mut::<NodeExternalForce<D::Vec>>(n),
             NodeExternalForce(z),
         );
-        b.fill(
+        fill_box(
             grid,
+            b,
             &mut col_mut::<NodeAcceleration<D::Vec>>(n),
             NodeAcceleration(z),
         );
-        b.fill(grid, &mut col_mut::<NodeVelocity<D::Vec>>(n), NodeVelocity(z));
+        fill_box(grid, b, &mut col_mut::<NodeVelocity<D::Vec>>(n), NodeVelocity(z));
         ctx.state.active_nodes = NodeBox::default();
         Ok(())
     }

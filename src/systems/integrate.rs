@@ -2,11 +2,11 @@
 
 use crate::columns::{col, col_mut, nodes};
 use crate::components::*;
+use crate::context::Context;
 use crate::dim::{Dim, Vector};
 use crate::error::StepError;
 use crate::parallel::{for_each_box_node, Disjoint};
 use crate::schedule::System;
-use crate::simulation::Context;
 use crate::state::Damping;
 
 /// a_i = (f_i + f_damp)/max(m_i, m_floor) and v_i ← p_i/m_i + a_i Δt (explicit Euler on the

@@ -3,13 +3,13 @@
 
 use crate::columns::{col, col_mut, nodes, points_with};
 use crate::components::*;
+use crate::context::Context;
 use crate::dim::Dim;
 use crate::error::StepError;
 use crate::grid::NodeBox;
-use crate::parallel::{for_each_box_node, scatter, Disjoint};
+use crate::parallel::{fill_box, for_each_box_node, scatter, Disjoint};
 use crate::schedule::System;
 use crate::shape::{for_each_node, Shape};
-use crate::simulation::Context;
 use std::marker::PhantomData;
 
 /// The paper's eq. (2) mass only sets the path to a static answer, not the answer. With
@@ -105,7 +105,7 @@ impl<D: Dim, S: Shape> System<D> for MassScaling<D, S> {
                 }
             }
         });
-        active.fill(grid, sums, [0.0; 2]);
+        fill_box(grid, active, sums, [0.0; 2]);
         Ok(())
     }
 }

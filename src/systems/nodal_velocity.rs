@@ -3,11 +3,11 @@
 use super::boundary::constrain;
 use crate::columns::{col, col_mut, nodes};
 use crate::components::*;
+use crate::context::Context;
 use crate::dim::{Dim, Vector};
 use crate::error::StepError;
 use crate::parallel::{for_each_box_node, Disjoint};
 use crate::schedule::System;
-use crate::simulation::Context;
 
 /// Sets `NodeVelocity` from `NodeMomentum` and `NodeMass` (zero on massless nodes and on
 /// fixed components). Used by the MUSL remap and by USF before its stress update.

@@ -2,13 +2,13 @@
 
 use crate::columns::{col, col_mut, nodes, points_with};
 use crate::components::*;
+use crate::context::Context;
 use crate::dim::Dim;
 use crate::error::StepError;
 use crate::lanes::F64x4;
 use crate::parallel::{scatter, Disjoint};
 use crate::schedule::System;
 use crate::shape::{for_each_node, from_lanes, Shape, StressColumns};
-use crate::simulation::Context;
 use crate::tensor::StoredSym;
 use std::marker::PhantomData;
 

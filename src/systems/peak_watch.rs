@@ -3,10 +3,10 @@
 
 use crate::columns::{col_mut, points_with};
 use crate::components::*;
+use crate::context::Context;
 use crate::dim::{Dim, Vector};
 use crate::error::StepError;
 use crate::schedule::System;
-use crate::simulation::Context;
 use crate::state::Peak;
 
 /// When E_k(n) < E_k(n−1) the energy peaked in the previous step: every point velocity is

@@ -2,11 +2,11 @@
 
 use crate::columns::{col, col_mut, nodes, points_with};
 use crate::components::*;
+use crate::context::Context;
 use crate::dim::Dim;
 use crate::error::StepError;
 use crate::schedule::System;
 use crate::shape::{for_each_node, Shape};
-use crate::simulation::Context;
 use std::marker::PhantomData;
 
 /// Spreads each point load F over the nodes of its support that carry mass, with the shape

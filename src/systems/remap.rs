@@ -3,12 +3,12 @@
 use super::nodal_velocity::velocity_from_momentum;
 use crate::columns::{col, col_mut, nodes, points_with};
 use crate::components::*;
+use crate::context::Context;
 use crate::dim::{Dim, Vector};
 use crate::error::StepError;
-use crate::parallel::{scatter, Disjoint};
+use crate::parallel::{fill_box, scatter, Disjoint};
 use crate::schedule::System;
 use crate::shape::{for_each_node, Shape};
-use crate::simulation::Context;
 use std::marker::PhantomData;
 
 /// p_i = Σ_p w_ip m_p v_p with the new v_p, then v_i = p_i/m_i with boundary conditions.
@@ -32,17 +32,18 @@ impl<D: Dim, S: Shape> System<D> for Remap<D, S> {
         let n = nodes(&ctx.world);
         if ctx.state.reset_this_step {
             let mut nv = col_mut::<NodeVelocity<D::Vec>>(n);
-            ctx.state
-                .active_nodes
-                .fill(&ctx.grid, &mut nv, NodeVelocity(D::Vec::ZERO));
+            fill_box(
+                &ctx.grid,
+                ctx.state.active_nodes,
+                &mut nv,
+                NodeVelocity(D::Vec::ZERO),
+            );
             return Ok(());
         }
         {
             let grid = &ctx.grid;
             let mut np = col_mut::<NodeMomentum<D::Vec>>(n);
-            ctx.state
-                .active_nodes
-                .fill(grid, &mut np, NodeMomentum(D::Vec::ZERO));
+            fill_box(grid, ctx.state.active_nodes, &mut np, NodeMomentum(D::Vec::ZERO));
             let mut reached = ctx.state.active_nodes;
             for arch in points_with::<Velocity<D::Vec>>(&ctx.world) {
                 let (xg, mg, vg) = (

@@ -11,12 +11,12 @@
 
 use crate::columns::{col, points_with};
 use crate::components::*;
+use crate::context::Context;
 use crate::dim::Dim;
 use crate::error::StepError;
 use crate::grid::Grid;
 use crate::point_components;
 use crate::schedule::System;
-use crate::simulation::Context;
 use hecs::{Archetype, World};
 use rayon::prelude::*;
 use std::any::TypeId;

@@ -2,13 +2,13 @@
 
 use crate::columns::{col, col_mut, points_with};
 use crate::components::*;
+use crate::context::Context;
 use crate::dim::Dim;
 use crate::error::StepError;
 use crate::lanes::{gather, F64x4, LANES};
 use crate::materials::{update_lane_by_lane, Material, MaterialModel};
 use crate::parallel::CHUNK;
 use crate::schedule::System;
-use crate::simulation::Context;
 use crate::tensor::{StoredSym, Sym3x4};
 use rayon::prelude::*;
 

@@ -2,11 +2,11 @@
 
 use crate::columns::{col, col_mut, points_with};
 use crate::components::*;
+use crate::context::Context;
 use crate::dim::Dim;
 use crate::error::StepError;
 use crate::parallel::CHUNK;
 use crate::schedule::System;
-use crate::simulation::Context;
 use rayon::prelude::*;
 
 /// V_p ← V_p · det(I + L_p Δt). Density is not stored: it is m_p / V_p.

@@ -3,13 +3,13 @@
 
 use crate::columns::{col, col_mut, points_with};
 use crate::components::*;
+use crate::context::Context;
 use crate::dim::Dim;
 use crate::error::StepError;
 use crate::grid::NodeBox;
-use crate::parallel::{for_each_box_node, scatter, Disjoint, CHUNK};
+use crate::parallel::{fill_box, for_each_box_node, scatter, Disjoint, CHUNK};
 use crate::schedule::System;
 use crate::shape::{for_each_node, Shape};
-use crate::simulation::Context;
 use rayon::prelude::*;
 use std::marker::PhantomData;
 
@@ -102,7 +102,7 @@ impl<D: Dim, S: Shape> System<D> for VolumetricSmoothing<D, S> {
                 }
             });
         }
-        active.fill(grid, sums, [0.0; 2]);
+        fill_box(grid, active, sums, [0.0; 2]);
         Ok(())
     }
 }
