@@ -18,7 +18,7 @@ use crate::grid::NodeBox;
 use crate::parallel::SlabCache;
 use crate::point_components;
 use crate::simulation::Simulation;
-use crate::state::{Peak, SolverState, StopReason};
+use crate::state::{CurvePoint, Drive, Peak, SolverState, StopReason};
 use hecs::Archetype;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
@@ -26,7 +26,7 @@ use thiserror::Error;
 /// The first bytes of a checkpoint file.
 const MAGIC: &[u8; 8] = b"KDMPMCK\0";
 /// Format version; a file of another version is refused.
-const VERSION: u32 = 2;
+const VERSION: u32 = 3;
 /// The file's name in an output directory.
 pub const FILE_NAME: &str = "checkpoint.kdc";
 
@@ -199,6 +199,23 @@ fn encode_state(w: &mut Writer, s: &SolverState) {
     for x in &s.static_window_snapshot {
         x.iter().for_each(|&c| w.f64(c));
     }
+    w.u64(s.drives.len() as u64);
+    for d in &s.drives {
+        w.str(&d.name);
+        w.u8(d.axes);
+        d.velocity.iter().chain(&d.reaction).for_each(|&c| w.f64(c));
+        w.f64(d.travel);
+        w.u64(d.increments as u64);
+    }
+    w.u64(s.curve.len() as u64);
+    for c in &s.curve {
+        w.str(&c.name);
+        w.u64(c.step);
+        w.f64(c.time);
+        w.f64(c.displacement);
+        c.force.iter().for_each(|&f| w.f64(f));
+        w.opt(c.pressure);
+    }
 }
 
 fn decode_state(r: &mut Reader) -> Result<SolverState, CheckpointError> {
@@ -232,6 +249,26 @@ fn decode_state(r: &mut Reader) -> Result<SolverState, CheckpointError> {
     let n = r.u64()?;
     for _ in 0..n {
         s.static_window_snapshot.push([r.f64()?, r.f64()?, r.f64()?]);
+    }
+    for _ in 0..r.u64()? {
+        s.drives.push(Drive {
+            name: r.str()?,
+            axes: r.u8()?,
+            velocity: [r.f64()?, r.f64()?, r.f64()?],
+            reaction: [r.f64()?, r.f64()?, r.f64()?],
+            travel: r.f64()?,
+            increments: r.u64()? as u32,
+        });
+    }
+    for _ in 0..r.u64()? {
+        s.curve.push(CurvePoint {
+            name: r.str()?,
+            step: r.u64()?,
+            time: r.f64()?,
+            displacement: r.f64()?,
+            force: [r.f64()?, r.f64()?, r.f64()?],
+            pressure: r.opt()?,
+        });
     }
     Ok(s)
 }

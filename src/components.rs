@@ -93,15 +93,37 @@ pub struct NodeAcceleration<V>(pub V);
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct NodeVelocity<V>(pub V);
 
-/// Fixed velocity components of a node: bit `a` set means axis `a` is held at zero.
+/// Constrained velocity components of a node: bit `a` (0–2) set means axis `a` is held,
+/// at zero, or, when the high four bits name a prescribed motion (its index + 1 in
+/// [`crate::state::SolverState::drives`]) that drives the axis, at its velocity.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub struct NodeFixity(pub u8);
 
 impl NodeFixity {
-    /// True when axis `a` is fixed.
+    /// Most prescribed motions a scene may have.
+    pub const MAX_DRIVES: usize = 15;
+
+    /// True when axis `a` is held.
     #[inline(always)]
     pub fn is_fixed(self, axis: usize) -> bool {
         self.0 & (1 << axis) != 0
+    }
+
+    /// The prescribed motion that drives the held axes, if any.
+    #[inline(always)]
+    pub fn driver(self) -> Option<usize> {
+        match self.0 >> 4 {
+            0 => None,
+            k => Some(k as usize - 1),
+        }
+    }
+
+    /// Held on the axes of `mask` with prescribed motion `drive` (< [`Self::MAX_DRIVES`]);
+    /// the motion's own axes ([`crate::state::Drive::axes`]) move with it, the others stay
+    /// fixed.
+    pub fn driven(mask: u8, drive: usize) -> NodeFixity {
+        debug_assert!(drive < Self::MAX_DRIVES);
+        NodeFixity((mask & 0b111) | ((drive as u8 + 1) << 4))
     }
 }
 

@@ -18,6 +18,13 @@ pub trait System<D: Dim>: Send {
     fn name(&self) -> &str;
     /// Runs the stage once.
     fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError>;
+    /// Prepares the world before the first step this schedule runs (marks nodes, sets up
+    /// state): called again when the schedule changes and after a resume, so it must give
+    /// the same result when repeated. Nothing by default.
+    fn prepare(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
+        let _ = ctx;
+        Ok(())
+    }
 }
 
 /// A system made from a closure, for user code (see `examples/custom_system.rs`).
@@ -61,6 +68,8 @@ pub struct Schedule<D: Dim> {
     systems: Vec<Box<dyn System<D>>>,
     time: Vec<Duration>,
     calls: Vec<u64>,
+    /// Every system's `prepare` ran since the list last changed.
+    prepared: bool,
 }
 
 impl<D: Dim> Default for Schedule<D> {
@@ -69,6 +78,7 @@ impl<D: Dim> Default for Schedule<D> {
             systems: Vec::new(),
             time: Vec::new(),
             calls: Vec::new(),
+            prepared: false,
         }
     }
 }
@@ -87,6 +97,7 @@ impl<D: Dim> Schedule<D> {
     /// Appends a boxed system.
     pub fn push_boxed(&mut self, system: Box<dyn System<D>>) -> &mut Self {
         self.systems.push(system);
+        self.prepared = false;
         self.time.push(Duration::ZERO);
         self.calls.push(0);
         self
@@ -97,6 +108,7 @@ impl<D: Dim> Schedule<D> {
         match self.position(after) {
             Some(i) => {
                 self.systems.insert(i + 1, Box::new(system));
+                self.prepared = false;
                 self.time.insert(i + 1, Duration::ZERO);
                 self.calls.insert(i + 1, 0);
                 true
@@ -110,6 +122,7 @@ impl<D: Dim> Schedule<D> {
         match self.position(before) {
             Some(i) => {
                 self.systems.insert(i, Box::new(system));
+                self.prepared = false;
                 self.time.insert(i, Duration::ZERO);
                 self.calls.insert(i, 0);
                 true
@@ -128,8 +141,15 @@ impl<D: Dim> Schedule<D> {
         self.systems.iter().map(|s| s.name().to_string()).collect()
     }
 
-    /// Runs every system once, in order, timing each.
+    /// Runs every system once, in order, timing each (after their `prepare`, the first
+    /// time).
     pub fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
+        if !self.prepared {
+            for system in &mut self.systems {
+                system.prepare(ctx)?;
+            }
+            self.prepared = true;
+        }
         for (i, system) in self.systems.iter_mut().enumerate() {
             #[cfg(feature = "trace")]
             let _span = tracing::info_span!("system", name = system.name()).entered();

@@ -153,6 +153,45 @@ pub struct Peak {
     pub energy: f64,
 }
 
+/// A prescribed motion of grid nodes: the velocity its nodes are held at and the force
+/// they exert on the body. The system that drives it (`systems::prescribed_motion`) sets
+/// the velocity; `boundary` holds the nodes to it and sums the reaction.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Drive {
+    /// Name given in the scene.
+    pub name: String,
+    /// The axes the motion drives (bit `a` for axis `a`); its nodes' other held axes are
+    /// fixed by a face condition.
+    pub axes: u8,
+    /// Velocity of the driven components this step (m/s, x y z; zero while holding).
+    pub velocity: [f64; 3],
+    /// Force the driven nodes exert on the body this step, Σ −(f_int + f_ext) over their
+    /// driven components (N; N per metre of thickness in 2D).
+    pub reaction: [f64; 3],
+    /// Distance travelled along the motion so far (m).
+    pub travel: f64,
+    /// Increments finished, each ending at a static state.
+    pub increments: u32,
+}
+
+/// One static state of a load–displacement curve (`curve.csv`).
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct CurvePoint {
+    /// Name of the motion or load.
+    pub name: String,
+    /// Step of the static state.
+    pub step: u64,
+    /// Simulated time (s).
+    pub time: f64,
+    /// Displacement along the motion (m).
+    pub displacement: f64,
+    /// Force on the body (N; N/m in 2D, x y z).
+    pub force: [f64; 3],
+    /// Mean pressure against the motion over the loaded area (Pa), when the scene gives
+    /// the area.
+    pub pressure: Option<f64>,
+}
+
 /// Solver-wide quantities updated by the systems every step.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct SolverState {
@@ -206,6 +245,12 @@ pub struct SolverState {
     /// momentum, forces, acceleration, velocity), so grid passes skip it: a scatter adds the
     /// nodes it reaches, the grid reset zeroes the box and empties it.
     pub active_nodes: NodeBox,
+    /// Prescribed motions, in scene order (a node's [`NodeFixity::driver`]).
+    ///
+    /// [`NodeFixity::driver`]: crate::components::NodeFixity::driver
+    pub drives: Vec<Drive>,
+    /// Static states of the load–displacement curve so far.
+    pub curve: Vec<CurvePoint>,
 }
 
 impl Settings {
@@ -225,6 +270,11 @@ impl SolverState {
             (true, f) if f != 0.0 => Some(f * self.dt),
             _ => None,
         }
+    }
+
+    /// True while a prescribed motion moves: not a static state, however balanced.
+    pub fn driving(&self) -> bool {
+        self.drives.iter().any(|d| d.velocity != [0.0; 3])
     }
 
     /// K_F in the norm the stopping rule reads.

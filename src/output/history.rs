@@ -6,13 +6,15 @@ use crate::error::StepError;
 use crate::output::dir::RowFile;
 use crate::schedule::System;
 use crate::simulation::TracedPoint;
+use crate::state::Drive;
 use crate::systems::convergence::ratio_text;
 use std::marker::PhantomData;
 use std::path::Path;
 use std::sync::{Arc, Mutex, MutexGuard};
 
-/// Writes step, time, E_k (J), W_ext (J), K_F (max and mean norm), K_E, resets and each
-/// traced point's displacement (m) every `every` steps and at the last step. A ratio whose
+/// Writes step, time, E_k (J), W_ext (J), K_F (max and mean norm), K_E, resets, each
+/// traced point's displacement (m) and each prescribed motion's travel (m) and reaction
+/// (N; N/m in 2D) every `every` steps and at the last step. A ratio whose
 /// denominator is zero is written `undefined`.
 ///
 /// The file only ever holds whole rows ([`RowFile`]): a run stopped by an error, a crash or
@@ -25,8 +27,8 @@ pub struct History<D> {
     _marker: PhantomData<fn() -> D>,
 }
 
-/// The column names of `history.csv` for these traced points.
-fn header<D: Dim>(traced: &[TracedPoint]) -> Vec<String> {
+/// The column names of `history.csv` for these traced points and motions.
+fn header<D: Dim>(traced: &[TracedPoint], drives: &[Drive]) -> Vec<String> {
     let mut header: Vec<String> = [
         "step",
         "time",
@@ -43,6 +45,12 @@ fn header<D: Dim>(traced: &[TracedPoint]) -> Vec<String> {
     for t in traced {
         for axis in ["x", "y", "z"].iter().take(D::N) {
             header.push(format!("{}_u{axis}", t.name));
+        }
+    }
+    for d in drives {
+        header.push(format!("{}_travel", d.name));
+        for axis in ["x", "y", "z"].iter().take(D::N) {
+            header.push(format!("{}_force_{axis}", d.name));
         }
     }
     header
@@ -65,9 +73,14 @@ fn line(fields: &[String]) -> Vec<u8> {
 
 impl<D: Dim> History<D> {
     /// Creates `path` and writes the header.
-    pub fn create(path: &Path, every: u64, traced: &[TracedPoint]) -> std::io::Result<Self> {
+    pub fn create(
+        path: &Path,
+        every: u64,
+        traced: &[TracedPoint],
+        drives: &[Drive],
+    ) -> std::io::Result<Self> {
         let mut rows = RowFile::create(path)?;
-        rows.row(&line(&header::<D>(traced)))?;
+        rows.row(&line(&header::<D>(traced, drives)))?;
         rows.flush()?;
         Ok(Self::with(rows, every, traced))
     }
@@ -121,6 +134,10 @@ impl<D: Dim> System<D> for History<D> {
             // A handful of traced points: an entity lookup is fine here.
             let u = t.displacement::<D>(&ctx.world);
             row.extend(u.iter().take(D::N).map(|c| format!("{c:.9e}")));
+        }
+        for d in &s.drives {
+            row.push(format!("{:.9e}", d.travel));
+            row.extend(d.reaction.iter().take(D::N).map(|c| format!("{c:.9e}")));
         }
         let mut rows = lock(&self.rows);
         rows.row(&line(&row))?;

@@ -17,6 +17,9 @@ pub const FILES: [&str; 4] = [
     "displacement_field.svg",
 ];
 
+/// The load–displacement plot, drawn when the run wrote `curve.csv`.
+pub const CURVE_PLOT: &str = "curve.svg";
+
 /// `history.csv` as columns of numbers (a value written `undefined` is NaN here, and
 /// left out of every plot).
 struct History {
@@ -134,7 +137,7 @@ pub fn draw(dir: &Path) -> std::io::Result<(Vec<&'static str>, Vec<String>)> {
     let traced: Vec<(String, Vec<f64>)> = history
         .names
         .iter()
-        .filter(|n| n.contains("_u"))
+        .filter(|n| n.ends_with("_ux") || n.ends_with("_uy") || n.ends_with("_uz"))
         .filter_map(|n| Some((n.clone(), history.column(n)?)))
         .collect();
     if traced.is_empty() {
@@ -151,7 +154,79 @@ pub fn draw(dir: &Path) -> std::io::Result<(Vec<&'static str>, Vec<String>)> {
         Ok(_) => skipped.push(format!("{}: the run keeps no displacements", FILES[3])),
         Err(e) => skipped.push(format!("{}: {e}", FILES[3])),
     }
+    if let Ok(curve) = History::read(&dir.join("curve.csv")) {
+        // The first column (the motion's name) reads as NaN: the rows are in file order.
+        let names: Vec<String> = std::fs::read_to_string(dir.join("curve.csv"))?
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').next().unwrap_or("").to_string())
+            .collect();
+        let y = curve
+            .column("pressure")
+            .map(|p| (p, "mean pressure (Pa)"))
+            .or_else(|| {
+                let f = curve.column("force_y")?;
+                Some((f.iter().map(|v| -v).collect(), "-force_y (N; N/m in 2D)"))
+            });
+        if let (Some(u), Some((y, label))) = (curve.column("displacement"), y) {
+            save(CURVE_PLOT, curve_plot(&names, &u, &y, label))?;
+            written.push(CURVE_PLOT);
+        }
+    }
     Ok((written, skipped))
+}
+
+/// Each motion's static states: pressure (or force) against displacement.
+fn curve_plot(names: &[String], u: &[f64], y: &[f64], label: &str) -> String {
+    svg((960, 600), |root| {
+        let hi_u = u.iter().copied().fold(0.0f64, f64::max).max(1e-30);
+        let (lo, hi) = y.iter().fold((0.0f64, 0.0f64), |(a, b), &v| (a.min(v), b.max(v)));
+        let pad = 0.05 * (hi - lo).max(1e-30);
+        let mut c = ChartBuilder::on(&root)
+            .caption("Load against displacement (static states)", ("sans-serif", 22))
+            .margin(20)
+            .x_label_area_size(50)
+            .y_label_area_size(90)
+            .build_cartesian_2d(0.0..hi_u * 1.05, (lo - pad)..(hi + pad))?;
+        c.configure_mesh()
+            .x_desc("displacement along the motion (m)")
+            .y_desc(label)
+            .y_label_formatter(&|v| format!("{v:.3e}"))
+            .label_style(("sans-serif", 15))
+            .draw()?;
+        let mut seen: Vec<&String> = Vec::new();
+        for n in names {
+            if !seen.contains(&n) {
+                seen.push(n);
+            }
+        }
+        for (k, name) in seen.into_iter().enumerate() {
+            let colour = Palette99::pick(k).to_rgba();
+            let pts: Vec<(f64, f64)> = std::iter::once((0.0, 0.0))
+                .chain(
+                    names
+                        .iter()
+                        .zip(u.iter().zip(y))
+                        .filter(|p| p.0 == name)
+                        .map(|(_, (a, b))| (*a, *b)),
+                )
+                .collect();
+            c.draw_series(LineSeries::new(pts.clone(), colour.stroke_width(2)))?
+                .label(name.as_str())
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2)));
+            c.draw_series(
+                pts.into_iter()
+                    .skip(1)
+                    .map(|p| Circle::new(p, 4, colour.filled())),
+            )?;
+        }
+        c.configure_series_labels()
+            .border_style(BLACK)
+            .background_style(WHITE.mix(0.9))
+            .label_font(("sans-serif", 14))
+            .draw()?;
+        Ok(())
+    })
 }
 
 /// The lower and upper ends of a log axis through the positive finite values of `v`.

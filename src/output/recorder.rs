@@ -10,8 +10,39 @@ use crate::output::summary::Summary;
 use crate::output::vtk::write_points;
 use crate::output::RowFile;
 use crate::simulation::Simulation;
+use crate::state::CurvePoint;
 use std::io::Write;
 use std::sync::{Arc, Mutex};
+
+/// The load–displacement curve's file.
+pub const CURVE: &str = "curve.csv";
+
+/// `curve.csv`: one row a static state of a prescribed motion: name, step, time (s),
+/// displacement along the motion (m), force on the body (N; N/m in 2D) and, when every
+/// motion has a loaded area, the mean pressure (Pa).
+fn curve_csv<D: Dim>(curve: &[CurvePoint]) -> String {
+    let pressure = curve.iter().all(|c| c.pressure.is_some());
+    let axes = &["x", "y", "z"][..D::N];
+    let mut t = format!(
+        "name,step,time,displacement,{}{}\n",
+        axes.iter()
+            .map(|a| format!("force_{a}"))
+            .collect::<Vec<_>>()
+            .join(","),
+        if pressure { ",pressure" } else { "" }
+    );
+    for c in curve {
+        t += &format!("{},{},{:.9e},{:.9e}", c.name, c.step, c.time, c.displacement);
+        for f in &c.force[..D::N] {
+            t += &format!(",{f:.9e}");
+        }
+        if let (true, Some(p)) = (pressure, c.pressure) {
+            t += &format!(",{p:.9e}");
+        }
+        t += "\n";
+    }
+    t
+}
 
 /// The outputs a run writes into its directory: `history.csv` every `history_every` steps,
 /// the snapshot series when `snapshots` is set, and at the end `points.vtu`,
@@ -39,7 +70,7 @@ impl Recorder {
     ) -> std::io::Result<Recorder> {
         let file = dir.file("history.csv");
         let history = match history_bytes {
-            None => History::<D>::create(&file, history_every, &sim.traced)?,
+            None => History::<D>::create(&file, history_every, &sim.traced, &sim.ctx.state.drives)?,
             Some(bytes) => History::<D>::resume(&file, bytes, history_every, &sim.traced)?,
         };
         let rows = history.rows();
@@ -86,6 +117,11 @@ impl Recorder {
                     ""
                 }
             )),
+        }
+        if !sim.ctx.state.curve.is_empty() {
+            dir.write_atomic(CURVE, |out| {
+                out.write_all(curve_csv::<D>(&sim.ctx.state.curve).as_bytes())
+            })?;
         }
         // After the output, so that the peak memory covers the whole run.
         let mut summary = Summary::collect(scene, sim, wall_seconds, error);

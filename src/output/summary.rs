@@ -4,7 +4,7 @@ use crate::dim::Dim;
 use crate::measure::{max_displacements, surface_angle, SurfaceAngle};
 use crate::schedule::Timing;
 use crate::simulation::{Simulation, TracedResult};
-use crate::state::{ForceNorm, Peak, StopReason};
+use crate::state::{CurvePoint, ForceNorm, Peak, StopReason};
 use crate::systems::convergence::is_defined;
 use serde::Serialize;
 
@@ -92,6 +92,17 @@ pub struct Summary {
     /// Wall-clock seconds stepping waited for the snapshot writer (s).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub output_wait_seconds: Option<f64>,
+    /// The largest mean pressure of the load–displacement curve's static states (Pa), for
+    /// motions given a loaded area: the limit pressure where the curve has levelled off.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub limit_pressure: Option<f64>,
+    /// How much the pressure rose over the curve's last increment, relative to the limit
+    /// pressure: near 0 on a plateau, well above it while the curve still climbs.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub last_increment_rise: Option<f64>,
+    /// Static states of the load–displacement curve (`curve.csv`).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub curve: Vec<CurvePoint>,
 }
 
 /// How a run ended, as `summary.json` writes it (snake case).
@@ -178,7 +189,25 @@ impl Summary {
             systems: sim.schedule.timings(),
             snapshots: None,
             output_wait_seconds: None,
+            limit_pressure: limit_pressure(&s.curve),
+            last_increment_rise: last_increment_rise(&s.curve),
+            curve: s.curve.clone(),
         }
+    }
+}
+
+/// The largest pressure over the curve's static states (Pa).
+fn limit_pressure(curve: &[CurvePoint]) -> Option<f64> {
+    curve.iter().filter_map(|c| c.pressure).reduce(f64::max)
+}
+
+/// (p_last − p_before) / p_limit over the last two static states with a pressure.
+fn last_increment_rise(curve: &[CurvePoint]) -> Option<f64> {
+    let p: Vec<f64> = curve.iter().filter_map(|c| c.pressure).collect();
+    let limit = limit_pressure(curve)?;
+    match p[..] {
+        [.., before, last] if limit > 0.0 => Some((last - before) / limit),
+        _ => None,
     }
 }
 

@@ -1,15 +1,22 @@
-//! Essential boundary conditions on the grid (paper step 2).
+//! Essential boundary conditions on the grid (paper step 2): fixed components held at zero,
+//! driven ones at their prescribed motion's velocity.
 
 use crate::columns::{col, col_mut, nodes};
 use crate::components::*;
 use crate::context::Context;
 use crate::dim::{Dim, Vector};
 use crate::error::StepError;
-use crate::parallel::{for_each_box_node, Disjoint};
+use crate::parallel::{grid_pass, Disjoint};
 use crate::schedule::System;
+use crate::state::Drive;
 
-/// Zeroes the fixed components of nodal momentum and force, so that fixed nodes neither
-/// move nor accelerate.
+/// Holds the constrained components of every node: momentum m·v̄ (v̄ = 0 on a fixed face,
+/// the motion's velocity on a driven node) and no force, so that the node moves at v̄.
+///
+/// A driven node's removed force is its reaction: the motion exerts −(f_int + f_ext) on
+/// the body there. It is summed per motion in node order (the same bits on any thread
+/// count) into [`Drive::reaction`] and added to the node's external force, so that K_F
+/// counts the motion's load as applied load and W_ext its work.
 #[derive(Debug, Default)]
 pub struct Boundary;
 
@@ -19,34 +26,86 @@ impl<D: Dim> System<D> for Boundary {
     }
     fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
         let n = nodes(&ctx.world);
-        let fix = col::<NodeFixity>(n);
-        let fix = &*fix; // a plain slice: the column guard cannot be shared with the pool
+        let (fix, nm) = (col::<NodeFixity>(n), col::<NodeMass>(n));
+        // Plain slices: the column guards cannot be shared with the pool.
+        let (fix, nm) = (&*fix, &*nm);
+        let drives = &ctx.state.drives[..];
+        let velocities: Vec<[f64; 3]> = drives.iter().map(|d| d.velocity).collect();
+        let velocities = &velocities[..];
         let mut np = col_mut::<NodeMomentum<D::Vec>>(n);
         let mut nf = col_mut::<NodeForce<D::Vec>>(n);
-        let target = (Disjoint::new(&mut np), Disjoint::new(&mut nf));
-        for_each_box_node(&ctx.grid, ctx.state.active_nodes, &target, |i, k, (np, nf)| {
-            let f = fix[i];
-            if f.0 == 0 {
-                return;
-            }
-            for a in 0..D::N {
-                if f.is_fixed(a) {
-                    np[k].0.set(a, 0.0);
+        let mut ne = col_mut::<NodeExternalForce<D::Vec>>(n);
+        let target = (
+            Disjoint::new(&mut np),
+            Disjoint::new(&mut nf),
+            Disjoint::new(&mut ne),
+        );
+        let grid = &ctx.grid;
+        let parts = grid_pass(grid, ctx.state.active_nodes, &target, |b, (np, nf, ne), first| {
+            let mut reactions = vec![[0.0; 3]; velocities.len()];
+            for i in b.rows(grid).flatten() {
+                let f = fix[i];
+                if f.0 == 0 {
+                    continue;
+                }
+                let k = i - first;
+                for a in 0..D::N {
+                    match hold(f, a, drives) {
+                        Hold::Free => continue,
+                        Hold::Driven(d) => {
+                            let r = -nf[k].0.get(a);
+                            reactions[d][a] += r;
+                            ne[k].0.set(a, ne[k].0.get(a) + r);
+                            np[k].0.set(a, nm[i].0 * velocities[d][a]);
+                        }
+                        Hold::Fixed => np[k].0.set(a, 0.0),
+                    }
                     nf[k].0.set(a, 0.0);
                 }
             }
+            reactions
         });
+        for (d, drive) in ctx.state.drives.iter_mut().enumerate() {
+            drive.reaction = parts
+                .iter()
+                .fold([0.0; 3], |s, p| std::array::from_fn(|a| s[a] + p[d][a]));
+        }
         Ok(())
     }
 }
 
-/// Zeroes the fixed components of a nodal velocity.
+/// How a node holds one axis.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Hold {
+    /// Not at all.
+    Free,
+    /// At zero (a face condition).
+    Fixed,
+    /// At the velocity of this prescribed motion.
+    Driven(usize),
+}
+
+/// How `fixity` holds axis `axis`, given the scene's motions.
 #[inline(always)]
-pub fn constrain<V: Vector>(v: &mut V, fixity: NodeFixity, dims: usize) {
+pub fn hold(fixity: NodeFixity, axis: usize, drives: &[Drive]) -> Hold {
+    if !fixity.is_fixed(axis) {
+        return Hold::Free;
+    }
+    match fixity.driver() {
+        Some(d) if drives[d].axes & (1 << axis) != 0 => Hold::Driven(d),
+        _ => Hold::Fixed,
+    }
+}
+
+/// Sets the held components of a nodal velocity: zero, or the driving motion's velocity.
+#[inline(always)]
+pub fn constrain<V: Vector>(v: &mut V, fixity: NodeFixity, dims: usize, drives: &[Drive]) {
     if fixity.0 != 0 {
         for a in 0..dims {
-            if fixity.is_fixed(a) {
-                v.set(a, 0.0);
+            match hold(fixity, a, drives) {
+                Hold::Free => {}
+                Hold::Fixed => v.set(a, 0.0),
+                Hold::Driven(d) => v.set(a, drives[d].velocity[a]),
             }
         }
     }

@@ -10,6 +10,7 @@ use crate::measure::{max_movement, positions};
 use crate::parallel::grid_pass;
 use crate::schedule::System;
 use crate::state::{StaticCheck, StopReason};
+use crate::systems::boundary::{hold, Hold};
 
 /// K_E above which a run is declared unstable (a sound run stays at or below 1).
 pub const UNSTABLE_ENERGY_RATIO: f64 = 10.0;
@@ -36,7 +37,8 @@ pub fn ratio_text(ratio: f64, digits: usize) -> String {
 /// Force-ratio sums over the free degrees of freedom of nodes that carry mass.
 ///
 /// Fixed components are left out (their reaction keeps K_F near 1 for ever), and so are
-/// massless nodes (they carry no degree of freedom). With no external force on any free
+/// massless nodes (they carry no degree of freedom). A component driven by a prescribed
+/// motion counts its load (the reaction) as external force and has no unbalanced force. With no external force on any free
 /// degree of freedom both ratios are [`UNDEFINED`].
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct ForceRatios {
@@ -56,6 +58,7 @@ pub fn force_ratios<D: Dim>(ctx: &Context<D>) -> ForceRatios {
     let fix = col::<NodeFixity>(n);
     // Plain slices: the column guards cannot be shared with the pool.
     let (nm, nf, ne, fix) = (&*nm, &*nf, &*ne, &*fix);
+    let drives = &ctx.state.drives[..];
     let grid = &ctx.grid;
     // Per group of node layers: max|F_unb|, max|F_ext|, Σ|F_unb|, Σ|F_ext|, combined in node
     // order below.
@@ -66,10 +69,14 @@ pub fn force_ratios<D: Dim>(ctx: &Context<D>) -> ForceRatios {
                 continue;
             }
             for a in 0..D::N {
-                if fix[i].is_fixed(a) {
-                    continue;
-                }
-                let u = nf[i].0.get(a).abs();
+                // A driven component's external force is the motion's load (applied, and
+                // balanced by construction); a fixed one's would be a support reaction.
+                let driven = match hold(fix[i], a, drives) {
+                    Hold::Free => false,
+                    Hold::Fixed => continue,
+                    Hold::Driven(_) => true,
+                };
+                let u = if driven { 0.0 } else { nf[i].0.get(a).abs() };
                 let e = ne[i].0.get(a).abs();
                 max_u = max_u.max(u);
                 max_e = max_e.max(e);
@@ -182,11 +189,13 @@ impl<D: Dim> System<D> for Convergence {
         }
         let tol = ctx.settings.tolerance;
         let (step, time) = (s.step, s.time);
-        // A load still ramping up is not a static state, however balanced this step is.
+        // A load still ramping up, or a prescribed motion still moving, is not a static
+        // state, however balanced this step is.
         let loading = ctx
             .settings
             .gravity
-            .is_some_and(|g| g.step_factor(time, s.dt) < 1.0);
+            .is_some_and(|g| g.step_factor(time, s.dt) < 1.0)
+            || s.driving();
         // An undefined ratio (NaN) compares false: it never meets the tolerance.
         let met = !loading && s.force_ratio(ctx.settings.force_norm) <= tol && s.energy_ratio <= tol;
         let converged = match ctx.settings.static_check {

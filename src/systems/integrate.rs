@@ -8,6 +8,7 @@ use crate::error::StepError;
 use crate::parallel::{for_each_box_node, Disjoint};
 use crate::schedule::System;
 use crate::state::Damping;
+use crate::systems::boundary::constrain;
 
 /// a_i = (f_i + f_damp)/max(m_i, m_floor) and v_i ← p_i/m_i + a_i Δt (explicit Euler on the
 /// grid). Viscous damping f_damp = −2β m_i v_i and local damping f_damp,a = −α |f_a| sign(v_a)
@@ -40,8 +41,10 @@ impl<D: Dim> System<D> for Integrate {
         let nm = col::<NodeMass>(n);
         let np = col::<NodeMomentum<D::Vec>>(n);
         let nf = col::<NodeForce<D::Vec>>(n);
+        let fix = col::<NodeFixity>(n);
         // Plain slices: the column guards cannot be shared with the pool.
-        let (nm, np, nf) = (&*nm, &*np, &*nf);
+        let (nm, np, nf, fix) = (&*nm, &*np, &*nf, &*fix);
+        let drives = &ctx.state.drives[..];
         let mut na = col_mut::<NodeAcceleration<D::Vec>>(n);
         let mut nv = col_mut::<NodeVelocity<D::Vec>>(n);
         let grid = &ctx.grid;
@@ -61,9 +64,15 @@ impl<D: Dim> System<D> for Integrate {
                         }
                     }
                 }
-                let a = f * (1.0 / grid.inertia(i, m, floor));
+                let mut a = f * (1.0 / grid.inertia(i, m, floor));
+                let mut v = np[i].0 * (1.0 / m) + a * dt;
+                if fix[i].0 != 0 {
+                    // Held components stay held whatever the damping force did.
+                    constrain(&mut v, fix[i], D::N, drives);
+                    constrain(&mut a, NodeFixity(fix[i].0 & 0b111), D::N, drives);
+                }
                 na[k].0 = a;
-                nv[k].0 = np[i].0 * (1.0 / m) + a * dt;
+                nv[k].0 = v;
             } else {
                 na[k].0 = D::Vec::ZERO;
                 nv[k].0 = D::Vec::ZERO;

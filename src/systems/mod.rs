@@ -1,29 +1,18 @@
-//! The stages of one explicit MPM step, one file each, and the default schedule.
+//! The stages of one explicit MPM step, one file each, and the registry that makes the
+//! schedules.
 //!
-//! MUSL with kinetic damping (the default) runs, in order:
+//! [`registry`] holds one [`Entry`] per system: its name, its [`Stage`], when a scene needs
+//! it, the systems it must follow and its constructor. The list of names, each scheme's
+//! default schedule ([`default_names`]: the scheme's [`stages`] in order, and in each the
+//! systems it needs), the checks on a scene's own `solver.schedule` ([`check_names`]) and
+//! the table in docs/writing-a-system.md ([`systems_table`]) all come from it.
 //!
-//! | system          | file                 | what it does                                   |
-//! |-----------------|----------------------|------------------------------------------------|
-//! | `grid_reset`    | `grid_reset.rs`      | empty, undeformed grid                          |
-//! | `spatial_sort`  | `spatial_sort.rs`    | points back in cell order (every N steps)       |
-//! | `p2g`           | `p2g.rs`             | mass, momentum, internal force to the nodes     |
-//! | `gravity`       | `gravity.rs`         | body force m_i g (only with gravity)            |
-//! | `point_loads`   | `point_loads.rs`     | concentrated loads (only with loads)            |
-//! | `boundary`      | `boundary.rs`        | fixed components of momentum and force to zero  |
-//! | `integrate`     | `integrate.rs`       | nodal acceleration and velocity (+ viscous)     |
-//! | `mass_scaling`  | `mass_scaling.rs`    | fictitious inertia (only with mass scaling)     |
-//! | `g2p`           | `g2p.rs`             | point velocities, kinetic energy                |
-//! | `peak_watch`    | `peak_watch.rs`      | kinetic damping reset (only kinetic damping)    |
-//! | `remap`         | `remap.rs`           | MUSL: point velocities back to the grid         |
-//! | `kinematics`    | `kinematics.rs`      | velocity gradient, position update              |
-//! | `stress_update` | `stress_update.rs`   | Jaumann rotation + material law                 |
-//! | `volume_update` | `volume_update.rs`   | V ← V det(I + LΔt)                              |
-//! | `convergence`   | `convergence.rs`     | K_F, W_ext, K_E, stopping rule                  |
-//!
-//! USL drops `remap` (points move with the updated grid velocity); USF maps momentum first
-//! (`p2g_momentum`, `nodal_velocity`), updates stress (`velocity_gradient`,
-//! `stress_update`, `volume_update`), then maps forces (`p2g_force`) and moves the points
-//! at the end (`move_points`).
+//! MUSL with kinetic damping (the default) runs `grid_reset`, `spatial_sort`, `p2g`,
+//! `gravity`, `boundary`, `integrate`, `g2p`, `peak_watch`, `remap`, `kinematics`,
+//! `stress_update`, `volume_update`, `convergence`. USL drops `remap` (points move with the
+//! updated grid velocity); USF maps momentum first (`p2g_momentum`, `nodal_velocity`),
+//! updates stress (`velocity_gradient`, `stress_update`, `volume_update`), then maps forces
+//! (`p2g_force`) and moves the points at the end (`move_points`).
 
 pub mod boundary;
 pub mod convergence;
@@ -61,7 +50,7 @@ pub use stress_update::StressUpdate;
 pub use volume_update::VolumeUpdate;
 pub use volumetric_smoothing::VolumetricSmoothing;
 
-use crate::dim::Dim;
+use crate::dim::{Dim, Dim2};
 use crate::schedule::{Schedule, System};
 use crate::shape::{Linear, QuadraticBSpline, Shape, ShapeKind, UniformGimp};
 use crate::state::{Damping, Scheme, Settings};
@@ -73,228 +62,398 @@ pub struct Needs {
     pub point_loads: bool,
 }
 
-/// Every system a scene may name in `solver.schedule`.
-pub const SYSTEM_NAMES: &[&str] = &[
-    "grid_reset",
+/// The place of a system in a step. A scheme runs its stages in the order
+/// [`stages`] gives; systems of one stage run in registry order.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Stage {
+    /// Empty the grid.
+    Reset,
+    /// Put the points in cell order.
+    Sort,
+    /// Map mass and momentum (and, but for USF, the internal force).
+    Map,
+    /// USF: nodal velocity from the mapped momentum.
+    NodalVelocity,
+    /// Velocity gradient (and, but for USF, the point motion).
+    Strain,
+    /// Smooth the volumetric strain rate.
+    Smooth,
+    /// The material law.
+    Stress,
+    /// Point volumes.
+    Volume,
+    /// USF: map the internal force of the updated stress.
+    MapForce,
+    /// External nodal forces.
+    Forces,
+    /// Boundary conditions on nodal momentum and force.
+    Constrain,
+    /// Nodal accelerations and velocities.
+    Integrate,
+    /// Changes to the integrated nodal accelerations.
+    Scale,
+    /// Nodal accelerations and velocities to the points.
+    Interpolate,
+    /// Kinetic damping.
+    Damp,
+    /// MUSL: point velocities back to the grid.
+    Remap,
+    /// USF: move the points.
+    Move,
+    /// Energies, force ratios and the stopping rule.
+    Monitor,
+    /// Acts on the step's outcome: load and displacement control.
+    Control,
+}
+
+/// The stages of one step of `scheme`, in order.
+pub fn stages(scheme: Scheme) -> &'static [Stage] {
+    use Stage::*;
+    match scheme {
+        Scheme::Musl | Scheme::Usl => &[
+            Reset,
+            Sort,
+            Map,
+            Forces,
+            Constrain,
+            Integrate,
+            Scale,
+            Interpolate,
+            Damp,
+            Remap,
+            Strain,
+            Smooth,
+            Stress,
+            Volume,
+            Monitor,
+            Control,
+        ],
+        Scheme::Usf => &[
+            Reset,
+            Sort,
+            Map,
+            NodalVelocity,
+            Strain,
+            Smooth,
+            Stress,
+            Volume,
+            MapForce,
+            Forces,
+            Constrain,
+            Integrate,
+            Scale,
+            Interpolate,
+            Damp,
+            Move,
+            Monitor,
+            Control,
+        ],
+    }
+}
+
+/// When the default schedule holds a system.
+#[derive(Clone, Copy)]
+pub enum When {
+    /// In every scheme's default schedule, and required in any schedule.
+    Always,
+    /// In the default schedule of these schemes.
+    Schemes(&'static [Scheme]),
+    /// Exactly when the scene needs it: required then, refused otherwise. The text says
+    /// when ("the scene has gravity").
+    Needed(fn(&Settings, Needs) -> bool, &'static str),
+}
+
+/// One system: everything the schedule, its checks and the docs know about it.
+pub struct Entry<D: Dim> {
+    /// The name scenes use in `solver.schedule`, profiles and errors.
+    pub name: &'static str,
+    /// Its place in a step.
+    pub stage: Stage,
+    /// When a schedule holds it.
+    pub when: When,
+    /// Systems it must run after when both are scheduled, and why.
+    pub after: &'static [(&'static str, &'static str)],
+    /// What it does, one line (the docs' list and `kdmpm check`).
+    pub does: &'static str,
+    /// Builds it for a scene's settings.
+    pub build: fn(&Settings) -> Box<dyn System<D>>,
+}
+
+const MUSL_USL: &[Scheme] = &[Scheme::Musl, Scheme::Usl];
+const USF: &[Scheme] = &[Scheme::Usf];
+const SORTED: (&str, &str) = (
     "spatial_sort",
-    "p2g",
-    "p2g_momentum",
-    "nodal_velocity",
-    "velocity_gradient",
-    "p2g_force",
-    "gravity",
-    "point_loads",
-    "boundary",
-    "integrate",
-    "mass_scaling",
-    "g2p",
-    "peak_watch",
-    "remap",
-    "kinematics",
-    "move_points",
-    "volumetric_smoothing",
-    "stress_update",
-    "volume_update",
-    "convergence",
-];
+    "the points are put in cell order before the step maps them",
+);
+const STRAINED: &str = "the stress update needs the velocity gradient";
+const SMOOTHED: &str = "smoothing works on the velocity gradient";
+const COMPLETE: &str = "boundary conditions act on the complete nodal force";
+const NOT_IN_RESET: &str = "points must not move in a reset step";
+const INTEGRATED: &str = "points move with the integrated velocity";
 
-/// Pairs (a, b): when both are scheduled, a must run before b.
-const ORDER: &[(&str, &str, &str)] = &[
-    (
-        "spatial_sort",
-        "p2g",
-        "the points are put in cell order before the step maps them",
-    ),
-    (
-        "spatial_sort",
-        "p2g_momentum",
-        "the points are put in cell order before the step maps them",
-    ),
-    ("p2g", "gravity", "gravity acts on the nodal mass that p2g maps"),
-    (
-        "p2g_momentum",
-        "gravity",
-        "gravity acts on the nodal mass that p2g_momentum maps",
-    ),
-    (
-        "p2g",
-        "point_loads",
-        "point loads go to nodes that carry mapped mass",
-    ),
-    (
-        "p2g_momentum",
-        "point_loads",
-        "point loads go to nodes that carry mapped mass",
-    ),
-    (
-        "p2g_momentum",
-        "nodal_velocity",
-        "the nodal velocity needs the mapped momentum",
-    ),
-    (
-        "nodal_velocity",
-        "velocity_gradient",
-        "the velocity gradient needs the nodal velocity",
-    ),
-    (
-        "velocity_gradient",
-        "stress_update",
-        "the stress update needs the velocity gradient",
-    ),
-    (
-        "kinematics",
-        "stress_update",
-        "the stress update needs the velocity gradient",
-    ),
-    (
-        "velocity_gradient",
-        "volumetric_smoothing",
-        "smoothing works on the velocity gradient",
-    ),
-    (
-        "kinematics",
-        "volumetric_smoothing",
-        "smoothing works on the velocity gradient",
-    ),
-    (
-        "volumetric_smoothing",
-        "stress_update",
-        "the stress must see the smoothed strain",
-    ),
-    (
-        "stress_update",
-        "volume_update",
-        "the volume update follows the stress update",
-    ),
-    ("stress_update", "p2g_force", "p2g_force maps the updated stress"),
-    (
-        "p2g",
-        "boundary",
-        "boundary conditions act on mapped momentum and force",
-    ),
-    (
-        "p2g_force",
-        "boundary",
-        "boundary conditions act on the complete nodal force",
-    ),
-    (
-        "gravity",
-        "boundary",
-        "boundary conditions act on the complete nodal force",
-    ),
-    (
-        "point_loads",
-        "boundary",
-        "boundary conditions act on the complete nodal force",
-    ),
-    (
-        "boundary",
-        "integrate",
-        "integration needs constrained momentum and force",
-    ),
-    ("integrate", "g2p", "g2p interpolates the nodal accelerations"),
-    (
-        "integrate",
-        "mass_scaling",
-        "mass scaling rescales the integrated accelerations",
-    ),
-    (
-        "mass_scaling",
-        "g2p",
-        "g2p interpolates the rescaled accelerations",
-    ),
-    (
-        "g2p",
-        "peak_watch",
-        "the peak watch reads the kinetic energy g2p computes",
-    ),
-    ("g2p", "remap", "the remap maps the updated point velocities"),
-    (
-        "peak_watch",
-        "remap",
-        "a reset must happen before the velocities are remapped",
-    ),
-    (
-        "remap",
-        "kinematics",
-        "MUSL strains and moves the points with the remapped velocity",
-    ),
-    ("peak_watch", "kinematics", "points must not move in a reset step"),
-    (
-        "peak_watch",
-        "move_points",
-        "points must not move in a reset step",
-    ),
-    (
-        "integrate",
-        "move_points",
-        "points move with the integrated velocity",
-    ),
-    (
-        "integrate",
-        "kinematics",
-        "points move with the integrated velocity",
-    ),
-];
-
-/// The default list of system names for a scene's settings.
-pub fn default_names(settings: &Settings, needs: Needs) -> Vec<&'static str> {
-    let mut n = vec!["grid_reset"];
-    if settings.sort_every > 0 {
-        n.push("spatial_sort");
-    }
-    let forces = |n: &mut Vec<&'static str>| {
-        if settings.gravity.is_some() {
-            n.push("gravity");
-        }
-        if needs.point_loads {
-            n.push("point_loads");
-        }
-        n.extend(["boundary", "integrate"]);
-        if settings.mass_scaling() {
-            n.push("mass_scaling");
-        }
-        n.push("g2p");
-        if settings.damping == Damping::Kinetic {
-            n.push("peak_watch");
-        }
+/// Every system, in the order they run within a stage. The names, the default schedules,
+/// the order rules and the list in docs/writing-a-system.md all come from here: a new
+/// system is one entry. `S` is the scene's shape function.
+pub fn registry<D: Dim, S: Shape>() -> Vec<Entry<D>> {
+    use Stage as St;
+    use When::*;
+    let e = |name, stage, when, after, does, build| Entry {
+        name,
+        stage,
+        when,
+        after,
+        does,
+        build,
     };
-    match settings.scheme {
-        Scheme::Musl | Scheme::Usl => {
-            n.push("p2g");
-            forces(&mut n);
-            if settings.scheme == Scheme::Musl {
-                n.push("remap");
+    vec![
+        e(
+            "grid_reset",
+            St::Reset,
+            Always,
+            &[],
+            "empty, undeformed grid",
+            |_| Box::new(GridReset),
+        ),
+        e(
+            "spatial_sort",
+            St::Sort,
+            Needed(|s, _| s.sort_every > 0, "solver.sort_every is above 0"),
+            &[],
+            "points back in cell order (every N steps)",
+            |s| Box::new(SpatialSort::new(s.sort_every)),
+        ),
+        e(
+            "p2g",
+            St::Map,
+            Schemes(MUSL_USL),
+            &[SORTED],
+            "mass, momentum, internal force to the nodes",
+            |_| Box::new(P2g::<D, S>::new(P2gPart::All)),
+        ),
+        e(
+            "p2g_momentum",
+            St::Map,
+            Schemes(USF),
+            &[SORTED],
+            "USF: mass and momentum to the nodes",
+            |_| Box::new(P2g::<D, S>::new(P2gPart::MassMomentum)),
+        ),
+        e(
+            "nodal_velocity",
+            St::NodalVelocity,
+            Schemes(USF),
+            &[("p2g_momentum", "the nodal velocity needs the mapped momentum")],
+            "USF: nodal velocity from momentum",
+            |_| Box::new(NodalVelocity),
+        ),
+        e(
+            "kinematics",
+            St::Strain,
+            Schemes(MUSL_USL),
+            &[
+                ("integrate", INTEGRATED),
+                ("peak_watch", NOT_IN_RESET),
+                (
+                    "remap",
+                    "MUSL strains and moves the points with the remapped velocity",
+                ),
+            ],
+            "velocity gradient, position update",
+            |_| Box::new(Kinematics::<D, S>::both()),
+        ),
+        e(
+            "velocity_gradient",
+            St::Strain,
+            Schemes(USF),
+            &[("nodal_velocity", "the velocity gradient needs the nodal velocity")],
+            "USF: velocity gradient",
+            |_| Box::new(Kinematics::<D, S>::gradient_only()),
+        ),
+        e(
+            "volumetric_smoothing",
+            St::Smooth,
+            Needed(
+                |s, _| s.volumetric_smoothing,
+                "solver.volumetric_smoothing is true",
+            ),
+            &[("kinematics", SMOOTHED), ("velocity_gradient", SMOOTHED)],
+            "cell-averaged volumetric strain rate",
+            |_| Box::new(VolumetricSmoothing::<D, S>::default()),
+        ),
+        e(
+            "stress_update",
+            St::Stress,
+            Always,
+            &[
+                ("kinematics", STRAINED),
+                ("velocity_gradient", STRAINED),
+                ("volumetric_smoothing", "the stress must see the smoothed strain"),
+            ],
+            "Jaumann rotation + material law",
+            |_| Box::new(StressUpdate),
+        ),
+        e(
+            "volume_update",
+            St::Volume,
+            Always,
+            &[("stress_update", "the volume update follows the stress update")],
+            "V ← V det(I + LΔt)",
+            |_| Box::new(VolumeUpdate),
+        ),
+        e(
+            "p2g_force",
+            St::MapForce,
+            Schemes(USF),
+            &[("stress_update", "p2g_force maps the updated stress")],
+            "USF: internal force of the updated stress",
+            |_| Box::new(P2g::<D, S>::new(P2gPart::InternalForce)),
+        ),
+        e(
+            "gravity",
+            St::Forces,
+            Needed(|s, _| s.gravity.is_some(), "the scene has gravity"),
+            &[
+                ("p2g", "gravity acts on the nodal mass that p2g maps"),
+                (
+                    "p2g_momentum",
+                    "gravity acts on the nodal mass that p2g_momentum maps",
+                ),
+            ],
+            "body force m_i g",
+            |s| Box::new(Gravity::new(s.gravity.expect("checked: the scene has gravity"))),
+        ),
+        e(
+            "point_loads",
+            St::Forces,
+            Needed(|_, n| n.point_loads, "the scene has point loads"),
+            &[
+                ("p2g", "point loads go to nodes that carry mapped mass"),
+                ("p2g_momentum", "point loads go to nodes that carry mapped mass"),
+            ],
+            "concentrated loads",
+            |_| Box::new(PointLoads::<D, S>::default()),
+        ),
+        e(
+            "boundary",
+            St::Constrain,
+            Always,
+            &[
+                ("p2g", "boundary conditions act on mapped momentum and force"),
+                ("p2g_force", COMPLETE),
+                ("gravity", COMPLETE),
+                ("point_loads", COMPLETE),
+            ],
+            "held components: fixed at zero, or at a motion's velocity",
+            |_| Box::new(Boundary),
+        ),
+        e(
+            "integrate",
+            St::Integrate,
+            Always,
+            &[("boundary", "integration needs constrained momentum and force")],
+            "nodal acceleration and velocity (+ viscous or local damping)",
+            |_| Box::new(Integrate),
+        ),
+        e(
+            "mass_scaling",
+            St::Scale,
+            Needed(|s, _| s.mass_scaling(), "solver.mass_scaling is true"),
+            &[("integrate", "mass scaling rescales the integrated accelerations")],
+            "fictitious inertia",
+            |_| Box::new(MassScaling::<D, S>::default()),
+        ),
+        e(
+            "g2p",
+            St::Interpolate,
+            Always,
+            &[
+                ("integrate", "g2p interpolates the nodal accelerations"),
+                ("mass_scaling", "g2p interpolates the rescaled accelerations"),
+            ],
+            "point velocities, kinetic energy",
+            |_| Box::new(G2p::<D, S>::default()),
+        ),
+        e(
+            "peak_watch",
+            St::Damp,
+            Needed(|s, _| s.damping == Damping::Kinetic, "solver.damping is Kinetic"),
+            &[("g2p", "the peak watch reads the kinetic energy g2p computes")],
+            "kinetic damping reset",
+            |_| Box::new(PeakWatch),
+        ),
+        e(
+            "remap",
+            St::Remap,
+            Schemes(&[Scheme::Musl]),
+            &[
+                ("g2p", "the remap maps the updated point velocities"),
+                (
+                    "peak_watch",
+                    "a reset must happen before the velocities are remapped",
+                ),
+            ],
+            "MUSL: point velocities back to the grid",
+            |_| Box::new(Remap::<D, S>::default()),
+        ),
+        e(
+            "move_points",
+            St::Move,
+            Schemes(USF),
+            &[("integrate", INTEGRATED), ("peak_watch", NOT_IN_RESET)],
+            "USF: position update",
+            |_| Box::new(Kinematics::<D, S>::motion_only()),
+        ),
+        e(
+            "convergence",
+            St::Monitor,
+            Always,
+            &[],
+            "K_F, W_ext, K_E, stopping rule",
+            |_| Box::new(Convergence),
+        ),
+    ]
+}
+
+/// The registry's names, kinds and rules; they do not depend on the dimension or shape.
+fn entries() -> Vec<Entry<Dim2>> {
+    registry::<Dim2, Linear>()
+}
+
+/// Every system a scene may name in `solver.schedule`, in registry order.
+pub fn system_names() -> Vec<&'static str> {
+    entries().iter().map(|e| e.name).collect()
+}
+
+/// The default list of system names for a scene's settings: each scheme's stages in
+/// order, and in each the systems its scheme or the scene needs.
+pub fn default_names(settings: &Settings, needs: Needs) -> Vec<&'static str> {
+    let entries = entries();
+    let mut names = Vec::new();
+    for &stage in stages(settings.scheme) {
+        for e in entries.iter().filter(|e| e.stage == stage) {
+            let wanted = match e.when {
+                When::Always => true,
+                When::Schemes(s) => s.contains(&settings.scheme),
+                When::Needed(needed, _) => needed(settings, needs),
+            };
+            if wanted {
+                names.push(e.name);
             }
-            n.push("kinematics");
-            if settings.volumetric_smoothing {
-                n.push("volumetric_smoothing");
-            }
-            n.extend(["stress_update", "volume_update"]);
-        }
-        Scheme::Usf => {
-            n.extend(["p2g_momentum", "nodal_velocity", "velocity_gradient"]);
-            if settings.volumetric_smoothing {
-                n.push("volumetric_smoothing");
-            }
-            n.extend(["stress_update", "volume_update", "p2g_force"]);
-            forces(&mut n);
-            n.push("move_points");
         }
     }
-    n.push("convergence");
-    n
+    names
 }
 
 /// Checks a list of system names: all known, none twice, every required stage present,
 /// the optional ones present exactly when the scene needs them, and every order rule kept.
 /// The error says what is wrong and why.
 pub fn check_names(names: &[String], settings: &Settings, needs: Needs) -> Result<(), String> {
+    let entries = entries();
     for n in names {
-        if !SYSTEM_NAMES.contains(&n.as_str()) {
+        if !entries.iter().any(|e| e.name == n) {
             return Err(format!(
                 "unknown system `{n}`; valid names: {}",
-                SYSTEM_NAMES.join(", ")
+                system_names().join(", ")
             ));
         }
         if names.iter().filter(|m| *m == n).count() > 1 {
@@ -306,9 +465,16 @@ pub fn check_names(names: &[String], settings: &Settings, needs: Needs) -> Resul
     if names.first().map(String::as_str) != Some("grid_reset") {
         return Err("`grid_reset` must come first: every step starts from an empty grid".into());
     }
-    if names.last().map(String::as_str) != Some("convergence") {
-        return Err("`convergence` must come last: it judges the completed step".into());
+    // Only control systems, which act on the judged step, may follow the convergence
+    // monitor.
+    let control = |n: &String| entries.iter().any(|e| e.name == n && e.stage == Stage::Control);
+    let before_control = names.iter().rev().find(|n| !control(n));
+    if before_control.map(String::as_str) != Some("convergence") {
+        return Err(
+            "`convergence` must come last (but for control systems): it judges the completed step".into(),
+        );
     }
+    // The scheme-dependent stages: each job done by exactly one of the systems that can.
     let one_of = |a: &str, b: &str, why: &str| -> Result<(), String> {
         match (has(a), has(b)) {
             (true, true) => Err(format!("`{a}` and `{b}` both {why}: keep one")),
@@ -334,53 +500,55 @@ pub fn check_names(names: &[String], settings: &Settings, needs: Needs) -> Resul
     if !has("kinematics") && !has("move_points") {
         return Err("the schedule lacks `kinematics` (or `move_points`): nothing moves the points".into());
     }
-    for required in ["boundary", "integrate", "g2p", "stress_update", "volume_update"] {
-        if !has(required) {
-            return Err(format!(
-                "the schedule lacks `{required}`, a stage of every explicit step"
-            ));
+    for e in &entries {
+        match e.when {
+            When::Always if !has(e.name) => {
+                return Err(format!(
+                    "the schedule lacks `{}`, a stage of every explicit step",
+                    e.name
+                ))
+            }
+            When::Needed(needed, why) => {
+                let needed = needed(settings, needs);
+                if needed && !has(e.name) {
+                    return Err(format!("`{}` is required because {why}", e.name));
+                }
+                if !needed && has(e.name) {
+                    return Err(format!("`{}` is scheduled but only belongs when {why}", e.name));
+                }
+            }
+            _ => {}
         }
     }
-    let optional = [
-        (
-            "spatial_sort",
-            settings.sort_every > 0,
-            "solver.sort_every is above 0",
-        ),
-        ("gravity", settings.gravity.is_some(), "the scene has gravity"),
-        ("point_loads", needs.point_loads, "the scene has point loads"),
-        (
-            "mass_scaling",
-            settings.mass_scaling(),
-            "solver.mass_scaling is true",
-        ),
-        (
-            "peak_watch",
-            settings.damping == Damping::Kinetic,
-            "solver.damping is Kinetic",
-        ),
-        (
-            "volumetric_smoothing",
-            settings.volumetric_smoothing,
-            "solver.volumetric_smoothing is true",
-        ),
-    ];
-    for (name, needed, why) in optional {
-        if needed && !has(name) {
-            return Err(format!("`{name}` is required because {why}"));
-        }
-        if !needed && has(name) {
-            return Err(format!("`{name}` is scheduled but only belongs when {why}"));
-        }
-    }
-    for (a, b, why) in ORDER {
-        if let (Some(i), Some(j)) = (pos(a), pos(b)) {
-            if i > j {
-                return Err(format!("`{a}` must run before `{b}`: {why}"));
+    for e in &entries {
+        for (before, why) in e.after {
+            if let (Some(i), Some(j)) = (pos(before), pos(e.name)) {
+                if i > j {
+                    return Err(format!("`{before}` must run before `{}`: {why}", e.name));
+                }
             }
         }
     }
     Ok(())
+}
+
+/// The registry as a Markdown table (name, stage, when, what it does), as
+/// docs/writing-a-system.md lists it.
+pub fn systems_table() -> String {
+    let mut t = String::from("| system | stage | in the schedule | what it does |\n|---|---|---|---|\n");
+    for e in entries() {
+        let when = match e.when {
+            When::Always => "always".to_string(),
+            When::Schemes(s) => s
+                .iter()
+                .map(|s| format!("`{s:?}`"))
+                .collect::<Vec<_>>()
+                .join(", "),
+            When::Needed(_, why) => format!("when {why}"),
+        };
+        t += &format!("| `{}` | {:?} | {when} | {} |\n", e.name, e.stage, e.does);
+    }
+    t
 }
 
 /// The default schedule for a scene: its scheme, its shape functions, and only the optional
@@ -395,44 +563,20 @@ pub fn default_schedule<D: Dim>(settings: &Settings, shape: ShapeKind, needs: Ne
 
 /// Builds the systems named in `names` (checked by [`check_names`]) in that order.
 pub fn schedule_from_names<D: Dim>(names: &[String], settings: &Settings, shape: ShapeKind) -> Schedule<D> {
+    let entries = match shape {
+        ShapeKind::Linear => registry::<D, Linear>(),
+        ShapeKind::QuadraticBSpline => registry::<D, QuadraticBSpline>(),
+        ShapeKind::UniformGimp => registry::<D, UniformGimp>(),
+    };
     let mut s = Schedule::new();
     for n in names {
-        s.push_boxed(match shape {
-            ShapeKind::Linear => make::<D, Linear>(n, settings),
-            ShapeKind::QuadraticBSpline => make::<D, QuadraticBSpline>(n, settings),
-            ShapeKind::UniformGimp => make::<D, UniformGimp>(n, settings),
-        });
+        let e = entries
+            .iter()
+            .find(|e| e.name == n)
+            .unwrap_or_else(|| unreachable!("checked by check_names: {n}"));
+        s.push_boxed((e.build)(settings));
     }
     s
-}
-
-fn make<D: Dim, S: Shape>(name: &str, settings: &Settings) -> Box<dyn System<D>> {
-    match name {
-        "grid_reset" => Box::new(GridReset),
-        "spatial_sort" => Box::new(SpatialSort::new(settings.sort_every)),
-        "p2g" => Box::new(P2g::<D, S>::new(P2gPart::All)),
-        "p2g_momentum" => Box::new(P2g::<D, S>::new(P2gPart::MassMomentum)),
-        "p2g_force" => Box::new(P2g::<D, S>::new(P2gPart::InternalForce)),
-        "nodal_velocity" => Box::new(NodalVelocity),
-        "velocity_gradient" => Box::new(Kinematics::<D, S>::gradient_only()),
-        "move_points" => Box::new(Kinematics::<D, S>::motion_only()),
-        "kinematics" => Box::new(Kinematics::<D, S>::both()),
-        "gravity" => Box::new(Gravity::new(
-            settings.gravity.expect("checked: the scene has gravity"),
-        )),
-        "point_loads" => Box::new(PointLoads::<D, S>::default()),
-        "boundary" => Box::new(Boundary),
-        "integrate" => Box::new(Integrate),
-        "mass_scaling" => Box::new(MassScaling::<D, S>::default()),
-        "g2p" => Box::new(G2p::<D, S>::default()),
-        "peak_watch" => Box::new(PeakWatch),
-        "remap" => Box::new(Remap::<D, S>::default()),
-        "volumetric_smoothing" => Box::new(VolumetricSmoothing::<D, S>::default()),
-        "stress_update" => Box::new(StressUpdate),
-        "volume_update" => Box::new(VolumeUpdate),
-        "convergence" => Box::new(Convergence),
-        other => unreachable!("checked by check_names: {other}"),
-    }
 }
 
 #[cfg(test)]
@@ -481,6 +625,82 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn default_schedules_run_the_stages_of_each_scheme_in_order() {
+        let mut st = settings(Scheme::Musl, Damping::Kinetic, true);
+        st.volumetric_smoothing = true;
+        let needs = Needs { point_loads: true };
+        assert_eq!(
+            default_names(&st, needs),
+            [
+                "grid_reset",
+                "spatial_sort",
+                "p2g",
+                "gravity",
+                "point_loads",
+                "boundary",
+                "integrate",
+                "g2p",
+                "peak_watch",
+                "remap",
+                "kinematics",
+                "volumetric_smoothing",
+                "stress_update",
+                "volume_update",
+                "convergence"
+            ]
+        );
+        st.scheme = Scheme::Usf;
+        assert_eq!(
+            default_names(&st, needs),
+            [
+                "grid_reset",
+                "spatial_sort",
+                "p2g_momentum",
+                "nodal_velocity",
+                "velocity_gradient",
+                "volumetric_smoothing",
+                "stress_update",
+                "volume_update",
+                "p2g_force",
+                "gravity",
+                "point_loads",
+                "boundary",
+                "integrate",
+                "g2p",
+                "peak_watch",
+                "move_points",
+                "convergence"
+            ]
+        );
+        let plain = settings(Scheme::Usl, Damping::None, false);
+        assert_eq!(
+            default_names(&plain, Needs::default()),
+            [
+                "grid_reset",
+                "spatial_sort",
+                "p2g",
+                "boundary",
+                "integrate",
+                "g2p",
+                "kinematics",
+                "stress_update",
+                "volume_update",
+                "convergence"
+            ]
+        );
+    }
+
+    #[test]
+    fn the_docs_list_every_system_of_the_registry() {
+        let docs = include_str!("../../docs/writing-a-system.md");
+        assert!(
+            docs.contains(&systems_table()),
+            "docs/writing-a-system.md's table is not the registry's; paste this:\n{}",
+            systems_table()
+        );
     }
 
     #[test]

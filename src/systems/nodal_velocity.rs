@@ -20,7 +20,7 @@ pub fn velocity_from_momentum<D: Dim>(ctx: &Context<D>) {
     // Plain slices: the column guards cannot be shared with the pool.
     let (nm, np, fix) = (&*nm, &*np, &*fix);
     let mut nv = col_mut::<NodeVelocity<D::Vec>>(n);
-    let grid = &ctx.grid;
+    let (grid, drives) = (&ctx.grid, &ctx.state.drives[..]);
     for_each_box_node(
         grid,
         ctx.state.active_nodes,
@@ -31,7 +31,7 @@ pub fn velocity_from_momentum<D: Dim>(ctx: &Context<D>) {
             } else {
                 D::Vec::ZERO
             };
-            constrain(&mut v, fix[i], D::N);
+            constrain(&mut v, fix[i], D::N, drives);
             nv[k].0 = v;
         },
     );
