@@ -142,6 +142,8 @@ pub struct Settings {
     /// Leaving a node out drops its share of Σ_i ∇w_ip = 0, which acts as a spurious force
     /// V_p σ_p ∇w_ip: keep this tiny and tame light nodes with `virtual_mass_floor`.
     pub min_node_mass: f64,
+    /// Prescribed motions (displacement control), in scene order.
+    pub motions: Vec<MotionSpec>,
 }
 
 /// A kinetic-energy peak at which velocities were reset.
@@ -172,6 +174,100 @@ pub struct Drive {
     pub travel: f64,
     /// Increments finished, each ending at a static state.
     pub increments: u32,
+}
+
+/// A prescribed motion of grid nodes (`motions: [...]` in a scene), driven by
+/// `systems::prescribed_motion`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MotionSpec {
+    /// Name: `curve.csv` rows and `history.csv` columns carry it.
+    pub name: String,
+    /// Lower corner of the box of driven nodes (m).
+    pub min: Vec<f64>,
+    /// Upper corner of the box of driven nodes (m); nodes on its faces are inside.
+    pub max: Vec<f64>,
+    /// Velocity per axis (m/s); `None` leaves that axis free (a smooth footing moves
+    /// only vertically).
+    pub velocity: Vec<Option<f64>>,
+    /// Distance to travel along the velocity (m).
+    pub travel: f64,
+    /// Distance of one increment (m), each ending at a static state: a row of
+    /// `curve.csv`. Default: the whole travel in one.
+    #[serde(default)]
+    pub increment: Option<f64>,
+    /// Loaded area (m²; m per metre of thickness in 2D), for the mean pressure in
+    /// `curve.csv` and `limit_pressure` in summary.json.
+    #[serde(default)]
+    pub area: Option<f64>,
+}
+
+impl MotionSpec {
+    /// The velocity as a vector (m/s, x y z; free axes 0).
+    pub fn vector(&self) -> [f64; 3] {
+        std::array::from_fn(|a| self.velocity.get(a).copied().flatten().unwrap_or(0.0))
+    }
+
+    /// Speed along the motion (m/s).
+    pub fn speed(&self) -> f64 {
+        self.vector().iter().map(|v| v * v).sum::<f64>().sqrt()
+    }
+
+    /// The motion's state at the start of a run: moving.
+    pub fn drive(&self) -> Drive {
+        Drive {
+            name: self.name.clone(),
+            axes: self
+                .velocity
+                .iter()
+                .enumerate()
+                .filter(|(_, v)| v.is_some())
+                .fold(0, |mask, (a, _)| mask | 1 << a),
+            velocity: self.vector(),
+            ..Drive::default()
+        }
+    }
+
+    /// Checks the fields for a scene of `dimension`: `Err((field, rule))`.
+    pub fn check(&self, dimension: usize) -> Result<(), (&'static str, String)> {
+        for (field, v) in [("min", &self.min), ("max", &self.max)] {
+            if v.len() != dimension {
+                return Err((field, format!("needs {dimension} entries, one per axis")));
+            }
+        }
+        if self.min.iter().zip(&self.max).any(|(lo, hi)| lo > hi) {
+            return Err(("max", "every entry must be at least min's".into()));
+        }
+        if self.velocity.len() != dimension {
+            return Err((
+                "velocity",
+                format!("needs {dimension} entries (Some(m/s) or None)"),
+            ));
+        }
+        if self.velocity.iter().flatten().any(|v| !v.is_finite()) {
+            return Err(("velocity", "must be finite".into()));
+        }
+        if self.speed() <= 0.0 {
+            return Err((
+                "velocity",
+                "must move: at least one entry Some and not zero".into(),
+            ));
+        }
+        if !(self.travel.is_finite() && self.travel > 0.0) {
+            return Err(("travel", "must be above 0 (m)".into()));
+        }
+        if let Some(inc) = self.increment {
+            if !(inc.is_finite() && inc > 0.0 && inc <= self.travel) {
+                return Err(("increment", "must be above 0 and at most travel (m)".into()));
+            }
+        }
+        if let Some(a) = self.area {
+            if !(a.is_finite() && a > 0.0) {
+                return Err(("area", "must be above 0".into()));
+            }
+        }
+        Ok(())
+    }
 }
 
 /// One static state of a load–displacement curve (`curve.csv`).

@@ -176,6 +176,9 @@ fn summary_numbers(dir: &Path) -> serde_json::Value {
 /// Every output of run directory `a` equals that of `b`, snapshot series included.
 fn same_results(a: &Path, b: &Path) {
     let mut files = vec!["points.vtu".to_string(), "history.csv".to_string()];
+    if a.join("curve.csv").exists() {
+        files.push("curve.csv".into());
+    }
     if a.join("points.pvd").exists() {
         files.push("points.pvd".into());
         for e in std::fs::read_dir(a.join("snapshots")).unwrap().flatten() {
@@ -249,6 +252,13 @@ fn the_bar_resumed_by_the_binary_writes_the_same_files() {
 fn a_3d_block_resumed_by_the_binary_writes_the_same_files() {
     // It converges after 92 steps: the last checkpoint is at step 80.
     resume_from_last_checkpoint("block_10k.ron", 40, &[]);
+}
+
+/// The footing, checkpointed in its sixth increment (step 5 000 of 8 743): the motion's
+/// travel, its hold and the curve so far come back with the points.
+#[test]
+fn the_footing_resumed_in_the_middle_of_an_increment_writes_the_same_curve() {
+    resume_from_last_checkpoint("footing.ron", 5_000, &[]);
 }
 
 /// The paper's slope, checkpointed in the middle of its run (step 15 000 of 28 131).

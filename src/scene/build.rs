@@ -13,7 +13,7 @@ use crate::materials::Material;
 use crate::parallel::SlabCache;
 use crate::shape::{for_each_node, Linear, QuadraticBSpline, ShapeKind, UniformGimp};
 use crate::simulation::{AnySimulation, Simulation, TracedPoint};
-use crate::state::{Gravity, Settings, SolverState};
+use crate::state::{Gravity, MotionSpec, Settings, SolverState};
 use crate::systems::spatial_sort::sort_points;
 use crate::systems::{check_names, default_names, schedule_from_names, Needs};
 use hecs::{Entity, World};
@@ -420,6 +420,7 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
             ramp_time: g.ramp_time,
         }),
         min_node_mass: s.solver.node_mass_cutoff * full_node_mass,
+        motions: s.motions.clone(),
         virtual_mass_floor: s.solver.virtual_mass_floor * full_node_mass,
     };
     let needs = Needs {
@@ -451,6 +452,7 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
     };
     let state = SolverState {
         dt,
+        drives: s.motions.iter().map(MotionSpec::drive).collect(),
         ..SolverState::default()
     };
     let materials = table.into_iter().map(|(_, m)| m).collect();

@@ -14,7 +14,7 @@ pub use validate::{check, Checked, Derived, Estimate};
 use crate::error::SceneError;
 use crate::grid::Face;
 use crate::shape::ShapeKind;
-use crate::state::{Damping, ForceNorm, Scheme, StaticCheck};
+use crate::state::{Damping, ForceNorm, MotionSpec, Scheme, StaticCheck};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -44,6 +44,10 @@ pub struct Scene {
     /// Concentrated loads, each carried by a massless point that moves with the body.
     #[serde(default)]
     pub point_loads: Vec<PointLoadSpec>,
+    /// Prescribed motions of grid nodes (displacement control), each with its reaction and
+    /// a load–displacement curve of static states.
+    #[serde(default)]
+    pub motions: Vec<MotionSpec>,
     /// Points whose displacement is recorded each output step and reported at the end.
     #[serde(default)]
     pub traced: Vec<TracedSpec>,

@@ -2,6 +2,7 @@
 //! from it.
 
 use super::{LoadedScene, MaterialSpec, Region, TimeStep};
+use crate::components::NodeFixity;
 use crate::error::SceneError;
 use crate::materials::{LinearElastic, Material, MaterialModel, MohrCoulomb};
 use crate::shape::ShapeKind;
@@ -592,6 +593,20 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
         finite(&format!("point_loads[{i}].position"), &l.position, "m")?;
         finite(&format!("point_loads[{i}].force"), &l.force, "N")?;
     }
+    if s.motions.len() > NodeFixity::MAX_DRIVES {
+        return bad(
+            "motions",
+            format!(
+                "at most {} motions, found {}",
+                NodeFixity::MAX_DRIVES,
+                s.motions.len()
+            ),
+        );
+    }
+    for (i, m) in s.motions.iter().enumerate() {
+        m.check(s.dimension as usize)
+            .map_err(|(field, rule)| loaded.invalid(&format!("motions[{i}].{field}"), rule))?;
+    }
     for (i, t) in s.traced.iter().enumerate() {
         len(&format!("traced[{i}].position"), t.position.len())?;
         finite(&format!("traced[{i}].position"), &t.position, "m")?;
@@ -603,15 +618,15 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
         .as_ref()
         .is_some_and(|g| g.acceleration.iter().any(|&a| a != 0.0));
     let loads = s.point_loads.iter().any(|l| l.force.iter().any(|&f| f != 0.0));
-    if !gravity && !loads {
+    if !gravity && !loads && s.motions.is_empty() {
         return bad(
             if s.gravity.is_some() {
                 "gravity.acceleration"
             } else {
                 "gravity"
             },
-            "the scene applies no load (no gravity and no non-zero point load): its static \
-             state is the state it starts in; add gravity or point_loads"
+            "the scene applies no load (no gravity, no non-zero point load, no motion): its \
+             static state is the state it starts in; add gravity, point_loads or motions"
                 .into(),
         );
     }

@@ -26,6 +26,7 @@ pub mod nodal_velocity;
 pub mod p2g;
 pub mod peak_watch;
 pub mod point_loads;
+pub mod prescribed_motion;
 pub mod remap;
 pub mod spatial_sort;
 pub mod stress_update;
@@ -44,6 +45,7 @@ pub use nodal_velocity::NodalVelocity;
 pub use p2g::{P2g, P2gPart};
 pub use peak_watch::PeakWatch;
 pub use point_loads::PointLoads;
+pub use prescribed_motion::PrescribedMotion;
 pub use remap::Remap;
 pub use spatial_sort::SpatialSort;
 pub use stress_update::StressUpdate;
@@ -411,6 +413,14 @@ pub fn registry<D: Dim, S: Shape>() -> Vec<Entry<D>> {
             "K_F, W_ext, K_E, stopping rule",
             |_| Box::new(Convergence),
         ),
+        e(
+            "prescribed_motion",
+            St::Control,
+            Needed(|s, _| !s.motions.is_empty(), "the scene has motions"),
+            &[("convergence", "it acts on the step's static state")],
+            "displacement control: travel, hold, curve of static states",
+            |s| Box::new(PrescribedMotion::new(s.motions.clone())),
+        ),
     ]
 }
 
@@ -603,6 +613,7 @@ mod tests {
             inertia_factors: Vec::new(),
             flip: 1.0,
             min_node_mass: 0.0,
+            motions: Vec::new(),
             virtual_mass_floor: 0.0,
         }
     }

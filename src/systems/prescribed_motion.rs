@@ -1,0 +1,117 @@
+//! Prescribed motion of grid nodes (displacement control): a rigid footing pushed into the
+//! ground, a wall moved, with the reaction on it and a load–displacement curve of static
+//! states.
+//!
+//! The nodes on or inside a box are held at the motion's velocity on its given axes
+//! (`boundary` does the holding and sums the reaction). The motion travels its distance in
+//! increments: it moves one increment, then holds still while kinetic damping relaxes the
+//! body to a static state (the run's own stopping rule), records that state as a row of the
+//! curve, and moves on. While it moves, no state counts as static.
+//!
+//! Kinetic damping and a motion: a reset zeroes the points' velocities, not the motion's.
+//! The driven nodes take their velocity again at the next step; a reset step moves no
+//! point, and the motion travels nothing in it.
+
+use crate::columns::{col_mut, nodes};
+use crate::components::NodeFixity;
+use crate::context::Context;
+use crate::dim::Dim;
+use crate::error::StepError;
+use crate::schedule::System;
+use crate::state::{CurvePoint, MotionSpec, StopReason};
+
+/// Drives the scene's motions: marks their nodes before the first step, and after each
+/// step's convergence check advances their travel, holds them at the end of an increment
+/// and, at the static state that follows, records the curve and starts the next increment.
+#[derive(Debug)]
+pub struct PrescribedMotion {
+    motions: Vec<MotionSpec>,
+}
+
+impl PrescribedMotion {
+    /// The system for these motions (in scene order: [`crate::state::SolverState::drives`]).
+    pub fn new(motions: Vec<MotionSpec>) -> Self {
+        PrescribedMotion { motions }
+    }
+}
+
+impl<D: Dim> System<D> for PrescribedMotion {
+    fn name(&self) -> &str {
+        "prescribed_motion"
+    }
+
+    fn prepare(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
+        let grid = &ctx.grid;
+        let mut fix = col_mut::<NodeFixity>(nodes(&ctx.world));
+        // A node on the box's face, to round-off of the grid's coordinates.
+        let slack = 1e-9 * grid.cell_size;
+        for (k, m) in self.motions.iter().enumerate() {
+            for (id, f) in fix.iter_mut().enumerate() {
+                let x = D::vec_to3(grid.node_position(grid.node_ijk(id)));
+                if (0..D::N).all(|a| x[a] >= m.min[a] - slack && x[a] <= m.max[a] + slack) {
+                    // Face conditions on other axes stay (a footing on a symmetry
+                    // plane keeps its roller).
+                    *f = NodeFixity::driven(f.0 | ctx.state.drives[k].axes, k);
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
+        let s = &mut ctx.state;
+        let dt = s.motion_dt().unwrap_or(0.0);
+        for (m, d) in self.motions.iter().zip(&mut s.drives) {
+            if d.velocity == [0.0; 3] {
+                continue;
+            }
+            let speed = d.velocity.iter().map(|v| v * v).sum::<f64>().sqrt();
+            d.travel += speed * dt;
+            let left = target(m, d.increments) - d.travel;
+            let full = m.speed() * s.dt;
+            d.velocity = if left <= 1e-12 * m.travel {
+                [0.0; 3]
+            } else if left < full {
+                // The last step of an increment covers what is left, not a whole step.
+                m.vector().map(|v| v * left / full)
+            } else {
+                m.vector()
+            };
+        }
+        if s.stop != Some(StopReason::Converged) {
+            return Ok(());
+        }
+        // Every motion holds (a moving one blocks convergence): a static state.
+        let mut more = false;
+        for (m, d) in self.motions.iter().zip(&mut s.drives) {
+            let v = m.vector().map(|c| c / m.speed());
+            let along: f64 = (0..3).map(|a| d.reaction[a] * v[a]).sum();
+            s.curve.push(CurvePoint {
+                name: m.name.clone(),
+                step: s.step,
+                time: s.time,
+                displacement: d.travel,
+                force: d.reaction,
+                pressure: m.area.map(|a| along / a),
+            });
+            d.increments += 1;
+            if d.travel < m.travel * (1.0 - 1e-9) {
+                d.velocity = m.vector();
+                more = true;
+            }
+        }
+        if more {
+            s.stop = None;
+            s.static_window_start = None;
+        }
+        Ok(())
+    }
+}
+
+/// Travel at the end of increment `k` (0-based), m.
+fn target(m: &MotionSpec, k: u32) -> f64 {
+    match m.increment {
+        Some(inc) => (inc * (k + 1) as f64).min(m.travel),
+        None => m.travel,
+    }
+}

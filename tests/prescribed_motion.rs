@@ -1,0 +1,108 @@
+//! Prescribed motion of grid nodes (displacement control): the reaction it reports and the
+//! limit pressure of a footing.
+
+mod common;
+
+use common::{rel, run};
+use kdmpm::scene::{build, LoadedScene};
+use std::path::Path;
+
+/// An elastic column between rollers, its top pushed down by δ = 1 mm in one increment:
+/// the static state is uniaxial strain ε = δ/H, σ_yy = −M δ/H with
+/// M = E(1 − ν)/((1 + ν)(1 − 2ν)), and the top carries the force σ_yy × width.
+const COLUMN: &str = r#"Scene(
+    dimension: 2,
+    grid: (origin: [0.0, 0.0], cell_size: 0.25, cells: [4, 18]),
+    shape: Linear,
+    materials: { "soil": LinearElastic(density: 2000.0, youngs_modulus: 1.0e7, poisson_ratio: 0.3) },
+    bodies: [(material: "soil", region: Box(min: [0.0, 0.0], max: [1.0, 4.0]), points_per_cell: [2, 2])],
+    boundaries: [(face: XMin, condition: Roller), (face: XMax, condition: Roller), (face: YMin, condition: Fixed)],
+    motions: [(name: "plate", min: [0.0, 4.0], max: [1.0, 4.5], velocity: [None, Some(-0.001)], travel: 0.001, area: 1.0)],
+    traced: [(name: "mid", position: [0.375, 1.875])],
+    solver: (time_step: Courant(0.5), tolerance: 1e-4, max_time: 60.0),
+)"#;
+
+#[test]
+fn a_column_pushed_down_by_its_top_carries_m_delta_over_h() {
+    let loaded = LoadedScene::from_text(Path::new("column.ron"), COLUMN, &[]).expect("scene loads");
+    let (mut sim, _) = build(&loaded).expect("scene builds");
+    let summary = kdmpm::with_simulation!(&mut sim, s => {
+        let result = s.run(|_| {});
+        kdmpm::output::Summary::collect("column", s, 0.0, result.err().map(|e| e.to_string()))
+    });
+    assert!(summary.converged, "{:?}", summary.error);
+    let (e, nu, delta, h) = (1.0e7, 0.3, 0.001, 4.0);
+    let m = e * (1.0 - nu) / ((1.0 + nu) * (1.0 - 2.0 * nu));
+    let sigma = -m * delta / h;
+    let row = summary.curve.last().expect("a static state");
+    assert_eq!(
+        row.displacement, delta,
+        "the increment travels exactly its distance"
+    );
+    // The force on the body, downward: σ_yy over the 1 m width; its pressure along the
+    // motion is positive.
+    assert!(
+        rel(row.force[1], sigma).abs() < 0.01,
+        "force {:?} against {sigma}",
+        row.force
+    );
+    assert!(
+        row.force[0].abs() < 1e-6 * sigma.abs(),
+        "a roller-side plate pushes no x force"
+    );
+    assert!(rel(row.pressure.unwrap(), -sigma).abs() < 0.01);
+    let mid = &summary.traced[0];
+    assert!(
+        rel(mid.stress.yy, sigma).abs() < 0.01,
+        "σ_yy {} against {sigma}",
+        mid.stress.yy
+    );
+    // Uniaxial strain: a point at height y moves by δ y/H.
+    let expected = -delta * mid.initial_position[1] / h;
+    assert!(
+        rel(mid.displacement[1], expected).abs() < 0.01,
+        "{:?} against {expected}",
+        mid.displacement
+    );
+}
+
+#[test]
+fn a_motion_moving_sideways_off_its_axes_is_refused() {
+    let bad = COLUMN.replace("velocity: [None, Some(-0.001)]", "velocity: [None, None]");
+    let loaded = LoadedScene::from_text(Path::new("column.ron"), &bad, &[]).expect("scene parses");
+    let e = build(&loaded).err().expect("refused").to_string();
+    assert!(
+        e.contains("motions[0].velocity") && e.contains("must move"),
+        "{e}"
+    );
+    let bad = COLUMN.replace("travel: 0.001", "travel: 0.001, increment: 0.002");
+    let loaded = LoadedScene::from_text(Path::new("column.ron"), &bad, &[]).expect("scene parses");
+    let e = build(&loaded).err().expect("refused").to_string();
+    assert!(e.contains("motions[0].increment"), "{e}");
+}
+
+/// Prandtl's limit pressure of a smooth strip footing on weightless Tresca clay,
+/// (2 + π) c (Prandtl 1920; Hill 1950), c = 10 kPa, against `scenes/footing.ron` at two
+/// cell sizes. The driven nodes' loaded width is the footing's plus half the edge node's
+/// support, so the pressure over the footing's own width lies above Prandtl's by about
+/// h/B and closes in on it as the grid is refined.
+#[test]
+fn a_smooth_strip_footing_on_tresca_clay_reaches_prandtls_limit_pressure() {
+    let prandtl = (2.0 + std::f64::consts::PI) * 10.0e3;
+    let coarse = run("footing.ron", &[]);
+    let fine = run("footing.ron", &["grid.cell_size=0.125", "grid.cells=[48, 36]"]);
+    let mut errors = Vec::new();
+    for s in [&coarse, &fine] {
+        assert!(s.converged, "{:?}", s.error);
+        let limit = s.limit_pressure.expect("the footing has an area");
+        errors.push(rel(limit, prandtl));
+        assert!(rel(limit, prandtl).abs() < 0.10, "{limit} Pa against {prandtl}");
+        // A plateau, not a curve still climbing.
+        assert!(s.last_increment_rise.unwrap().abs() < 0.02);
+        assert_eq!(s.curve.len(), 10, "ten increments, ten static states");
+    }
+    assert!(
+        errors[1].abs() < errors[0].abs(),
+        "refining closes in: {errors:?}"
+    );
+}
