@@ -19,6 +19,7 @@ pub mod components;
 pub mod context;
 pub mod dim;
 pub mod error;
+pub mod fos;
 pub mod grid;
 pub mod lanes;
 pub mod materials;

@@ -86,6 +86,26 @@ enum Command {
         #[arg(long, short)]
         quiet: bool,
     },
+    /// Factor of safety by strength reduction: solve the scene with c and tan φ divided by
+    /// trial factors, bisecting between the largest that stands and the smallest that fails
+    /// (the scene's `strength_reduction` field); writes summary.json, fos.csv, fos.svg and
+    /// each trial under trials/.
+    Fos {
+        /// Scene file (RON) with a `strength_reduction` field.
+        scene: PathBuf,
+        /// Output directory (default: out/fos-<scene file stem>).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Override a scene field (repeatable).
+        #[arg(long = "set", value_name = "PATH=VALUE")]
+        overrides: Vec<String>,
+        /// Worker threads (default: all cores).
+        #[arg(long)]
+        threads: Option<std::num::NonZeroUsize>,
+        /// Print nothing but errors.
+        #[arg(long, short)]
+        quiet: bool,
+    },
     /// Draw (again) the plots of a run from its output directory, finished or running:
     /// kinetic energy, K_F and K_E, traced displacements, displacement field (SVG).
     Plot {
@@ -131,6 +151,16 @@ fn main() -> ExitCode {
             threads,
             quiet,
         } => run_study(&study, out, threads, quiet),
+        Command::Fos {
+            scene,
+            out,
+            overrides,
+            threads,
+            quiet,
+        } => match start_threads(threads) {
+            Ok(()) => run_fos(&scene, out, &overrides, quiet),
+            Err(code) => code,
+        },
         Command::Resume { dir, stepping } => match start_threads(stepping.threads) {
             Ok(()) => resume(&dir, stepping.profile, stepping.quiet),
             Err(code) => code,
@@ -439,6 +469,55 @@ fn drive<D: Dim>(
         return ExitCode::from(INTERRUPTED_EXIT);
     }
     ExitCode::SUCCESS
+}
+
+/// `kdmpm fos`: the strength-reduction analysis of a scene.
+fn run_fos(path: &Path, out: Option<PathBuf>, overrides: &[String], quiet: bool) -> ExitCode {
+    let loaded = match LoadedScene::from_file(path, overrides) {
+        Ok(l) => l,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(BAD_INPUT);
+        }
+    };
+    let stem = path
+        .file_stem()
+        .map_or("scene".into(), |s| s.to_string_lossy().into_owned());
+    let out = out.unwrap_or_else(|| Path::new("out").join(format!("fos-{stem}")));
+    let result = kdmpm::fos::strength_reduction(&loaded, &out, |t| {
+        if !quiet {
+            eprintln!(
+                "F = {:.4}: {} ({}), largest displacement {:.3e} m, {} steps, {:.1} s",
+                t.factor,
+                if t.failed { "fails" } else { "stands" },
+                t.outcome,
+                t.max_displacement,
+                t.steps,
+                t.wall_seconds
+            );
+        }
+    });
+    match result {
+        Ok(r) => {
+            println!(
+                "factor of safety {:.3} (stands at {:.4}, fails at {:.4}), {} trials, {:.1} s → {}",
+                r.factor_of_safety,
+                r.bracket[0],
+                r.bracket[1],
+                r.trials.len(),
+                r.wall_seconds,
+                out.display()
+            );
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(match e {
+                kdmpm::fos::FosError::Scene(_) | kdmpm::fos::FosError::NotAnAnalysis(_) => BAD_INPUT,
+                _ => RUN_FAILED,
+            })
+        }
+    }
 }
 
 fn print_profile(summary: &Summary) {

@@ -61,6 +61,9 @@ pub enum StopReason {
     MaxSteps,
     /// The time limit was reached first.
     MaxTime,
+    /// A point moved farther than an analysis allows (a strength-reduction trial that
+    /// fails).
+    DisplacementLimit,
 }
 
 /// Gravity acting on all points (m/s²), applied at once or ramped linearly.

@@ -115,6 +115,8 @@ pub enum Outcome {
     MaxSteps,
     /// The simulated-time limit came first.
     MaxTime,
+    /// A point moved farther than the analysis allows (`strength_reduction`).
+    DisplacementLimit,
     /// Stopped by Ctrl-C; `kdmpm resume` continues it from its checkpoint.
     Interrupted,
     /// Stopped by an error (see `error`).
@@ -150,6 +152,7 @@ impl Summary {
                 (None, Some(StopReason::Converged)) => Outcome::Converged,
                 (None, Some(StopReason::MaxSteps)) => Outcome::MaxSteps,
                 (None, Some(StopReason::MaxTime)) => Outcome::MaxTime,
+                (None, Some(StopReason::DisplacementLimit)) => Outcome::DisplacementLimit,
                 (None, Some(StopReason::Interrupted)) => Outcome::Interrupted,
             },
             converged: s.stop == Some(StopReason::Converged),

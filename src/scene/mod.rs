@@ -48,6 +48,9 @@ pub struct Scene {
     /// a load–displacement curve of static states.
     #[serde(default)]
     pub motions: Vec<MotionSpec>,
+    /// Factor of safety by strength reduction (`kdmpm fos`).
+    #[serde(default)]
+    pub strength_reduction: Option<StrengthReductionSpec>,
     /// Points whose displacement is recorded each output step and reported at the end.
     #[serde(default)]
     pub traced: Vec<TracedSpec>,
@@ -135,6 +138,31 @@ pub enum Region {
         #[serde(default)]
         z: Option<Vec<f64>>,
     },
+}
+
+/// How `kdmpm fos` brackets the factor of safety (see [`crate::fos`]).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StrengthReductionSpec {
+    /// Two factors: the slope must stand at the first and fail at the second.
+    pub bracket: Vec<f64>,
+    /// Bisect until the bracket is this narrow (default 0.02).
+    #[serde(default = "default_fos_tolerance")]
+    pub tolerance: f64,
+    /// A trial fails when a point moves farther than this (m), or when it finds no static
+    /// state by `max_time` or `max_steps`.
+    pub failure_displacement: f64,
+    /// Steps between looks at the largest displacement (default 50).
+    #[serde(default = "default_fos_check_every")]
+    pub check_every: u64,
+}
+
+fn default_fos_tolerance() -> f64 {
+    0.02
+}
+
+fn default_fos_check_every() -> u64 {
+    50
 }
 
 /// Condition on a grid face.

@@ -607,6 +607,36 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
         m.check(s.dimension as usize)
             .map_err(|(field, rule)| loaded.invalid(&format!("motions[{i}].{field}"), rule))?;
     }
+    if let Some(r) = &s.strength_reduction {
+        let ok = matches!(r.bracket[..], [lo, hi] if lo.is_finite() && hi.is_finite() && 0.0 < lo && lo < hi);
+        if !ok {
+            return bad(
+                "strength_reduction.bracket",
+                format!("needs two factors 0 < low < high, found {:?}", r.bracket),
+            );
+        }
+        if !(r.tolerance.is_finite() && r.tolerance > 0.0) {
+            return bad("strength_reduction.tolerance", "must be above 0".into());
+        }
+        if !(r.failure_displacement.is_finite() && r.failure_displacement > 0.0) {
+            return bad(
+                "strength_reduction.failure_displacement",
+                "must be above 0 (m)".into(),
+            );
+        }
+        if r.check_every == 0 {
+            return bad(
+                "strength_reduction.check_every",
+                "must be at least 1 (steps)".into(),
+            );
+        }
+        if !s.output.displacements {
+            return bad(
+                "output.displacements",
+                "strength reduction judges trials by displacement: keep them (true)".into(),
+            );
+        }
+    }
     for (i, t) in s.traced.iter().enumerate() {
         len(&format!("traced[{i}].position"), t.position.len())?;
         finite(&format!("traced[{i}].position"), &t.position, "m")?;

@@ -1,0 +1,348 @@
+//! Factor of safety by strength reduction (`kdmpm fos SCENE`).
+//!
+//! Every Mohr-Coulomb material's strength is divided by a trial factor F: c/F,
+//! φ_F = atan(tan φ / F), ψ_F = atan(tan ψ / F) and an explicit tension cut-off /F. The
+//! scene is solved to its static state for each F. A trial *fails* when no static state is
+//! found: a point moves farther than `failure_displacement`, the run reaches its time or step
+//! limit, or it stops on an error (a failing slope running off its grid). The factor of
+//! safety is bracketed between the largest F that stands and the smallest that fails, by
+//! bisection to `tolerance` (Griffiths & Lane 1999, Géotechnique 49(3), who take a finite
+//! element run's failure to converge as the criterion).
+//!
+//! Each trial is a normal run into `trials/F<factor>/` (history, points, plots); the
+//! analysis writes `fos.csv` (the F–displacement curve), `fos.svg` and `summary.json` with
+//! `factor_of_safety` and its `bracket`. The failure mechanism is the displacement field of
+//! the trial at the smallest failing F (`mechanism`).
+
+use crate::dim::Dim;
+use crate::error::SceneError;
+use crate::measure::max_displacements;
+use crate::output::dir::write_atomic;
+use crate::output::{OutputDir, Recorder};
+use crate::scene::{build, LoadedScene, MaterialSpec, StrengthReductionSpec};
+use crate::simulation::Simulation;
+use crate::state::StopReason;
+use crate::with_simulation;
+use serde::Serialize;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// One strength-reduction trial.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Trial {
+    /// The strength reduction factor F.
+    pub factor: f64,
+    /// True when the trial found no static state.
+    pub failed: bool,
+    /// How the run ended (summary.json's `outcome`).
+    pub outcome: String,
+    /// The largest point displacement at the end (m).
+    pub max_displacement: f64,
+    /// Steps taken.
+    pub steps: u64,
+    /// Wall-clock seconds of the trial.
+    pub wall_seconds: f64,
+    /// The trial's output directory, relative to the analysis's.
+    pub dir: String,
+}
+
+/// What the analysis found.
+#[derive(Clone, Debug, Serialize)]
+pub struct FosReport {
+    /// The scene.
+    pub scene: String,
+    /// The middle of the final bracket.
+    pub factor_of_safety: f64,
+    /// The largest factor that stands and the smallest that fails.
+    pub bracket: [f64; 2],
+    /// The width the bisection stopped at.
+    pub tolerance: f64,
+    /// A trial fails when a point moves farther than this (m).
+    pub failure_displacement: f64,
+    /// The trial directory whose displacement field shows the failure mechanism.
+    pub mechanism: String,
+    /// Every trial, in the order run.
+    pub trials: Vec<Trial>,
+    /// Wall-clock seconds of the whole analysis.
+    pub wall_seconds: f64,
+}
+
+/// Why the analysis could not give a factor of safety.
+#[derive(Debug, thiserror::Error)]
+pub enum FosError {
+    /// The scene is unusable (exit 2).
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+    /// The scene has no `strength_reduction` or no Mohr-Coulomb material (exit 2).
+    #[error("{0}")]
+    NotAnAnalysis(String),
+    /// The bracket does not hold the factor of safety: the trials are in their folders.
+    #[error("{0}")]
+    NotBracketed(String),
+    /// The output could not be written.
+    #[error("cannot write into {0}: {1}")]
+    Output(PathBuf, std::io::Error),
+}
+
+/// The scene with every Mohr-Coulomb strength divided by `factor`.
+pub fn reduced(loaded: &LoadedScene, factor: f64) -> LoadedScene {
+    let mut l = loaded.clone();
+    let reduce = |deg: f64| (deg.to_radians().tan() / factor).atan().to_degrees();
+    for m in l.scene.materials.values_mut() {
+        if let MaterialSpec::MohrCoulomb {
+            cohesion,
+            friction_angle,
+            dilatancy_angle,
+            tension_cutoff,
+            ..
+        } = m
+        {
+            *cohesion /= factor;
+            *friction_angle = reduce(*friction_angle);
+            *dilatancy_angle = reduce(*dilatancy_angle);
+            if let Some(t) = tension_cutoff {
+                *t /= factor;
+            }
+        }
+    }
+    l
+}
+
+/// Runs the analysis of `loaded` into `out`; `report` sees each trial as it ends.
+pub fn strength_reduction(
+    loaded: &LoadedScene,
+    out: &Path,
+    mut report: impl FnMut(&Trial),
+) -> Result<FosReport, FosError> {
+    let spec = loaded.scene.strength_reduction.clone().ok_or_else(|| {
+        FosError::NotAnAnalysis(format!(
+            "{}: the scene has no `strength_reduction` field (bracket, tolerance, \
+             failure_displacement): see docs/scene-format.md",
+            loaded.path.display()
+        ))
+    })?;
+    if !loaded
+        .scene
+        .materials
+        .values()
+        .any(|m| matches!(m, MaterialSpec::MohrCoulomb { .. }))
+    {
+        return Err(FosError::NotAnAnalysis(format!(
+            "{}: no Mohr-Coulomb material: there is no strength to reduce",
+            loaded.path.display()
+        )));
+    }
+    let start = Instant::now();
+    let io = |e: std::io::Error| FosError::Output(out.to_path_buf(), e);
+    std::fs::create_dir_all(out).map_err(io)?;
+    let mut trials: Vec<Trial> = Vec::new();
+    let mut trial = |f: f64| -> Result<Trial, FosError> {
+        let t = run_trial(loaded, &spec, f, out)?;
+        report(&t);
+        trials.push(t.clone());
+        Ok(t)
+    };
+    let [mut lo, mut hi] = [spec.bracket[0], spec.bracket[1]];
+    if trial(lo)?.failed {
+        return Err(FosError::NotBracketed(format!(
+            "the slope fails at F = {lo}, the bracket's low end: its factor of safety is below \
+             {lo}; lower strength_reduction.bracket[0]"
+        )));
+    }
+    if !trial(hi)?.failed {
+        return Err(FosError::NotBracketed(format!(
+            "the slope stands at F = {hi}, the bracket's high end: its factor of safety is above \
+             {hi}; raise strength_reduction.bracket[1]"
+        )));
+    }
+    while hi - lo > spec.tolerance {
+        let mid = 0.5 * (lo + hi);
+        if trial(mid)?.failed {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    let mechanism = trial_dir(hi);
+    let fos = FosReport {
+        scene: loaded.path.display().to_string(),
+        factor_of_safety: 0.5 * (lo + hi),
+        bracket: [lo, hi],
+        tolerance: spec.tolerance,
+        failure_displacement: spec.failure_displacement,
+        mechanism,
+        trials,
+        wall_seconds: start.elapsed().as_secs_f64(),
+    };
+    write_report(&fos, out).map_err(io)?;
+    Ok(fos)
+}
+
+/// The folder of the trial at `factor`, relative to the analysis's.
+fn trial_dir(factor: f64) -> String {
+    format!("trials/F{factor:.4}")
+}
+
+/// Runs the scene at `factor` into its trial folder, stopping early once a point moved
+/// farther than the spec allows.
+fn run_trial(
+    loaded: &LoadedScene,
+    spec: &StrengthReductionSpec,
+    factor: f64,
+    out: &Path,
+) -> Result<Trial, FosError> {
+    let scene = reduced(loaded, factor);
+    let (mut sim, _) = build(&scene)?;
+    let rel = trial_dir(factor);
+    let path = out.join(&rel);
+    let dir = OutputDir::claim(&path)
+        .map_err(|e| FosError::Output(path.clone(), std::io::Error::other(e.to_string())))?;
+    let start = Instant::now();
+    with_simulation!(&mut sim, s => {
+        let (steps, outcome, max_u) = trial_run(s, &scene, spec, &dir, start)
+            .map_err(|e| FosError::Output(path.clone(), e))?;
+        Ok(Trial {
+            factor,
+            failed: outcome != "converged" || max_u > spec.failure_displacement,
+            outcome,
+            max_displacement: max_u,
+            steps,
+            wall_seconds: start.elapsed().as_secs_f64(),
+            dir: rel,
+        })
+    })
+}
+
+/// Steps one trial with its outputs; returns its steps, outcome and largest displacement.
+fn trial_run<D: Dim>(
+    sim: &mut Simulation<D>,
+    scene: &LoadedScene,
+    spec: &StrengthReductionSpec,
+    dir: &OutputDir,
+    start: Instant,
+) -> std::io::Result<(u64, String, f64)> {
+    let output = &scene.scene.output;
+    let recorder = Recorder::attach(sim, dir, output.history_every, output.snapshots, None)?;
+    let (every, limit) = (spec.check_every, spec.failure_displacement);
+    let result = sim.run_with(|s| {
+        let st = &s.ctx.state;
+        if st.stop.is_none() && st.step.is_multiple_of(every) {
+            let (u, _) = max_displacements(s).unwrap_or_default();
+            if u > limit {
+                s.ctx.state.stop = Some(StopReason::DisplacementLimit);
+            }
+        }
+        Ok(())
+    });
+    let error = result.err().map(|e| e.to_string());
+    let wall = start.elapsed().as_secs_f64();
+    let (summary, _) = recorder.finish(sim, dir, &scene.path.display().to_string(), wall, error)?;
+    let outcome = serde_json::to_value(summary.outcome)
+        .ok()
+        .and_then(|v| v.as_str().map(str::to_string))
+        .unwrap_or_default();
+    Ok((summary.steps, outcome, summary.max_displacement.unwrap_or(0.0)))
+}
+
+/// `fos.csv`, `fos.svg` and `summary.json` of the analysis.
+fn write_report(fos: &FosReport, out: &Path) -> std::io::Result<()> {
+    let mut rows: Vec<&Trial> = fos.trials.iter().collect();
+    rows.sort_by(|a, b| a.factor.total_cmp(&b.factor));
+    write_atomic(&out.join("fos.csv"), |w| {
+        writeln!(w, "factor,failed,outcome,max_displacement,steps,wall_seconds,dir")?;
+        for t in &rows {
+            writeln!(
+                w,
+                "{},{},{},{:.9e},{},{:.3},{}",
+                t.factor, t.failed, t.outcome, t.max_displacement, t.steps, t.wall_seconds, t.dir
+            )?;
+        }
+        Ok(())
+    })?;
+    write_atomic(&out.join("fos.svg"), |w| w.write_all(plot(fos, &rows).as_bytes()))?;
+    write_atomic(&out.join("summary.json"), |w| {
+        serde_json::to_writer_pretty(&mut *w, fos).map_err(std::io::Error::other)?;
+        w.write_all(b"\n")
+    })
+}
+
+/// The F–displacement curve: each trial's largest displacement against its factor,
+/// standing trials filled, failing ones open, the bracket shaded.
+fn plot(fos: &FosReport, rows: &[&Trial]) -> String {
+    use plotters::prelude::*;
+    let mut s = String::new();
+    {
+        let root = SVGBackend::with_string(&mut s, (960, 600)).into_drawing_area();
+        let _ = root.fill(&WHITE);
+        let draw = || -> Result<(), Box<dyn std::error::Error>> {
+            let (f0, f1) = rows.iter().fold((f64::INFINITY, 0.0f64), |(a, b), t| {
+                (a.min(t.factor), b.max(t.factor))
+            });
+            let u_hi = rows
+                .iter()
+                .map(|t| t.max_displacement)
+                .fold(fos.failure_displacement, f64::max);
+            let u_lo = rows
+                .iter()
+                .map(|t| t.max_displacement)
+                .filter(|u| *u > 0.0)
+                .fold(u_hi, f64::min);
+            let (y0, y1) = (u_lo / 2.0, u_hi * 2.0);
+            let pad = 0.05 * (f1 - f0).max(1e-3);
+            let mut c = ChartBuilder::on(&root)
+                .caption(
+                    format!(
+                        "Strength reduction: F = {:.3} (bracket {:.4}–{:.4})",
+                        fos.factor_of_safety, fos.bracket[0], fos.bracket[1]
+                    ),
+                    ("sans-serif", 22),
+                )
+                .margin(20)
+                .x_label_area_size(50)
+                .y_label_area_size(90)
+                .build_cartesian_2d((f0 - pad)..(f1 + pad), (y0..y1).log_scale())?;
+            c.configure_mesh()
+                .x_desc("strength reduction factor F")
+                .y_desc("largest displacement (m)")
+                .y_label_formatter(&|v| format!("{v:.0e}"))
+                .label_style(("sans-serif", 15))
+                .draw()?;
+            c.draw_series(std::iter::once(Rectangle::new(
+                [(fos.bracket[0], y0), (fos.bracket[1], y1)],
+                RED.mix(0.15).filled(),
+            )))?;
+            let limit = fos.failure_displacement;
+            c.draw_series(LineSeries::new(
+                vec![(f0 - pad, limit), (f1 + pad, limit)],
+                RED.stroke_width(2),
+            ))?
+            .label(format!("failure displacement {limit} m"))
+            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED.stroke_width(2)));
+            let pts: Vec<(f64, f64)> = rows
+                .iter()
+                .map(|t| (t.factor, t.max_displacement.max(y0)))
+                .collect();
+            c.draw_series(LineSeries::new(pts, BLUE.stroke_width(2)))?;
+            c.draw_series(rows.iter().map(|t| {
+                let p = (t.factor, t.max_displacement.max(y0));
+                if t.failed {
+                    Circle::new(p, 6, BLUE.stroke_width(2))
+                } else {
+                    Circle::new(p, 6, BLUE.filled())
+                }
+            }))?
+            .label("trial (filled: stands, open: fails)")
+            .legend(|(x, y)| Circle::new((x + 10, y), 5, BLUE.filled()));
+            c.configure_series_labels()
+                .position(SeriesLabelPosition::UpperLeft)
+                .border_style(BLACK)
+                .background_style(WHITE.mix(0.9))
+                .label_font(("sans-serif", 14))
+                .draw()?;
+            Ok(())
+        };
+        let _ = draw();
+    }
+    s
+}
