@@ -18,7 +18,7 @@ use crate::grid::NodeBox;
 use crate::parallel::SlabCache;
 use crate::point_components;
 use crate::simulation::Simulation;
-use crate::state::{CurvePoint, Drive, Peak, SolverState, StopReason};
+use crate::state::{CurvePoint, Drive, Peak, SolverState, StageResult, StopReason};
 use hecs::Archetype;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
@@ -26,7 +26,7 @@ use thiserror::Error;
 /// The first bytes of a checkpoint file.
 const MAGIC: &[u8; 8] = b"KDMPMCK\0";
 /// Format version; a file of another version is refused.
-const VERSION: u32 = 3;
+const VERSION: u32 = 4;
 /// The file's name in an output directory.
 pub const FILE_NAME: &str = "checkpoint.kdc";
 
@@ -216,6 +216,16 @@ fn encode_state(w: &mut Writer, s: &SolverState) {
         c.force.iter().for_each(|&f| w.f64(f));
         w.opt(c.pressure);
     }
+    w.u64(s.stage as u64);
+    w.u64(s.stages.len() as u64);
+    for st in &s.stages {
+        w.str(&st.name);
+        w.u64(st.step);
+        w.f64(st.time);
+        w.f64(st.force_ratio);
+        w.f64(st.energy_ratio);
+        w.u64(st.resets);
+    }
 }
 
 fn decode_state(r: &mut Reader) -> Result<SolverState, CheckpointError> {
@@ -268,6 +278,17 @@ fn decode_state(r: &mut Reader) -> Result<SolverState, CheckpointError> {
             displacement: r.f64()?,
             force: [r.f64()?, r.f64()?, r.f64()?],
             pressure: r.opt()?,
+        });
+    }
+    s.stage = r.u64()? as usize;
+    for _ in 0..r.u64()? {
+        s.stages.push(StageResult {
+            name: r.str()?,
+            step: r.u64()?,
+            time: r.f64()?,
+            force_ratio: r.f64()?,
+            energy_ratio: r.f64()?,
+            resets: r.u64()?,
         });
     }
     Ok(s)

@@ -95,6 +95,7 @@ impl<D: Dim> Simulation<D> {
         // time = n·Δt rather than a running sum, so long runs do not drift.
         s.time = s.step as f64 * s.dt;
         s.reset_this_step = false;
+        s.milestone = false;
         let result = self.schedule.run(&mut self.ctx);
         if self.ctx.state.points_reordered {
             for t in &mut self.traced {

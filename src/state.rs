@@ -1,6 +1,7 @@
 //! Solver-wide state and settings: plain structs outside the ECS world.
 
 use crate::grid::NodeBox;
+use crate::materials::MaterialModel;
 use serde::{Deserialize, Serialize};
 
 /// Where the stress update sits in the step.
@@ -147,6 +148,38 @@ pub struct Settings {
     pub min_node_mass: f64,
     /// Prescribed motions (displacement control), in scene order.
     pub motions: Vec<MotionSpec>,
+    /// Loading stages, in order; the first is the scene as built.
+    pub stages: Vec<LoadStage>,
+}
+
+/// A loading stage: what changes when it begins; it runs to the static stop.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LoadStage {
+    /// Name given in the scene.
+    pub name: String,
+    /// Materials it replaces, by material index.
+    pub materials: Vec<(u16, MaterialModel)>,
+    /// Point loads it sets, by the carrier's point id (force: N; N/m in 2D, x y z).
+    pub loads: Vec<(u32, [f64; 3])>,
+    /// Zero every point's accumulated displacement when it begins (after a geostatic stage).
+    pub reset_displacements: bool,
+}
+
+/// The static state that ended a stage (`stages.csv`).
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct StageResult {
+    /// The stage.
+    pub name: String,
+    /// Step of its static state.
+    pub step: u64,
+    /// Simulated time (s).
+    pub time: f64,
+    /// K_F (the stopping rule's norm) and K_E at the end.
+    pub force_ratio: f64,
+    /// K_E at the end.
+    pub energy_ratio: f64,
+    /// Kinetic-damping resets so far.
+    pub resets: u64,
 }
 
 /// A kinetic-energy peak at which velocities were reset.
@@ -350,6 +383,13 @@ pub struct SolverState {
     pub drives: Vec<Drive>,
     /// Static states of the load–displacement curve so far.
     pub curve: Vec<CurvePoint>,
+    /// The loading stage under way (index in `Settings::stages`).
+    pub stage: usize,
+    /// Stages finished so far.
+    pub stages: Vec<StageResult>,
+    /// True when a control system consumed a static state in this step (an increment or a
+    /// stage ended): snapshot writers take one.
+    pub milestone: bool,
 }
 
 impl Settings {

@@ -254,6 +254,13 @@ fn a_3d_block_resumed_by_the_binary_writes_the_same_files() {
     resume_from_last_checkpoint("block_10k.ron", 40, &[]);
 }
 
+/// The bar in two load stages, checkpointed in the second.
+#[test]
+fn a_staged_run_resumed_in_its_second_stage_writes_the_same_files() {
+    let stages = r#"stages=[(name: "first"), (name: "doubled", point_loads: {"F": [0.002, 0.0, 0.0]})]"#;
+    resume_from_last_checkpoint("bar.ron", 2_000, &[stages]);
+}
+
 /// The footing, checkpointed in its sixth increment (step 5 000 of 8 743): the motion's
 /// travel, its hold and the curve so far come back with the points.
 #[test]

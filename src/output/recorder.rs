@@ -10,7 +10,8 @@ use crate::output::summary::Summary;
 use crate::output::vtk::write_points;
 use crate::output::RowFile;
 use crate::simulation::Simulation;
-use crate::state::CurvePoint;
+use crate::state::{CurvePoint, StageResult};
+use crate::systems::convergence::ratio_text;
 use std::io::Write;
 use std::sync::{Arc, Mutex};
 
@@ -40,6 +41,26 @@ fn curve_csv<D: Dim>(curve: &[CurvePoint]) -> String {
             t += &format!(",{p:.9e}");
         }
         t += "\n";
+    }
+    t
+}
+
+/// The loading stages' file.
+pub const STAGES: &str = "stages.csv";
+
+/// `stages.csv`: one row a finished stage: name, step, time (s), K_F, K_E, resets so far.
+fn stages_csv(stages: &[StageResult]) -> String {
+    let mut t = String::from("stage,step,time,force_ratio,energy_ratio,resets\n");
+    for s in stages {
+        t += &format!(
+            "{},{},{:.9e},{},{},{}\n",
+            s.name,
+            s.step,
+            s.time,
+            ratio_text(s.force_ratio, 9),
+            ratio_text(s.energy_ratio, 9),
+            s.resets
+        );
     }
     t
 }
@@ -117,6 +138,11 @@ impl Recorder {
                     ""
                 }
             )),
+        }
+        if !sim.ctx.state.stages.is_empty() {
+            dir.write_atomic(STAGES, |out| {
+                out.write_all(stages_csv(&sim.ctx.state.stages).as_bytes())
+            })?;
         }
         if !sim.ctx.state.curve.is_empty() {
             dir.write_atomic(CURVE, |out| {

@@ -145,7 +145,12 @@ impl<D: Dim> Snapshots<D> {
             .spec
             .every_time
             .is_some_and(|t| (st.time / t).floor() > ((st.time - st.dt) / t).floor());
-        by_steps || by_time || (self.spec.at_resets && st.reset_this_step) || st.stop.is_some()
+        // Every static state a control system consumed (an increment, a stage) too.
+        by_steps
+            || by_time
+            || (self.spec.at_resets && st.reset_this_step)
+            || st.milestone
+            || st.stop.is_some()
     }
 }
 

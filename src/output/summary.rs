@@ -4,7 +4,7 @@ use crate::dim::Dim;
 use crate::measure::{max_displacements, surface_angle, SurfaceAngle};
 use crate::schedule::Timing;
 use crate::simulation::{Simulation, TracedResult};
-use crate::state::{CurvePoint, ForceNorm, Peak, StopReason};
+use crate::state::{CurvePoint, ForceNorm, Peak, StageResult, StopReason};
 use crate::systems::convergence::is_defined;
 use serde::Serialize;
 
@@ -103,6 +103,9 @@ pub struct Summary {
     /// Static states of the load–displacement curve (`curve.csv`).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub curve: Vec<CurvePoint>,
+    /// The static state that ended each loading stage (`stages.csv`).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub stages: Vec<StageResult>,
 }
 
 /// How a run ended, as `summary.json` writes it (snake case).
@@ -195,6 +198,7 @@ impl Summary {
             limit_pressure: limit_pressure(&s.curve),
             last_increment_rise: last_increment_rise(&s.curve),
             curve: s.curve.clone(),
+            stages: s.stages.clone(),
         }
     }
 }

@@ -1,8 +1,8 @@
 //! Building a simulation from a valid scene: grid nodes, material points, loads, tracing
 //! and the schedule. Only what the scene uses is created.
 
-use super::validate::{self, Checked, Derived};
-use super::{Condition, LoadedScene, Region, Scene};
+use super::validate::{self, material_model, Checked, Derived};
+use super::{Condition, LoadedScene, MaterialSpec, Region, Scene};
 use crate::columns::{col, points_with};
 use crate::components::*;
 use crate::context::Context;
@@ -10,10 +10,11 @@ use crate::dim::{Dim, Dim2, Dim3, Vector};
 use crate::error::SceneError;
 use crate::grid::Grid;
 use crate::materials::Material;
+use crate::materials::MaterialModel;
 use crate::parallel::SlabCache;
 use crate::shape::{for_each_node, Linear, QuadraticBSpline, ShapeKind, UniformGimp};
 use crate::simulation::{AnySimulation, Simulation, TracedPoint};
-use crate::state::{Gravity, MotionSpec, Settings, SolverState};
+use crate::state::{Gravity, LoadStage, MotionSpec, Settings, SolverState};
 use crate::systems::spatial_sort::sort_points;
 use crate::systems::{check_names, default_names, schedule_from_names, Needs};
 use hecs::{Entity, World};
@@ -158,6 +159,40 @@ impl<I: Iterator> Iterator for Counted<I> {
 
 impl<I: Iterator> ExactSizeIterator for Counted<I> {}
 
+/// The scene's stages with their materials built (indexed as `table`) and their loads by
+/// carrier id (`load_ids`).
+fn stages(
+    loaded: &LoadedScene,
+    table: &[(String, MaterialModel)],
+    load_ids: &[(String, u32)],
+) -> Result<Vec<LoadStage>, SceneError> {
+    let mut out = Vec::new();
+    for (k, st) in loaded.scene.stages.iter().enumerate() {
+        let mut materials = Vec::new();
+        for (name, spec) in &st.materials {
+            let at = |f: &str| format!("stages[{k}].materials.{name}.{f}");
+            let model = material_model(&at, spec).map_err(|(field, rule)| loaded.invalid(&field, rule))?;
+            let id = table.iter().position(|(n, _)| n == name).expect("validated");
+            materials.push((id as u16, model));
+        }
+        let loads = st
+            .point_loads
+            .iter()
+            .map(|(name, f)| {
+                let id = load_ids.iter().find(|(n, _)| n == name).expect("validated").1;
+                (id, pad3(f))
+            })
+            .collect();
+        out.push(LoadStage {
+            name: st.name.clone(),
+            materials,
+            loads,
+            reset_displacements: st.reset_displacements,
+        });
+    }
+    Ok(out)
+}
+
 fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulation<D>, Derived), SceneError> {
     let Checked {
         materials: table,
@@ -262,6 +297,14 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
             .position(|(name, _)| *name == body.material)
             .expect("validated");
         let model = &table[mat].1;
+        // A material a later stage makes plastic carries plastic state from the start.
+        let plastic = model.is_plastic()
+            || s.stages.iter().any(|st| {
+                matches!(
+                    st.materials.get(&body.material),
+                    Some(MaterialSpec::MohrCoulomb { .. })
+                )
+            });
         let volume = cell_volume / body.points_per_cell.iter().product::<usize>() as f64;
         let mass = model.density() * volume;
         full_node_mass = full_node_mass.min(model.density() * cell_volume);
@@ -289,7 +332,7 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         // Plastic state only where the material needs it, displacements only when asked for.
         // The spawned entities are not kept: points are found again through the columns,
         // which keeps the set-up's peak memory near the run's.
-        match (model.is_plastic(), s.output.displacements) {
+        match (plastic, s.output.displacements) {
             (true, true) => {
                 world.spawn_batch(xs.map(|x| {
                     let (a, b, c, d, e, f, g, h) = common(x);
@@ -323,6 +366,7 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
     }
 
     // Point loads: massless carriers that move with the body.
+    let mut load_ids = Vec::new();
     for (i, l) in s.point_loads.iter().enumerate() {
         let x = D::vec_from(pad3(&l.position));
         if !grid.contains(x) {
@@ -342,6 +386,7 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
                 ),
             ));
         }
+        load_ids.push((l.name.clone(), next_id));
         let carrier = world.spawn((
             PointId(next_id),
             Position(x),
@@ -421,6 +466,7 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         }),
         min_node_mass: s.solver.node_mass_cutoff * full_node_mass,
         motions: s.motions.clone(),
+        stages: stages(loaded, &table, &load_ids)?,
         virtual_mass_floor: s.solver.virtual_mass_floor * full_node_mass,
     };
     let needs = Needs {

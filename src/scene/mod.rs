@@ -48,6 +48,9 @@ pub struct Scene {
     /// a load–displacement curve of static states.
     #[serde(default)]
     pub motions: Vec<MotionSpec>,
+    /// Loading stages, each run to its static stop (the first names the scene as built).
+    #[serde(default)]
+    pub stages: Vec<StageSpec>,
     /// Factor of safety by strength reduction (`kdmpm fos`).
     #[serde(default)]
     pub strength_reduction: Option<StrengthReductionSpec>,
@@ -138,6 +141,23 @@ pub enum Region {
         #[serde(default)]
         z: Option<Vec<f64>>,
     },
+}
+
+/// A loading stage: what changes when it begins.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StageSpec {
+    /// Name (a row of `stages.csv`).
+    pub name: String,
+    /// Materials replaced, by name (each must be in `materials`).
+    #[serde(default, deserialize_with = "unique_keys")]
+    pub materials: BTreeMap<String, MaterialSpec>,
+    /// Point loads' new forces, by name (N; N/m in 2D).
+    #[serde(default, deserialize_with = "unique_keys")]
+    pub point_loads: BTreeMap<String, Vec<f64>>,
+    /// Zero the accumulated displacements when the stage begins.
+    #[serde(default)]
+    pub reset_displacements: bool,
 }
 
 /// How `kdmpm fos` brackets the factor of safety (see [`crate::fos`]).

@@ -220,6 +220,91 @@ fn non_negative(x: f64) -> bool {
     x >= 0.0 && x.is_finite()
 }
 
+/// The model of material `m`, checked field by field; an error names the field (by `at`)
+/// and the rule.
+pub(super) fn material_model(
+    at: &dyn Fn(&str) -> String,
+    m: &MaterialSpec,
+) -> Result<MaterialModel, (String, String)> {
+    let (rho, e, nu) = match m {
+        MaterialSpec::LinearElastic {
+            density,
+            youngs_modulus,
+            poisson_ratio,
+        }
+        | MaterialSpec::MohrCoulomb {
+            density,
+            youngs_modulus,
+            poisson_ratio,
+            ..
+        } => (*density, *youngs_modulus, *poisson_ratio),
+    };
+    if !positive(rho) {
+        return Err((at("density"), format!("must be > 0 kg/m³, found {rho}")));
+    }
+    if !positive(e) {
+        return Err((at("youngs_modulus"), format!("must be > 0 Pa, found {e}")));
+    }
+    if !(0.0..0.5).contains(&nu) {
+        return Err((at("poisson_ratio"), format!("must be in [0, 0.5), found {nu}")));
+    }
+    let model = match m {
+        MaterialSpec::LinearElastic { .. } => MaterialModel::LinearElastic(LinearElastic::new(rho, e, nu)),
+        MaterialSpec::MohrCoulomb {
+            cohesion,
+            friction_angle,
+            dilatancy_angle,
+            tension_cutoff,
+            ..
+        } => {
+            let (c, phi, psi) = (*cohesion, *friction_angle, *dilatancy_angle);
+            if !non_negative(c) {
+                return Err((at("cohesion"), format!("must be ≥ 0 Pa, found {c}")));
+            }
+            if !(0.0..90.0).contains(&phi) {
+                return Err((
+                    at("friction_angle"),
+                    format!("must be in [0°, 90°), found {phi}°"),
+                ));
+            }
+            if !(non_negative(psi) && psi <= phi) {
+                return Err((
+                    at("dilatancy_angle"),
+                    format!("must be in [0°, φ = {phi}°], found {psi}°"),
+                ));
+            }
+            if let Some(t) = tension_cutoff {
+                if !non_negative(*t) {
+                    return Err((
+                        at("tension_cutoff"),
+                        format!("must be a finite stress ≥ 0 Pa (at most c·cot φ), found {t}"),
+                    ));
+                }
+            }
+            if phi == 0.0 && c == 0.0 {
+                return Err((
+                    at("cohesion"),
+                    "with φ = 0 the cohesion must be > 0 (no strength at all)".into(),
+                ));
+            }
+            MaterialModel::MohrCoulomb(MohrCoulomb::new(rho, e, nu, c, phi, psi, *tension_cutoff))
+        }
+    };
+    // The P-wave speed sets the time step: it must be a finite number > 0 (an E near
+    // the largest double overflows M, a density near the smallest overflows M/ρ).
+    let speed = (model.p_wave_modulus() / model.density()).sqrt();
+    if !positive(speed) {
+        return Err((
+            at("youngs_modulus"),
+            format!(
+                "E = {e} Pa with ρ = {rho} kg/m³ and ν = {nu} gives a P-wave speed of {speed} m/s, \
+                 not a finite number > 0"
+            ),
+        ));
+    }
+    Ok(model)
+}
+
 /// Checks every rule that does not need the points.
 pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
     let s = &loaded.scene;
@@ -302,84 +387,7 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
     let mut table = Vec::new();
     for (name, m) in &s.materials {
         let at = |f: &str| format!("materials.{name}.{f}");
-        let (rho, e, nu) = match m {
-            MaterialSpec::LinearElastic {
-                density,
-                youngs_modulus,
-                poisson_ratio,
-            }
-            | MaterialSpec::MohrCoulomb {
-                density,
-                youngs_modulus,
-                poisson_ratio,
-                ..
-            } => (*density, *youngs_modulus, *poisson_ratio),
-        };
-        if !positive(rho) {
-            return bad(&at("density"), format!("must be > 0 kg/m³, found {rho}"));
-        }
-        if !positive(e) {
-            return bad(&at("youngs_modulus"), format!("must be > 0 Pa, found {e}"));
-        }
-        if !(0.0..0.5).contains(&nu) {
-            return bad(&at("poisson_ratio"), format!("must be in [0, 0.5), found {nu}"));
-        }
-        let model = match m {
-            MaterialSpec::LinearElastic { .. } => {
-                MaterialModel::LinearElastic(LinearElastic::new(rho, e, nu))
-            }
-            MaterialSpec::MohrCoulomb {
-                cohesion,
-                friction_angle,
-                dilatancy_angle,
-                tension_cutoff,
-                ..
-            } => {
-                let (c, phi, psi) = (*cohesion, *friction_angle, *dilatancy_angle);
-                if !non_negative(c) {
-                    return bad(&at("cohesion"), format!("must be ≥ 0 Pa, found {c}"));
-                }
-                if !(0.0..90.0).contains(&phi) {
-                    return bad(
-                        &at("friction_angle"),
-                        format!("must be in [0°, 90°), found {phi}°"),
-                    );
-                }
-                if !(non_negative(psi) && psi <= phi) {
-                    return bad(
-                        &at("dilatancy_angle"),
-                        format!("must be in [0°, φ = {phi}°], found {psi}°"),
-                    );
-                }
-                if let Some(t) = tension_cutoff {
-                    if !non_negative(*t) {
-                        return bad(
-                            &at("tension_cutoff"),
-                            format!("must be a finite stress ≥ 0 Pa (at most c·cot φ), found {t}"),
-                        );
-                    }
-                }
-                if phi == 0.0 && c == 0.0 {
-                    return bad(
-                        &at("cohesion"),
-                        "with φ = 0 the cohesion must be > 0 (no strength at all)".into(),
-                    );
-                }
-                MaterialModel::MohrCoulomb(MohrCoulomb::new(rho, e, nu, c, phi, psi, *tension_cutoff))
-            }
-        };
-        // The P-wave speed sets the time step: it must be a finite number > 0 (an E near
-        // the largest double overflows M, a density near the smallest overflows M/ρ).
-        let speed = (model.p_wave_modulus() / model.density()).sqrt();
-        if !positive(speed) {
-            return bad(
-                &at("youngs_modulus"),
-                format!(
-                    "E = {e} Pa with ρ = {rho} kg/m³ and ν = {nu} gives a P-wave speed of {speed} m/s, \
-                     not a finite number > 0"
-                ),
-            );
-        }
+        let model = material_model(&at, m).map_err(|(field, rule)| loaded.invalid(&field, rule))?;
         table.push((name.clone(), model));
     }
     if !positive(s.solver.tolerance) {
@@ -755,6 +763,45 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
                     "{t} s at Δt = {dt:e} s is {steps:.3e} steps (more than {MAX_IMPLIED_STEPS:e}): \
                      set max_steps as well, or a shorter max_time"
                 ),
+            );
+        }
+    }
+    for (k, st) in s.stages.iter().enumerate() {
+        for (name, spec) in &st.materials {
+            if !s.materials.contains_key(name) {
+                return bad(
+                    &format!("stages[{k}].materials"),
+                    format!("\"{name}\" is not a material of the scene: a stage replaces one"),
+                );
+            }
+            let at = |f: &str| format!("stages[{k}].materials.{name}.{f}");
+            let model = material_model(&at, spec).map_err(|(field, rule)| loaded.invalid(&field, rule))?;
+            let speed = (model.p_wave_modulus() / model.density()).sqrt();
+            if speed > c_p * (1.0 + 1e-12) {
+                return bad(
+                    &at("youngs_modulus"),
+                    format!(
+                        "a P-wave speed of {speed:.6} m/s, above the {c_p:.6} m/s that set the time \
+                         step: the explicit scheme would be unstable in this stage; give the \
+                         stiffest stage's material to the scene"
+                    ),
+                );
+            }
+        }
+        for (name, force) in &st.point_loads {
+            if !s.point_loads.iter().any(|l| l.name == *name) {
+                return bad(
+                    &format!("stages[{k}].point_loads"),
+                    format!("\"{name}\" is not a point load of the scene"),
+                );
+            }
+            len(&format!("stages[{k}].point_loads.{name}"), force.len())?;
+            finite(&format!("stages[{k}].point_loads.{name}"), force, "N")?;
+        }
+        if st.reset_displacements && !s.output.displacements {
+            return bad(
+                &format!("stages[{k}].reset_displacements"),
+                "needs the displacements kept (output.displacements: true)".into(),
             );
         }
     }

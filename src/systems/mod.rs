@@ -3,7 +3,7 @@
 //!
 //! [`registry`] holds one [`Entry`] per system: its name, its [`Stage`], when a scene needs
 //! it, the systems it must follow and its constructor. The list of names, each scheme's
-//! default schedule ([`default_names`]: the scheme's [`stages`] in order, and in each the
+//! default schedule ([`default_names`]: the scheme's [`scheme_stages`] in order, and in each the
 //! systems it needs), the checks on a scene's own `solver.schedule` ([`check_names`]) and
 //! the table in docs/writing-a-system.md ([`systems_table`]) all come from it.
 //!
@@ -29,6 +29,7 @@ pub mod point_loads;
 pub mod prescribed_motion;
 pub mod remap;
 pub mod spatial_sort;
+pub mod stages;
 pub mod stress_update;
 pub mod volume_update;
 pub mod volumetric_smoothing;
@@ -48,6 +49,7 @@ pub use point_loads::PointLoads;
 pub use prescribed_motion::PrescribedMotion;
 pub use remap::Remap;
 pub use spatial_sort::SpatialSort;
+pub use stages::Stages;
 pub use stress_update::StressUpdate;
 pub use volume_update::VolumeUpdate;
 pub use volumetric_smoothing::VolumetricSmoothing;
@@ -65,7 +67,7 @@ pub struct Needs {
 }
 
 /// The place of a system in a step. A scheme runs its stages in the order
-/// [`stages`] gives; systems of one stage run in registry order.
+/// [`scheme_stages`] gives; systems of one stage run in registry order.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Stage {
     /// Empty the grid.
@@ -109,7 +111,7 @@ pub enum Stage {
 }
 
 /// The stages of one step of `scheme`, in order.
-pub fn stages(scheme: Scheme) -> &'static [Stage] {
+pub fn scheme_stages(scheme: Scheme) -> &'static [Stage] {
     use Stage::*;
     match scheme {
         Scheme::Musl | Scheme::Usl => &[
@@ -421,6 +423,17 @@ pub fn registry<D: Dim, S: Shape>() -> Vec<Entry<D>> {
             "displacement control: travel, hold, curve of static states",
             |s| Box::new(PrescribedMotion::new(s.motions.clone())),
         ),
+        e(
+            "stages",
+            St::Control,
+            Needed(|s, _| !s.stages.is_empty(), "the scene has stages"),
+            &[
+                ("convergence", "it acts on the step's static state"),
+                ("prescribed_motion", "a stage ends once the motions are done"),
+            ],
+            "loading stages: the next stage at each static state",
+            |_| Box::new(Stages),
+        ),
     ]
 }
 
@@ -439,7 +452,7 @@ pub fn system_names() -> Vec<&'static str> {
 pub fn default_names(settings: &Settings, needs: Needs) -> Vec<&'static str> {
     let entries = entries();
     let mut names = Vec::new();
-    for &stage in stages(settings.scheme) {
+    for &stage in scheme_stages(settings.scheme) {
         for e in entries.iter().filter(|e| e.stage == stage) {
             let wanted = match e.when {
                 When::Always => true,
@@ -614,6 +627,7 @@ mod tests {
             flip: 1.0,
             min_node_mass: 0.0,
             motions: Vec::new(),
+            stages: Vec::new(),
             virtual_mass_floor: 0.0,
         }
     }

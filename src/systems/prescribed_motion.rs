@@ -95,6 +95,7 @@ impl<D: Dim> System<D> for PrescribedMotion {
                 pressure: m.area.map(|a| along / a),
             });
             d.increments += 1;
+            s.milestone = true;
             if d.travel < m.travel * (1.0 - 1e-9) {
                 d.velocity = m.vector();
                 more = true;

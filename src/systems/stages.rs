@@ -1,0 +1,88 @@
+//! Loading stages: a scene's `stages` run one after another, each to the static stop; a
+//! stage changes materials (e.g. elastic soil for the geostatic state, then its
+//! Mohr-Coulomb strength) and point loads when it begins, and may zero the displacements.
+
+use crate::columns::{col, col_mut, points_with};
+use crate::components::*;
+use crate::context::Context;
+use crate::dim::{Dim, Vector};
+use crate::error::StepError;
+use crate::schedule::System;
+use crate::state::{LoadStage, StageResult, StopReason};
+
+/// Moves to the next stage at each static state until the last: records the finished
+/// stage (`stages.csv`), applies the next one's changes and lets the run go on from the
+/// state reached. Its kinetic-damping record and external work start afresh, so that K_E
+/// measures the new stage's loading.
+#[derive(Debug, Default)]
+pub struct Stages;
+
+/// Sets the materials and loads of `stage` (the whole of it: applying it twice is applying
+/// it once).
+fn apply<D: Dim>(ctx: &mut Context<D>, stage: &LoadStage) {
+    for (id, model) in &stage.materials {
+        ctx.materials[*id as usize] = model.clone();
+    }
+    if stage.loads.is_empty() {
+        return;
+    }
+    for arch in points_with::<PointLoad<D::Vec>>(&ctx.world) {
+        let ids = col::<PointId>(arch);
+        let mut f = col_mut::<PointLoad<D::Vec>>(arch);
+        for (id, f) in ids.iter().zip(f.iter_mut()) {
+            if let Some((_, force)) = stage.loads.iter().find(|(i, _)| *i == id.0) {
+                f.0 = D::vec_from(*force);
+            }
+        }
+    }
+}
+
+impl<D: Dim> System<D> for Stages {
+    fn name(&self) -> &str {
+        "stages"
+    }
+
+    fn prepare(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
+        // The stages so far, in order (a resumed run starts inside one).
+        let stages = ctx.settings.stages.clone();
+        for stage in &stages[..=ctx.state.stage.min(stages.len() - 1)] {
+            apply(ctx, stage);
+        }
+        Ok(())
+    }
+
+    fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
+        if ctx.state.stop != Some(StopReason::Converged) {
+            return Ok(());
+        }
+        let s = &mut ctx.state;
+        let stages = &ctx.settings.stages;
+        s.stages.push(StageResult {
+            name: stages[s.stage].name.clone(),
+            step: s.step,
+            time: s.time,
+            force_ratio: s.force_ratio(ctx.settings.force_norm),
+            energy_ratio: s.energy_ratio,
+            resets: s.resets,
+        });
+        s.milestone = true;
+        if s.stage + 1 >= stages.len() {
+            return Ok(());
+        }
+        s.stage += 1;
+        s.stop = None;
+        s.static_window_start = None;
+        s.external_work = 0.0;
+        s.kinetic_energy = 0.0;
+        s.previous_kinetic_energy = 0.0;
+        s.earlier_kinetic_energy = 0.0;
+        let stage = stages[s.stage].clone();
+        apply(ctx, &stage);
+        if stage.reset_displacements {
+            for arch in points_with::<Displacement<D::Vec>>(&ctx.world) {
+                col_mut::<Displacement<D::Vec>>(arch).fill(Displacement(D::Vec::ZERO));
+            }
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,64 @@
+//! Loading stages: each runs to its static stop from the state the one before left.
+
+mod common;
+
+use common::{rel, run};
+
+/// The bar (the paper's example 1, linear elastic) loaded with F = 0.001 and then, in a
+/// second stage, 0.002: the second static state is the analytic one for 0.002,
+/// u_A = F x/(EA) = 9.5e-3 at x = 4.75 (the first, 4.75e-3, is the paper's).
+const TWO_LOADS: &str =
+    r#"stages=[(name: "first"), (name: "doubled", point_loads: {"F": [0.002, 0.0, 0.0]})]"#;
+
+#[test]
+fn a_second_stage_that_doubles_the_bars_load_doubles_its_displacement() {
+    let s = run("bar.ron", &[TWO_LOADS, "solver.tolerance=1e-4"]);
+    assert!(s.converged, "{:?}", s.error);
+    assert_eq!(s.stages.len(), 2);
+    assert_eq!(s.stages[0].name, "first");
+    assert!(s.stages[0].step < s.stages[1].step);
+    let u = s.traced[0].displacement[0];
+    assert!(rel(u, 9.5e-3).abs() < 2e-3, "u_A = {u}");
+    let sigma = s.traced[0].stress.xx;
+    assert!(rel(sigma, 2.0e-3).abs() < 2e-3, "σ = {sigma}");
+}
+
+/// The paper's slope with the fast preset, in two stages (elastic geostatic state, then
+/// the Mohr-Coulomb strength: `scenes/slope_staged.ron`) against one stage (gravity on the
+/// Mohr-Coulomb soil at once: `scenes/slope_fast.ron`). A slope that fails to its repose
+/// angle forgets the state it started from: both rest at Davis's angle (18.9°).
+#[test]
+fn the_slope_failed_from_its_geostatic_state_rests_at_the_one_stage_angle() {
+    let staged = run("slope_staged.ron", &[]);
+    let one = run("slope_fast.ron", &[]);
+    assert!(staged.converged && one.converged);
+    assert_eq!(staged.stages.len(), 2, "geostatic, then strength");
+    let angle = |s: &kdmpm::output::Summary| s.surface_angle.as_ref().unwrap().degrees;
+    assert!(
+        (angle(&staged) - angle(&one)).abs() < 0.25,
+        "{} against {}",
+        angle(&staged),
+        angle(&one)
+    );
+    // The crest's run-out counted from the geostatic state, against from the start.
+    let ux = |s: &kdmpm::output::Summary| s.traced[0].displacement[0];
+    assert!(
+        rel(ux(&staged), ux(&one)).abs() < 0.03,
+        "{} against {}",
+        ux(&staged),
+        ux(&one)
+    );
+}
+
+#[test]
+fn a_stage_that_would_outrun_the_time_step_is_refused() {
+    let path = common::scene("slope_staged.ron");
+    let stiff = r#"stages[1].materials.soil.youngs_modulus=80.0e6"#;
+    let o = common::kdmpm(&["check", path.to_str().unwrap(), "--set", stiff]);
+    assert_eq!(o.status.code(), Some(2));
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        e.contains("stages[1].materials.soil.youngs_modulus") && e.contains("time"),
+        "{e}"
+    );
+}
