@@ -250,6 +250,8 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
     let mut full_node_mass = f64::INFINITY;
     let (gmin, gmax) = (D::vec_to3(grid.origin), D::vec_to3(grid.max_corner()));
     let mut next_id = 0u32;
+    // The ids of each body's points (spawn order).
+    let mut body_ids: Vec<std::ops::Range<u32>> = Vec::new();
     for (b, body) in s.bodies.iter().enumerate() {
         let (lo, hi) = region_bounds(&body.region, n);
         if (0..n).any(|a| lo[a] < gmin[a] - 1e-9 || hi[a] > gmax[a] + 1e-9) {
@@ -308,6 +310,7 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         let volume = cell_volume / body.points_per_cell.iter().product::<usize>() as f64;
         let mass = model.density() * volume;
         full_node_mass = full_node_mass.min(model.density() * cell_volume);
+        let first = next_id;
         next_id = u32::try_from(count)
             .ok()
             .and_then(|c| next_id.checked_add(c))
@@ -317,6 +320,7 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
                     "more than 4 294 967 295 points in all",
                 )
             })?;
+        body_ids.push(first..next_id);
         let common = |(x, id): ([f64; 3], u32)| {
             (
                 PointId(id),
@@ -406,6 +410,54 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         }
     }
 
+    // Tractions: a point load on the outermost point of each column of points in the box,
+    // the traction times the column's share of the surface.
+    for (i, t) in s.tractions.iter().enumerate() {
+        let (normal, upper) = t.surface.axis_side();
+        // Column key: the point's sub-cell coordinates across the normal.
+        let mut outermost: Vec<(Vec<i64>, f64, Entity, f64)> = Vec::new();
+        for (e, x, id) in world.query::<(Entity, &Position<D::Vec>, &PointId)>().iter() {
+            if world.get::<&Stress<D::Stress>>(e).is_err() {
+                continue; // a load carrier
+            }
+            let x = D::vec_to3(x.0);
+            if !(0..n).all(|a| x[a] >= t.min[a] && x[a] <= t.max[a]) {
+                continue;
+            }
+            let body = body_ids
+                .iter()
+                .position(|r| r.contains(&id.0))
+                .expect("every point has a body");
+            let ppc = &s.bodies[body].points_per_cell;
+            let sub = |a: usize| s.grid.cell_size / ppc[a] as f64;
+            let key: Vec<i64> = (0..n)
+                .filter(|&a| a != normal)
+                .map(|a| (x[a] / sub(a)).floor() as i64)
+                .collect();
+            let share: f64 = (0..n).filter(|&a| a != normal).map(sub).product();
+            let out = if upper { x[normal] } else { -x[normal] };
+            match outermost.iter_mut().find(|c| c.0 == key) {
+                Some(c) if c.1 < out => (c.1, c.2, c.3) = (out, e, share),
+                Some(_) => {}
+                None => outermost.push((key, out, e, share)),
+            }
+        }
+        if outermost.is_empty() {
+            return Err(loaded.invalid(
+                &format!("tractions[{i}].min"),
+                format!("traction \"{}\": no point of a body lies in its box", t.name),
+            ));
+        }
+        for (_, _, e, share) in outermost {
+            let f = D::vec_from(pad3(&t.traction)) * share;
+            let total = match world.get::<&PointLoad<D::Vec>>(e) {
+                Ok(p) => p.0 + f,
+                Err(_) => f,
+            };
+            world.insert_one(e, PointLoad(total)).expect("a live point");
+        }
+    }
+
     // Bodies are filled row of points by row of points; cell order keeps the points that
     // share nodes together in memory from the first step.
     sort_points(&world, &grid).expect("set-up spawns only kdmpm components");
@@ -470,7 +522,7 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         virtual_mass_floor: s.solver.virtual_mass_floor * full_node_mass,
     };
     let needs = Needs {
-        point_loads: !s.point_loads.is_empty(),
+        point_loads: !s.point_loads.is_empty() || !s.tractions.is_empty(),
     };
     let names: Vec<String> = match &s.solver.schedule {
         Some(names) => {

@@ -54,6 +54,9 @@ pub struct Scene {
     /// Factor of safety by strength reduction (`kdmpm fos`).
     #[serde(default)]
     pub strength_reduction: Option<StrengthReductionSpec>,
+    /// Distributed loads on a body's surface, carried by its outermost points.
+    #[serde(default)]
+    pub tractions: Vec<TractionSpec>,
     /// Points whose displacement is recorded each output step and reported at the end.
     #[serde(default)]
     pub traced: Vec<TracedSpec>,
@@ -225,6 +228,24 @@ pub struct PointLoadSpec {
     pub position: Vec<f64>,
     /// The force (N; N per metre of thickness in 2D).
     pub force: Vec<f64>,
+}
+
+/// A traction (force per unit area) on the surface of the bodies inside a box, carried by
+/// the outermost point of each column of points along the surface's normal.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TractionSpec {
+    /// Name (for messages).
+    pub name: String,
+    /// The side of the bodies the surface faces, as a grid face: `YMax` loads a top surface.
+    pub surface: Face,
+    /// Lower corner of the box that holds the loaded part of the surface (m).
+    pub min: Vec<f64>,
+    /// Upper corner (m).
+    pub max: Vec<f64>,
+    /// Force per unit area of the surface projected on the plane normal to `surface`
+    /// (Pa), one entry per axis: `[0.0, -50e3]` presses a top surface down.
+    pub traction: Vec<f64>,
 }
 
 /// A traced point: the material point nearest to `position`.

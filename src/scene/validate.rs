@@ -645,6 +645,26 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
             );
         }
     }
+    for (i, t) in s.tractions.iter().enumerate() {
+        len(&format!("tractions[{i}].min"), t.min.len())?;
+        len(&format!("tractions[{i}].max"), t.max.len())?;
+        len(&format!("tractions[{i}].traction"), t.traction.len())?;
+        finite(&format!("tractions[{i}].min"), &t.min, "m")?;
+        finite(&format!("tractions[{i}].max"), &t.max, "m")?;
+        finite(&format!("tractions[{i}].traction"), &t.traction, "Pa")?;
+        if t.min.iter().zip(&t.max).any(|(lo, hi)| lo > hi) {
+            return bad(
+                &format!("tractions[{i}].max"),
+                "every entry must be at least min's".into(),
+            );
+        }
+        if t.surface.axis_side().0 >= n {
+            return bad(
+                &format!("tractions[{i}].surface"),
+                format!("{:?} is not a face of a {n}D grid", t.surface),
+            );
+        }
+    }
     for (i, t) in s.traced.iter().enumerate() {
         len(&format!("traced[{i}].position"), t.position.len())?;
         finite(&format!("traced[{i}].position"), &t.position, "m")?;
@@ -655,7 +675,8 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
         .gravity
         .as_ref()
         .is_some_and(|g| g.acceleration.iter().any(|&a| a != 0.0));
-    let loads = s.point_loads.iter().any(|l| l.force.iter().any(|&f| f != 0.0));
+    let loads = s.point_loads.iter().any(|l| l.force.iter().any(|&f| f != 0.0))
+        || s.tractions.iter().any(|t| t.traction.iter().any(|&f| f != 0.0));
     if !gravity && !loads && s.motions.is_empty() {
         return bad(
             if s.gravity.is_some() {
