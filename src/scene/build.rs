@@ -35,7 +35,7 @@ pub fn build(loaded: &LoadedScene) -> Result<(AnySimulation, Derived), SceneErro
     })
 }
 
-fn pad3(v: &[f64]) -> [f64; 3] {
+pub(super) fn pad3(v: &[f64]) -> [f64; 3] {
     [
         v[0],
         v.get(1).copied().unwrap_or(0.0),
@@ -410,53 +410,7 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         }
     }
 
-    // Tractions: a point load on the outermost point of each column of points in the box,
-    // the traction times the column's share of the surface.
-    for (i, t) in s.tractions.iter().enumerate() {
-        let (normal, upper) = t.surface.axis_side();
-        // Column key: the point's sub-cell coordinates across the normal.
-        let mut outermost: Vec<(Vec<i64>, f64, Entity, f64)> = Vec::new();
-        for (e, x, id) in world.query::<(Entity, &Position<D::Vec>, &PointId)>().iter() {
-            if world.get::<&Stress<D::Stress>>(e).is_err() {
-                continue; // a load carrier
-            }
-            let x = D::vec_to3(x.0);
-            if !(0..n).all(|a| x[a] >= t.min[a] && x[a] <= t.max[a]) {
-                continue;
-            }
-            let body = body_ids
-                .iter()
-                .position(|r| r.contains(&id.0))
-                .expect("every point has a body");
-            let ppc = &s.bodies[body].points_per_cell;
-            let sub = |a: usize| s.grid.cell_size / ppc[a] as f64;
-            let key: Vec<i64> = (0..n)
-                .filter(|&a| a != normal)
-                .map(|a| (x[a] / sub(a)).floor() as i64)
-                .collect();
-            let share: f64 = (0..n).filter(|&a| a != normal).map(sub).product();
-            let out = if upper { x[normal] } else { -x[normal] };
-            match outermost.iter_mut().find(|c| c.0 == key) {
-                Some(c) if c.1 < out => (c.1, c.2, c.3) = (out, e, share),
-                Some(_) => {}
-                None => outermost.push((key, out, e, share)),
-            }
-        }
-        if outermost.is_empty() {
-            return Err(loaded.invalid(
-                &format!("tractions[{i}].min"),
-                format!("traction \"{}\": no point of a body lies in its box", t.name),
-            ));
-        }
-        for (_, _, e, share) in outermost {
-            let f = D::vec_from(pad3(&t.traction)) * share;
-            let total = match world.get::<&PointLoad<D::Vec>>(e) {
-                Ok(p) => p.0 + f,
-                Err(_) => f,
-            };
-            world.insert_one(e, PointLoad(total)).expect("a live point");
-        }
-    }
+    super::tractions::place::<D>(&mut world, loaded, &body_ids)?;
 
     // Bodies are filled row of points by row of points; cell order keeps the points that
     // share nodes together in memory from the first step.

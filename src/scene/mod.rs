@@ -5,6 +5,7 @@
 
 mod build;
 pub mod locate;
+mod tractions;
 mod validate;
 
 pub use build::build;
