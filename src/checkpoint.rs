@@ -26,7 +26,7 @@ use thiserror::Error;
 /// The first bytes of a checkpoint file.
 const MAGIC: &[u8; 8] = b"KDMPMCK\0";
 /// Format version; a file of another version is refused.
-const VERSION: u32 = 4;
+const VERSION: u32 = 5;
 /// The file's name in an output directory.
 pub const FILE_NAME: &str = "checkpoint.kdc";
 
@@ -226,6 +226,8 @@ fn encode_state(w: &mut Writer, s: &SolverState) {
         w.f64(st.energy_ratio);
         w.u64(st.resets);
     }
+    w.u64(s.load_increments.len() as u64);
+    s.load_increments.iter().for_each(|&k| w.u64(k as u64));
 }
 
 fn decode_state(r: &mut Reader) -> Result<SolverState, CheckpointError> {
@@ -290,6 +292,9 @@ fn decode_state(r: &mut Reader) -> Result<SolverState, CheckpointError> {
             energy_ratio: r.f64()?,
             resets: r.u64()?,
         });
+    }
+    for _ in 0..r.u64()? {
+        s.load_increments.push(r.u64()? as u32);
     }
     Ok(s)
 }

@@ -150,6 +150,23 @@ pub struct Settings {
     pub motions: Vec<MotionSpec>,
     /// Loading stages, in order; the first is the scene as built.
     pub stages: Vec<LoadStage>,
+    /// Loads applied in increments (load control), each increment to its static stop.
+    pub load_steps: Vec<LoadSteps>,
+}
+
+/// A load applied in equal increments, each relaxed to its static state and recorded as a
+/// row of the load–displacement curve.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LoadSteps {
+    /// Name given in the scene.
+    pub name: String,
+    /// The points that carry it (ids) and the force each carries at full load (N; N/m in
+    /// 2D, x y z).
+    pub points: Vec<(u32, [f64; 3])>,
+    /// Number of increments.
+    pub increments: u32,
+    /// The full load as a pressure (Pa): the traction's size.
+    pub pressure: f64,
 }
 
 /// A loading stage: what changes when it begins; it runs to the static stop.
@@ -387,6 +404,8 @@ pub struct SolverState {
     pub stage: usize,
     /// Stages finished so far.
     pub stages: Vec<StageResult>,
+    /// Increments each load under load control has finished (`Settings::load_steps`).
+    pub load_increments: Vec<u32>,
     /// True when a control system consumed a static state in this step (an increment or a
     /// stage ended): snapshot writers take one.
     pub milestone: bool,

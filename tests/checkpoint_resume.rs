@@ -254,6 +254,12 @@ fn a_3d_block_resumed_by_the_binary_writes_the_same_files() {
     resume_from_last_checkpoint("block_10k.ron", 40, &[]);
 }
 
+/// The strip pressure under load control, checkpointed in its seventh increment.
+#[test]
+fn a_load_controlled_run_resumed_between_increments_writes_the_same_curve() {
+    resume_from_last_checkpoint("footing_load.ron", 2_000, &[]);
+}
+
 /// The bar in two load stages, checkpointed in the second.
 #[test]
 fn a_staged_run_resumed_in_its_second_stage_writes_the_same_files() {

@@ -96,3 +96,25 @@ fn a_traction_whose_box_holds_no_point_is_refused() {
     let e = build(&loaded).err().expect("refused").to_string();
     assert!(e.contains("tractions[0].min") && e.contains("no point"), "{e}");
 }
+
+/// `scenes/footing_load.ron`: a uniform strip pressure on weightless Tresca clay
+/// (c = 10 kPa) raised by 5 kPa increments. Prandtl's (2 + π) c = 51.42 kPa: the settlement
+/// stays elastic-plastic (centimetres) below it and jumps by well over an order of
+/// magnitude past it (the rigid footing reaches 55.6 kPa at this cell size).
+#[test]
+fn a_strip_pressure_under_load_control_settles_by_centimetres_below_prandtls_limit_and_collapses_above() {
+    let s = common::run("footing_load.ron", &[]);
+    assert!(s.converged, "{:?}", s.error);
+    assert_eq!(s.curve.len(), 12, "twelve increments, twelve static states");
+    let u: Vec<f64> = s.curve.iter().map(|c| c.displacement).collect();
+    let p: Vec<f64> = s.curve.iter().map(|c| c.pressure.unwrap()).collect();
+    assert_eq!(p[9], 50.0e3);
+    // Elastic at first: the first four increments settle in proportion to the load.
+    for k in 1..4 {
+        assert!(rel(u[k] / u[0], (k + 1) as f64).abs() < 0.02, "{u:?}");
+    }
+    assert!(u[9] < 0.03, "50 kPa settles by centimetres: {u:?}");
+    assert!(u[11] > 20.0 * u[9], "60 kPa collapses: {u:?}");
+    // Load control gives no limit pressure of its own: a collapse may end at rest.
+    assert!(s.limit_pressure.is_none());
+}

@@ -92,8 +92,8 @@ pub struct Summary {
     /// Wall-clock seconds stepping waited for the snapshot writer (s).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub output_wait_seconds: Option<f64>,
-    /// The largest mean pressure of the load–displacement curve's static states (Pa), for
-    /// motions given a loaded area: the limit pressure where the curve has levelled off.
+    /// The largest mean pressure of the static states of the prescribed motions given a
+    /// loaded area (Pa): the limit pressure where the curve has levelled off.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub limit_pressure: Option<f64>,
     /// How much the pressure rose over the curve's last increment, relative to the limit
@@ -147,6 +147,14 @@ impl Summary {
         let st = &sim.ctx.settings;
         let particles = sim.point_count();
         let max_u = max_displacements(sim);
+        // Under load control a static state may follow a collapse (the body rests again on
+        // what it heaved): the largest pressure is a limit only under displacement control.
+        let displacement_control: Vec<CurvePoint> = s
+            .curve
+            .iter()
+            .filter(|c| st.motions.iter().any(|m| m.name == c.name))
+            .cloned()
+            .collect();
         Summary {
             scene: scene.to_string(),
             dimension: D::N,
@@ -195,8 +203,8 @@ impl Summary {
             systems: sim.schedule.timings(),
             snapshots: None,
             output_wait_seconds: None,
-            limit_pressure: limit_pressure(&s.curve),
-            last_increment_rise: last_increment_rise(&s.curve),
+            limit_pressure: limit_pressure(&displacement_control),
+            last_increment_rise: last_increment_rise(&displacement_control),
             curve: s.curve.clone(),
             stages: s.stages.clone(),
         }

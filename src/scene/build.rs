@@ -410,7 +410,7 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         }
     }
 
-    super::tractions::place::<D>(&mut world, loaded, &body_ids)?;
+    let load_steps = super::tractions::place::<D>(&mut world, loaded, &body_ids)?;
 
     // Bodies are filled row of points by row of points; cell order keeps the points that
     // share nodes together in memory from the first step.
@@ -473,6 +473,7 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         min_node_mass: s.solver.node_mass_cutoff * full_node_mass,
         motions: s.motions.clone(),
         stages: stages(loaded, &table, &load_ids)?,
+        load_steps,
         virtual_mass_floor: s.solver.virtual_mass_floor * full_node_mass,
     };
     let needs = Needs {

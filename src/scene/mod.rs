@@ -247,6 +247,10 @@ pub struct TractionSpec {
     /// Force per unit area of the surface projected on the plane normal to `surface`
     /// (Pa), one entry per axis: `[0.0, -50e3]` presses a top surface down.
     pub traction: Vec<f64>,
+    /// Apply it in this many equal increments, each to its static stop and a row of
+    /// `curve.csv` (load control); default: all at once.
+    #[serde(default)]
+    pub increments: Option<u32>,
 }
 
 /// A traced point: the material point nearest to `position`.

@@ -5,20 +5,22 @@ use super::LoadedScene;
 use crate::components::*;
 use crate::dim::Dim;
 use crate::error::SceneError;
+use crate::state::LoadSteps;
 use hecs::{Entity, World};
 use std::collections::BTreeMap;
 
 /// Gives the outermost point of each column of points inside each traction's box (along
 /// the surface's normal) a point load: the traction times the column's share of the
 /// surface, (h/n) per axis across the normal for n points a cell. `body_ids` holds the
-/// point ids of each body.
+/// point ids of each body. Returns the tractions applied in increments.
 pub(super) fn place<D: Dim>(
     world: &mut World,
     loaded: &LoadedScene,
     body_ids: &[std::ops::Range<u32>],
-) -> Result<(), SceneError> {
+) -> Result<Vec<LoadSteps>, SceneError> {
     let s = &loaded.scene;
     let n = D::N;
+    let mut steps = Vec::new();
     for (i, t) in s.tractions.iter().enumerate() {
         let (normal, upper) = t.surface.axis_side();
         // Column key: the point's sub-cell coordinates across the normal.
@@ -55,6 +57,7 @@ pub(super) fn place<D: Dim>(
                 format!("traction \"{}\": no point of a body lies in its box", t.name),
             ));
         }
+        let mut points = Vec::new();
         for (_, (_, e, share)) in outermost {
             let f = D::vec_from(pad3(&t.traction)) * share;
             let total = match world.get::<&PointLoad<D::Vec>>(e) {
@@ -62,7 +65,18 @@ pub(super) fn place<D: Dim>(
                 Err(_) => f,
             };
             world.insert_one(e, PointLoad(total)).expect("a live point");
+            let id = world.get::<&PointId>(e).expect("a live point").0;
+            points.push((id, D::vec_to3(f)));
+        }
+        points.sort_by_key(|p| p.0);
+        if let Some(k) = t.increments {
+            steps.push(LoadSteps {
+                name: t.name.clone(),
+                points,
+                increments: k,
+                pressure: t.traction.iter().map(|c| c * c).sum::<f64>().sqrt(),
+            });
         }
     }
-    Ok(())
+    Ok(steps)
 }

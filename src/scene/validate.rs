@@ -658,6 +658,16 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
                 "every entry must be at least min's".into(),
             );
         }
+        if t.increments == Some(0) {
+            return bad(&format!("tractions[{i}].increments"), "must be at least 1".into());
+        }
+        if t.increments.is_some() && !s.output.displacements {
+            return bad(
+                &format!("tractions[{i}].increments"),
+                "the curve follows the loaded points' displacement: keep them (output.displacements: true)"
+                    .into(),
+            );
+        }
         if t.surface.axis_side().0 >= n {
             return bad(
                 &format!("tractions[{i}].surface"),

@@ -21,6 +21,7 @@ pub mod gravity;
 pub mod grid_reset;
 pub mod integrate;
 pub mod kinematics;
+pub mod load_steps;
 pub mod mass_scaling;
 pub mod nodal_velocity;
 pub mod p2g;
@@ -41,6 +42,7 @@ pub use gravity::Gravity;
 pub use grid_reset::GridReset;
 pub use integrate::Integrate;
 pub use kinematics::Kinematics;
+pub use load_steps::LoadControl;
 pub use mass_scaling::MassScaling;
 pub use nodal_velocity::NodalVelocity;
 pub use p2g::{P2g, P2gPart};
@@ -424,12 +426,27 @@ pub fn registry<D: Dim, S: Shape>() -> Vec<Entry<D>> {
             |s| Box::new(PrescribedMotion::new(s.motions.clone())),
         ),
         e(
+            "load_steps",
+            St::Control,
+            Needed(
+                |s, _| !s.load_steps.is_empty(),
+                "the scene has loads in increments",
+            ),
+            &[
+                ("convergence", "it acts on the step's static state"),
+                ("prescribed_motion", "a load increment follows the motions' last"),
+            ],
+            "load control: the next load increment at each static state",
+            |_| Box::new(LoadControl),
+        ),
+        e(
             "stages",
             St::Control,
             Needed(|s, _| !s.stages.is_empty(), "the scene has stages"),
             &[
                 ("convergence", "it acts on the step's static state"),
                 ("prescribed_motion", "a stage ends once the motions are done"),
+                ("load_steps", "a stage ends once its load increments are done"),
             ],
             "loading stages: the next stage at each static state",
             |_| Box::new(Stages),
@@ -628,6 +645,7 @@ mod tests {
             min_node_mass: 0.0,
             motions: Vec::new(),
             stages: Vec::new(),
+            load_steps: Vec::new(),
             virtual_mass_floor: 0.0,
         }
     }
