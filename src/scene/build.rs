@@ -17,7 +17,7 @@ use crate::simulation::{AnySimulation, Simulation, TracedPoint};
 use crate::state::{Gravity, LoadStage, MotionSpec, Settings, SolverState};
 use crate::systems::spatial_sort::sort_points;
 use crate::systems::{check_names, default_names, schedule_from_names, Needs};
-use hecs::{Entity, World};
+use hecs::{ColumnBatchBuilder, ColumnBatchType, Entity, World};
 
 /// Validates the scene and builds its simulation with its schedule (the default one for its
 /// settings unless `solver.schedule` names the systems).
@@ -136,6 +136,17 @@ fn fill_points<'a, D: Dim>(
             })
         })
     })
+}
+
+/// Writes `values` into the batch's column of `T`, if the batch has one.
+fn fill<T: hecs::Component>(batch: &ColumnBatchBuilder, values: impl Iterator<Item = T>) {
+    if let Some(mut w) = batch.writer::<T>() {
+        for v in values {
+            if w.push(v).is_err() {
+                unreachable!("a batch holds exactly its points");
+            }
+        }
+    }
 }
 
 /// An iterator that knows its length, so that `spawn_batch` reserves the columns once.
@@ -321,44 +332,40 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
                 )
             })?;
         body_ids.push(first..next_id);
-        let common = |(x, id): ([f64; 3], u32)| {
-            (
-                PointId(id),
-                Position(D::vec_from(x)),
-                Velocity(z),
-                Mass(mass),
-                Volume(volume),
-                Stress(D::Stress::default()),
-                VelocityGradient(D::MAT_ZERO),
-                MaterialId(mat as u16),
-            )
-        };
-        // Plastic state only where the material needs it, displacements only when asked for.
-        // The spawned entities are not kept: points are found again through the columns,
-        // which keeps the set-up's peak memory near the run's.
-        match (plastic, s.output.displacements) {
-            (true, true) => {
-                world.spawn_batch(xs.map(|x| {
-                    let (a, b, c, d, e, f, g, h) = common(x);
-                    (a, b, c, d, e, f, g, h, PlasticStrain(0.0), Displacement(z))
-                }));
-            }
-            (true, false) => {
-                world.spawn_batch(xs.map(|x| {
-                    let (a, b, c, d, e, f, g, h) = common(x);
-                    (a, b, c, d, e, f, g, h, PlasticStrain(0.0))
-                }));
-            }
-            (false, true) => {
-                world.spawn_batch(xs.map(|x| {
-                    let (a, b, c, d, e, f, g, h) = common(x);
-                    (a, b, c, d, e, f, g, h, Displacement(z))
-                }));
-            }
-            (false, false) => {
-                world.spawn_batch(xs.map(common));
-            }
+        // One column batch: the columns every point has, then the optional ones, plastic
+        // state only where the material needs it and displacements only when asked for.
+        // A new point column is one more `add` and one fill here. The spawned entities are
+        // not kept: points are found again through the columns, which keeps the set-up's
+        // peak memory near the run's.
+        let mut columns = ColumnBatchType::new();
+        columns.add_bundle::<(
+            PointId,
+            Position<D::Vec>,
+            Velocity<D::Vec>,
+            Mass,
+            Volume,
+            Stress<D::Stress>,
+            VelocityGradient<D::Mat>,
+            MaterialId,
+        )>();
+        if plastic {
+            columns.add::<PlasticStrain>();
         }
+        if s.output.displacements {
+            columns.add::<Displacement<D::Vec>>();
+        }
+        let batch = columns.into_batch(count as u32);
+        fill(&batch, xs.clone().map(|(_, id)| PointId(id)));
+        fill(&batch, xs.map(|(x, _)| Position(D::vec_from(x))));
+        fill(&batch, std::iter::repeat_n(Velocity(z), count));
+        fill(&batch, std::iter::repeat_n(Mass(mass), count));
+        fill(&batch, std::iter::repeat_n(Volume(volume), count));
+        fill(&batch, std::iter::repeat_n(Stress(D::Stress::default()), count));
+        fill(&batch, std::iter::repeat_n(VelocityGradient(D::MAT_ZERO), count));
+        fill(&batch, std::iter::repeat_n(MaterialId(mat as u16), count));
+        fill(&batch, std::iter::repeat_n(PlasticStrain(0.0), count));
+        fill(&batch, std::iter::repeat_n(Displacement(z), count));
+        world.spawn_column_batch(batch.build().expect("every column of the batch is filled"));
     }
 
     // Which nodes the points touch at the start.
