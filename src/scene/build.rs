@@ -2,7 +2,7 @@
 //! and the schedule. Only what the scene uses is created.
 
 use super::validate::{self, material_model, Checked, Derived};
-use super::{Condition, LoadedScene, MaterialSpec, Region, Scene};
+use super::{pad3, Condition, LoadedScene, MaterialSpec, Region, Scene};
 use crate::columns::{col, points_with};
 use crate::components::*;
 use crate::context::Context;
@@ -33,14 +33,6 @@ pub fn build(loaded: &LoadedScene) -> Result<(AnySimulation, Derived), SceneErro
             (AnySimulation::Three(sim), d)
         }
     })
-}
-
-pub(super) fn pad3(v: &[f64]) -> [f64; 3] {
-    [
-        v[0],
-        v.get(1).copied().unwrap_or(0.0),
-        v.get(2).copied().unwrap_or(0.0),
-    ]
 }
 
 /// Calls `f(node, w)` over the support of `x` with the scene's shape functions.

@@ -379,6 +379,15 @@ where
     deserializer.deserialize_map(Unique(std::marker::PhantomData))
 }
 
+/// A scene vector (one entry per axis) as x y z, the missing axes 0.
+fn pad3(v: &[f64]) -> [f64; 3] {
+    [
+        v[0],
+        v.get(1).copied().unwrap_or(0.0),
+        v.get(2).copied().unwrap_or(0.0),
+    ]
+}
+
 fn default_node_mass_cutoff() -> f64 {
     1e-3
 }

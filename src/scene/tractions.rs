@@ -1,7 +1,6 @@
 //! Tractions: a distributed load on a body's surface, carried by the outermost points.
 
-use super::build::pad3;
-use super::LoadedScene;
+use super::{pad3, LoadedScene};
 use crate::components::*;
 use crate::dim::Dim;
 use crate::error::SceneError;
