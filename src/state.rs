@@ -176,7 +176,8 @@ pub struct LoadStage {
     pub name: String,
     /// Materials it replaces, by material index.
     pub materials: Vec<(u16, MaterialModel)>,
-    /// Point loads it sets, by the carrier's point id (force: N; N/m in 2D, x y z).
+    /// Point loads it sets (carriers' and traction points'), by point id in ascending
+    /// order (force: N; N/m in 2D, x y z).
     pub loads: Vec<(u32, [f64; 3])>,
     /// Zero every point's accumulated displacement when it begins (after a geostatic stage).
     pub reset_displacements: bool,

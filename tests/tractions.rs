@@ -118,3 +118,23 @@ fn a_strip_pressure_under_load_control_settles_by_centimetres_below_prandtls_lim
     // Load control gives no limit pressure of its own: a collapse may end at rest.
     assert!(s.limit_pressure.is_none());
 }
+
+#[test]
+fn a_stage_that_doubles_the_pressure_doubles_the_stress_and_settlement() {
+    let staged = COLUMN_2D.replace(
+        "    traced:",
+        r#"    stages: [(name: "first"), (name: "doubled", tractions: {"p": [0.0, -20.0e3]})],
+    traced:"#,
+    );
+    let s = run(&staged);
+    assert!(s.converged, "{:?}", s.error);
+    assert_eq!(s.stages.len(), 2);
+    let mid = &s.traced[0];
+    assert!(rel(mid.stress.yy, -20.0e3).abs() < 0.01, "σ_yy {}", mid.stress.yy);
+    let expected = -20.0e3 * mid.initial_position[1] / m(1.0e7, 0.3);
+    assert!(
+        rel(mid.displacement[1], expected).abs() < 0.01,
+        "u_y {:?}",
+        mid.displacement
+    );
+}

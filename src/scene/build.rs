@@ -168,6 +168,7 @@ fn stages(
     loaded: &LoadedScene,
     table: &[(String, MaterialModel)],
     load_ids: &[(String, u32)],
+    shares: &[(String, Vec<(u32, f64)>)],
 ) -> Result<Vec<LoadStage>, SceneError> {
     let mut out = Vec::new();
     for (k, st) in loaded.scene.stages.iter().enumerate() {
@@ -178,7 +179,7 @@ fn stages(
             let id = table.iter().position(|(n, _)| n == name).expect("validated");
             materials.push((id as u16, model));
         }
-        let loads = st
+        let mut loads: Vec<(u32, [f64; 3])> = st
             .point_loads
             .iter()
             .map(|(name, f)| {
@@ -186,6 +187,11 @@ fn stages(
                 (id, pad3(f))
             })
             .collect();
+        for (name, t) in &st.tractions {
+            let points = &shares.iter().find(|(n, _)| n == name).expect("validated").1;
+            loads.extend(points.iter().map(|&(id, share)| (id, pad3(t).map(|c| c * share))));
+        }
+        loads.sort_by_key(|l| l.0);
         out.push(LoadStage {
             name: st.name.clone(),
             materials,
@@ -409,7 +415,7 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         }
     }
 
-    let load_steps = super::tractions::place::<D>(&mut world, loaded, &body_ids)?;
+    let placed = super::tractions::place::<D>(&mut world, loaded, &body_ids)?;
 
     // Bodies are filled row of points by row of points; cell order keeps the points that
     // share nodes together in memory from the first step.
@@ -471,8 +477,8 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         }),
         min_node_mass: s.solver.node_mass_cutoff * full_node_mass,
         motions: s.motions.clone(),
-        stages: stages(loaded, &table, &load_ids)?,
-        load_steps,
+        stages: stages(loaded, &table, &load_ids, &placed.shares)?,
+        load_steps: placed.steps,
         virtual_mass_floor: s.solver.virtual_mass_floor * full_node_mass,
     };
     let needs = Needs {

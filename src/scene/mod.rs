@@ -159,6 +159,9 @@ pub struct StageSpec {
     /// Point loads' new forces, by name (N; N/m in 2D).
     #[serde(default, deserialize_with = "unique_keys")]
     pub point_loads: BTreeMap<String, Vec<f64>>,
+    /// Tractions' new values, by name (Pa).
+    #[serde(default, deserialize_with = "unique_keys")]
+    pub tractions: BTreeMap<String, Vec<f64>>,
     /// Zero the accumulated displacements when the stage begins.
     #[serde(default)]
     pub reset_displacements: bool,

@@ -11,15 +11,15 @@ use std::collections::BTreeMap;
 /// Gives the outermost point of each column of points inside each traction's box (along
 /// the surface's normal) a point load: the traction times the column's share of the
 /// surface, (h/n) per axis across the normal for n points a cell. `body_ids` holds the
-/// point ids of each body. Returns the tractions applied in increments.
+/// point ids of each body.
 pub(super) fn place<D: Dim>(
     world: &mut World,
     loaded: &LoadedScene,
     body_ids: &[std::ops::Range<u32>],
-) -> Result<Vec<LoadSteps>, SceneError> {
+) -> Result<Placed, SceneError> {
     let s = &loaded.scene;
     let n = D::N;
-    let mut steps = Vec::new();
+    let mut placed = Placed::default();
     for (i, t) in s.tractions.iter().enumerate() {
         let (normal, upper) = t.surface.axis_side();
         // Column key: the point's sub-cell coordinates across the normal.
@@ -56,7 +56,7 @@ pub(super) fn place<D: Dim>(
                 format!("traction \"{}\": no point of a body lies in its box", t.name),
             ));
         }
-        let mut points = Vec::new();
+        let (mut points, mut shares) = (Vec::new(), Vec::new());
         for (_, (_, e, share)) in outermost {
             let f = D::vec_from(pad3(&t.traction)) * share;
             let total = match world.get::<&PointLoad<D::Vec>>(e) {
@@ -66,10 +66,12 @@ pub(super) fn place<D: Dim>(
             world.insert_one(e, PointLoad(total)).expect("a live point");
             let id = world.get::<&PointId>(e).expect("a live point").0;
             points.push((id, D::vec_to3(f)));
+            shares.push((id, share));
         }
         points.sort_by_key(|p| p.0);
+        placed.shares.push((t.name.clone(), shares));
         if let Some(k) = t.increments {
-            steps.push(LoadSteps {
+            placed.steps.push(LoadSteps {
                 name: t.name.clone(),
                 points,
                 increments: k,
@@ -77,5 +79,14 @@ pub(super) fn place<D: Dim>(
             });
         }
     }
-    Ok(steps)
+    Ok(placed)
+}
+
+/// Where the tractions went.
+#[derive(Default)]
+pub(super) struct Placed {
+    /// The tractions applied in increments.
+    pub steps: Vec<LoadSteps>,
+    /// Each traction's points (ids) and their shares of the surface (m²; m in 2D).
+    pub shares: Vec<(String, Vec<(u32, f64)>)>,
 }

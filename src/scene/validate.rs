@@ -829,6 +829,21 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
             len(&format!("stages[{k}].point_loads.{name}"), force.len())?;
             finite(&format!("stages[{k}].point_loads.{name}"), force, "N")?;
         }
+        for (name, traction) in &st.tractions {
+            let field = format!("stages[{k}].tractions.{name}");
+            match s.tractions.iter().find(|t| t.name == *name) {
+                None => return bad(&field, format!("\"{name}\" is not a traction of the scene")),
+                Some(t) if t.increments.is_some() => {
+                    return bad(
+                        &field,
+                        "this traction is applied in increments: a stage cannot set it too".into(),
+                    )
+                }
+                Some(_) => {}
+            }
+            len(&field, traction.len())?;
+            finite(&field, traction, "Pa")?;
+        }
         if st.reset_displacements && !s.output.displacements {
             return bad(
                 &format!("stages[{k}].reset_displacements"),

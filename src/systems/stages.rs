@@ -30,8 +30,8 @@ fn apply<D: Dim>(ctx: &mut Context<D>, stage: &LoadStage) {
         let ids = col::<PointId>(arch);
         let mut f = col_mut::<PointLoad<D::Vec>>(arch);
         for (id, f) in ids.iter().zip(f.iter_mut()) {
-            if let Some((_, force)) = stage.loads.iter().find(|(i, _)| *i == id.0) {
-                f.0 = D::vec_from(*force);
+            if let Ok(k) = stage.loads.binary_search_by_key(&id.0, |l| l.0) {
+                f.0 = D::vec_from(stage.loads[k].1);
             }
         }
     }
