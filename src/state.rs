@@ -74,13 +74,15 @@ pub struct Gravity {
     pub acceleration: [f64; 3],
     /// Time over which it rises linearly from zero (s); 0 applies it at once.
     pub ramp_time: f64,
+    /// When the ramp starts (s): 0, or the start of the loading stage that set it.
+    pub start: f64,
 }
 
 impl Gravity {
     /// The fraction of full gravity at time `t` (s).
     pub fn factor(&self, t: f64) -> f64 {
         if self.ramp_time > 0.0 {
-            (t / self.ramp_time).min(1.0)
+            ((t - self.start) / self.ramp_time).clamp(0.0, 1.0)
         } else {
             1.0
         }
@@ -106,7 +108,7 @@ pub struct StaticCheck {
     pub max_displacement: f64,
 }
 
-/// Settings fixed for the whole run.
+/// Settings fixed for the whole run (but for what a loading stage changes: gravity).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Settings {
     /// Update scheme.
@@ -179,6 +181,8 @@ pub struct LoadStage {
     /// Point loads it sets (carriers' and traction points'), by point id in ascending
     /// order (force: N; N/m in 2D, x y z).
     pub loads: Vec<(u32, [f64; 3])>,
+    /// Gravity it sets (its ramp starts with the stage).
+    pub gravity: Option<Gravity>,
     /// Zero every point's accumulated displacement when it begins (after a geostatic stage).
     pub reset_displacements: bool,
 }

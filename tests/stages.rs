@@ -62,3 +62,25 @@ fn a_stage_that_would_outrun_the_time_step_is_refused() {
         "{e}"
     );
 }
+
+/// `scenes/soil_column.ron` (elastic self-weight between rollers) with a second stage at
+/// twice the gravity, ramped over 1 s from the first stage's static state: the vertical
+/// stress at mid-height doubles, −2ρg(H − y) at the cell centre.
+#[test]
+fn a_stage_that_doubles_gravity_doubles_the_self_weight_stress() {
+    let stage =
+        r#"stages=[(name: "g"), (name: "2g", gravity: (acceleration: [0.0, -19.62], ramp_time: 1.0))]"#;
+    let s = run("soil_column.ron", &[stage]);
+    assert!(s.converged, "{:?}", s.error);
+    assert_eq!(s.stages.len(), 2);
+    // The ramp starts with the stage: it cannot end before a second has passed.
+    assert!(s.stages[1].time >= s.stages[0].time + 1.0, "{:?}", s.stages);
+    let mid = s.traced.iter().find(|t| t.name == "mid").unwrap();
+    let centre = (mid.initial_position[1] / 0.5).floor() * 0.5 + 0.25;
+    let sv = -1800.0 * 19.62 * (10.0 - centre);
+    assert!(
+        rel(mid.stress.yy, sv).abs() < 0.01,
+        "σv = {} vs {sv}",
+        mid.stress.yy
+    );
+}

@@ -192,7 +192,13 @@ fn stages(
             loads.extend(points.iter().map(|&(id, share)| (id, pad3(t).map(|c| c * share))));
         }
         loads.sort_by_key(|l| l.0);
+        let gravity = st.gravity.as_ref().map(|g| Gravity {
+            acceleration: pad3(&g.acceleration),
+            ramp_time: g.ramp_time,
+            start: 0.0,
+        });
         out.push(LoadStage {
+            gravity,
             name: st.name.clone(),
             materials,
             loads,
@@ -474,6 +480,7 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         gravity: s.gravity.as_ref().map(|g| Gravity {
             acceleration: pad3(&g.acceleration),
             ramp_time: g.ramp_time,
+            start: 0.0,
         }),
         min_node_mass: s.solver.node_mass_cutoff * full_node_mass,
         motions: s.motions.clone(),

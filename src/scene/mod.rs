@@ -159,6 +159,10 @@ pub struct StageSpec {
     /// Point loads' new forces, by name (N; N/m in 2D).
     #[serde(default, deserialize_with = "unique_keys")]
     pub point_loads: BTreeMap<String, Vec<f64>>,
+    /// Gravity from this stage on (its ramp starts with the stage); the scene must have
+    /// gravity.
+    #[serde(default)]
+    pub gravity: Option<GravitySpec>,
     /// Tractions' new values, by name (Pa).
     #[serde(default, deserialize_with = "unique_keys")]
     pub tractions: BTreeMap<String, Vec<f64>>,

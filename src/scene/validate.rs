@@ -844,6 +844,23 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
             len(&field, traction.len())?;
             finite(&field, traction, "Pa")?;
         }
+        if let Some(g) = &st.gravity {
+            if s.gravity.is_none() {
+                return bad(
+                    &format!("stages[{k}].gravity"),
+                    "the scene has no gravity: give it one (even [0, 0]) for a stage to change".into(),
+                );
+            }
+            len(&format!("stages[{k}].gravity.acceleration"), g.acceleration.len())?;
+            finite(
+                &format!("stages[{k}].gravity.acceleration"),
+                &g.acceleration,
+                "m/s²",
+            )?;
+            if !non_negative(g.ramp_time) {
+                return bad(&format!("stages[{k}].gravity.ramp_time"), "must be ≥ 0 s".into());
+            }
+        }
         if st.reset_displacements && !s.output.displacements {
             return bad(
                 &format!("stages[{k}].reset_displacements"),

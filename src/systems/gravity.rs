@@ -7,29 +7,22 @@ use crate::dim::Dim;
 use crate::error::StepError;
 use crate::parallel::{for_each_box_node, Disjoint};
 use crate::schedule::System;
-use crate::state::Gravity as GravitySpec;
-
-/// Adds m_i·g to every node. Since Σ_p w_ip m_p = m_i, this equals mapping each point's
-/// weight m_p·g, at the cost of a grid pass instead of a point pass.
-#[derive(Debug)]
-pub struct Gravity {
-    spec: GravitySpec,
-}
-
-impl Gravity {
-    /// Gravity as given by the scene.
-    pub fn new(spec: GravitySpec) -> Self {
-        Gravity { spec }
-    }
-}
+/// Adds m_i·g to every node, g from `Settings::gravity` (which a loading stage may change).
+/// Since Σ_p w_ip m_p = m_i, this equals mapping each point's weight m_p·g, at the cost of
+/// a grid pass instead of a point pass.
+#[derive(Debug, Default)]
+pub struct Gravity;
 
 impl<D: Dim> System<D> for Gravity {
     fn name(&self) -> &str {
         "gravity"
     }
     fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
-        let g = self.spec.step_factor(ctx.state.time, ctx.state.dt);
-        let a = self.spec.acceleration;
+        let Some(spec) = ctx.settings.gravity else {
+            return Ok(());
+        };
+        let g = spec.step_factor(ctx.state.time, ctx.state.dt);
+        let a = spec.acceleration;
         let gv = D::vec_from([a[0] * g, a[1] * g, a[2] * g]);
         let n = nodes(&ctx.world);
         let nm = col::<NodeMass>(n);

@@ -326,7 +326,7 @@ pub fn registry<D: Dim, S: Shape>() -> Vec<Entry<D>> {
                 ),
             ],
             "body force m_i g",
-            |s| Box::new(Gravity::new(s.gravity.expect("checked: the scene has gravity"))),
+            |_| Box::new(Gravity),
         ),
         e(
             "point_loads",
@@ -636,6 +636,7 @@ mod tests {
             gravity: gravity.then_some(G {
                 acceleration: [0.0, -9.81, 0.0],
                 ramp_time: 0.0,
+                start: 0.0,
             }),
             volumetric_smoothing: false,
             sort_every: 100,

@@ -1,6 +1,7 @@
 //! Loading stages: a scene's `stages` run one after another, each to the static stop; a
 //! stage changes materials (e.g. elastic soil for the geostatic state, then its
-//! Mohr-Coulomb strength) and point loads when it begins, and may zero the displacements.
+//! Mohr-Coulomb strength), gravity, point loads and tractions when it begins, and may zero
+//! the displacements.
 
 use crate::columns::{col, col_mut, points_with};
 use crate::components::*;
@@ -8,7 +9,7 @@ use crate::context::Context;
 use crate::dim::{Dim, Vector};
 use crate::error::StepError;
 use crate::schedule::System;
-use crate::state::{LoadStage, StageResult, StopReason};
+use crate::state::{Gravity, LoadStage, StageResult, StopReason};
 
 /// Moves to the next stage at each static state until the last: records the finished
 /// stage (`stages.csv`), applies the next one's changes and lets the run go on from the
@@ -19,7 +20,10 @@ pub struct Stages;
 
 /// Sets the materials and loads of `stage` (the whole of it: applying it twice is applying
 /// it once).
-fn apply<D: Dim>(ctx: &mut Context<D>, stage: &LoadStage) {
+fn apply<D: Dim>(ctx: &mut Context<D>, stage: &LoadStage, start: f64) {
+    if let Some(g) = stage.gravity {
+        ctx.settings.gravity = Some(Gravity { start, ..g });
+    }
     for (id, model) in &stage.materials {
         ctx.materials[*id as usize] = model.clone();
     }
@@ -45,8 +49,13 @@ impl<D: Dim> System<D> for Stages {
     fn prepare(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
         // The stages so far, in order (a resumed run starts inside one).
         let stages = ctx.settings.stages.clone();
-        for stage in &stages[..=ctx.state.stage.min(stages.len() - 1)] {
-            apply(ctx, stage);
+        for (k, stage) in stages[..=ctx.state.stage.min(stages.len() - 1)]
+            .iter()
+            .enumerate()
+        {
+            // A stage starts when the one before it ended.
+            let start = k.checked_sub(1).map_or(0.0, |j| ctx.state.stages[j].time);
+            apply(ctx, stage, start);
         }
         Ok(())
     }
@@ -77,7 +86,8 @@ impl<D: Dim> System<D> for Stages {
         s.previous_kinetic_energy = 0.0;
         s.earlier_kinetic_energy = 0.0;
         let stage = stages[s.stage].clone();
-        apply(ctx, &stage);
+        let start = ctx.state.time;
+        apply(ctx, &stage, start);
         if stage.reset_displacements {
             for arch in points_with::<Displacement<D::Vec>>(&ctx.world) {
                 col_mut::<Displacement<D::Vec>>(arch).fill(Displacement(D::Vec::ZERO));
