@@ -181,6 +181,8 @@ pub struct LoadStage {
     /// Point loads it sets (carriers' and traction points'), by point id in ascending
     /// order (force: N; N/m in 2D, x y z).
     pub loads: Vec<(u32, [f64; 3])>,
+    /// The face conditions it sets: each node's held axes (`NodeFixity` bits 0–2).
+    pub fixity: Option<Vec<u8>>,
     /// Gravity it sets (its ramp starts with the stage).
     pub gravity: Option<Gravity>,
     /// Zero every point's accumulated displacement when it begins (after a geostatic stage).

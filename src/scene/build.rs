@@ -2,7 +2,7 @@
 //! and the schedule. Only what the scene uses is created.
 
 use super::validate::{self, material_model, Checked, Derived};
-use super::{pad3, Condition, LoadedScene, MaterialSpec, Region, Scene};
+use super::{pad3, BoundarySpec, Condition, LoadedScene, MaterialSpec, Region, Scene};
 use crate::columns::{col, points_with};
 use crate::components::*;
 use crate::context::Context;
@@ -162,9 +162,29 @@ impl<I: Iterator> Iterator for Counted<I> {
 
 impl<I: Iterator> ExactSizeIterator for Counted<I> {}
 
+/// The held axes of every node under the face conditions `boundaries`.
+fn face_fixity<D: Dim>(grid: &Grid<D>, boundaries: &[BoundarySpec]) -> Vec<NodeFixity> {
+    let mut fixity = vec![NodeFixity(0); grid.node_count()];
+    for bc in boundaries {
+        let (axis, upper) = bc.face.axis_side();
+        let mask = match bc.condition {
+            Condition::Fixed => (1u8 << D::N) - 1,
+            Condition::Roller => 1u8 << axis,
+        };
+        let layer = if upper { grid.axes[axis].cells } else { 0 };
+        for (id, f) in fixity.iter_mut().enumerate() {
+            if grid.node_ijk(id)[axis] == layer {
+                f.0 |= mask;
+            }
+        }
+    }
+    fixity
+}
+
 /// The scene's stages with their materials built (indexed as `table`) and their loads by
 /// carrier id (`load_ids`).
-fn stages(
+fn stages<D: Dim>(
+    grid: &Grid<D>,
     loaded: &LoadedScene,
     table: &[(String, MaterialModel)],
     load_ids: &[(String, u32)],
@@ -198,6 +218,10 @@ fn stages(
             start: 0.0,
         });
         out.push(LoadStage {
+            fixity: st
+                .boundaries
+                .as_ref()
+                .map(|b| face_fixity(grid, b).into_iter().map(|f| f.0).collect()),
             gravity,
             name: st.name.clone(),
             materials,
@@ -232,20 +256,7 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
     let mut world = World::new();
 
     // Grid nodes, one archetype, spawned in id order.
-    let mut fixity = vec![NodeFixity(0); grid.node_count()];
-    for bc in &s.boundaries {
-        let (axis, upper) = bc.face.axis_side();
-        let mask = match bc.condition {
-            Condition::Fixed => (1u8 << n) - 1,
-            Condition::Roller => 1u8 << axis,
-        };
-        let layer = if upper { grid.axes[axis].cells } else { 0 };
-        for (id, f) in fixity.iter_mut().enumerate() {
-            if grid.node_ijk(id)[axis] == layer {
-                f.0 |= mask;
-            }
-        }
-    }
+    let fixity = face_fixity(&grid, &s.boundaries);
     let z = D::Vec::ZERO;
     world.spawn_batch(fixity.into_iter().map(|f| {
         (
@@ -484,7 +495,7 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         }),
         min_node_mass: s.solver.node_mass_cutoff * full_node_mass,
         motions: s.motions.clone(),
-        stages: stages(loaded, &table, &load_ids, &placed.shares)?,
+        stages: stages(&grid, loaded, &table, &load_ids, &placed.shares)?,
         load_steps: placed.steps,
         virtual_mass_floor: s.solver.virtual_mass_floor * full_node_mass,
     };

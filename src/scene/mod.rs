@@ -159,6 +159,10 @@ pub struct StageSpec {
     /// Point loads' new forces, by name (N; N/m in 2D).
     #[serde(default, deserialize_with = "unique_keys")]
     pub point_loads: BTreeMap<String, Vec<f64>>,
+    /// The face conditions from this stage on, replacing the scene's (nodes a motion drives
+    /// keep its axes).
+    #[serde(default)]
+    pub boundaries: Option<Vec<BoundarySpec>>,
     /// Gravity from this stage on (its ramp starts with the stage); the scene must have
     /// gravity.
     #[serde(default)]

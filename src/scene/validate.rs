@@ -1,7 +1,7 @@
 //! Rules a scene must satisfy before anything is built or written, and the figures derived
 //! from it.
 
-use super::{LoadedScene, MaterialSpec, Region, TimeStep};
+use super::{BoundarySpec, LoadedScene, MaterialSpec, Region, TimeStep};
 use crate::components::NodeFixity;
 use crate::error::SceneError;
 use crate::materials::{LinearElastic, Material, MaterialModel, MohrCoulomb};
@@ -305,6 +305,31 @@ pub(super) fn material_model(
     Ok(model)
 }
 
+/// Checks a list of face conditions (`field`: where it is in the scene): faces of the
+/// grid's dimension `n`, one condition a face.
+fn check_faces(list: &[BoundarySpec], field: &str, n: usize) -> Result<(), (String, String)> {
+    for (i, bc) in list.iter().enumerate() {
+        if bc.face.axis_side().0 >= n {
+            return Err((
+                format!("{field}[{i}].face"),
+                format!("{:?} does not exist in {n}D", bc.face),
+            ));
+        }
+        // One condition a face: two would leave the reader to guess which one holds.
+        if let Some(j) = list[..i].iter().position(|o| o.face == bc.face) {
+            return Err((
+                format!("{field}[{i}].face"),
+                format!(
+                    "{:?} already has a condition ({field}[{j}]): give each face one condition \
+                     (Fixed holds every component, Roller the normal one)",
+                    bc.face
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// Checks every rule that does not need the points.
 pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
     let s = &loaded.scene;
@@ -566,25 +591,7 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
             }
         }
     }
-    for (i, bc) in s.boundaries.iter().enumerate() {
-        if bc.face.axis_side().0 >= n {
-            return bad(
-                &format!("boundaries[{i}].face"),
-                format!("{:?} does not exist in {n}D", bc.face),
-            );
-        }
-        // One condition a face: two would leave the reader to guess which one holds.
-        if let Some(j) = s.boundaries[..i].iter().position(|o| o.face == bc.face) {
-            return bad(
-                &format!("boundaries[{i}].face"),
-                format!(
-                    "{:?} already has a condition (boundaries[{j}]): give each face one condition \
-                     (Fixed holds every component, Roller the normal one)",
-                    bc.face
-                ),
-            );
-        }
-    }
+    check_faces(&s.boundaries, "boundaries", n).map_err(|(field, rule)| loaded.invalid(&field, rule))?;
     if let Some(g) = &s.gravity {
         len("gravity.acceleration", g.acceleration.len())?;
         finite("gravity.acceleration", &g.acceleration, "m/s²")?;
@@ -843,6 +850,10 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
             }
             len(&field, traction.len())?;
             finite(&field, traction, "Pa")?;
+        }
+        if let Some(b) = &st.boundaries {
+            check_faces(b, &format!("stages[{k}].boundaries"), n)
+                .map_err(|(field, rule)| loaded.invalid(&field, rule))?;
         }
         if let Some(g) = &st.gravity {
             if s.gravity.is_none() {

@@ -3,7 +3,7 @@
 //! Mohr-Coulomb strength), gravity, point loads and tractions when it begins, and may zero
 //! the displacements.
 
-use crate::columns::{col, col_mut, points_with};
+use crate::columns::{col, col_mut, nodes, points_with};
 use crate::components::*;
 use crate::context::Context;
 use crate::dim::{Dim, Vector};
@@ -13,8 +13,9 @@ use crate::state::{Gravity, LoadStage, StageResult, StopReason};
 
 /// Moves to the next stage at each static state until the last: records the finished
 /// stage (`stages.csv`), applies the next one's changes and lets the run go on from the
-/// state reached. Its kinetic-damping record and external work start afresh, so that K_E
-/// measures the new stage's loading.
+/// state reached. Its kinetic-damping record starts afresh; the external work goes on
+/// accumulating, since a stage may release energy stored before it (a freed side, an
+/// unloading) rather than add any.
 #[derive(Debug, Default)]
 pub struct Stages;
 
@@ -23,6 +24,17 @@ pub struct Stages;
 fn apply<D: Dim>(ctx: &mut Context<D>, stage: &LoadStage, start: f64) {
     if let Some(g) = stage.gravity {
         ctx.settings.gravity = Some(Gravity { start, ..g });
+    }
+    if let Some(masks) = &stage.fixity {
+        let drives = &ctx.state.drives;
+        let mut fix = col_mut::<NodeFixity>(nodes(&ctx.world));
+        for (f, &mask) in fix.iter_mut().zip(masks) {
+            *f = match f.driver() {
+                // A motion's nodes keep its axes and its name.
+                Some(k) => NodeFixity::driven(mask | drives[k].axes, k),
+                None => NodeFixity(mask),
+            };
+        }
     }
     for (id, model) in &stage.materials {
         ctx.materials[*id as usize] = model.clone();
@@ -81,7 +93,6 @@ impl<D: Dim> System<D> for Stages {
         s.stage += 1;
         s.stop = None;
         s.static_window_start = None;
-        s.external_work = 0.0;
         s.kinetic_energy = 0.0;
         s.previous_kinetic_energy = 0.0;
         s.earlier_kinetic_energy = 0.0;
