@@ -1,13 +1,14 @@
 //! Load control: a load applied in equal increments, each relaxed by kinetic damping to its
 //! static state and recorded as a row of the load–displacement curve (`curve.csv`).
 
-use crate::columns::{col, col_mut, points_with};
+use crate::columns::{col, points_with};
 use crate::components::*;
 use crate::context::Context;
 use crate::dim::Dim;
 use crate::error::StepError;
 use crate::schedule::System;
 use crate::state::{CurvePoint, LoadSteps, StopReason};
+use crate::systems::point_loads::set_point_loads;
 
 /// Sets each incremental load to its present fraction before the first step and, at each
 /// static state, records the curve and raises the loads that have increments left.
@@ -18,19 +19,6 @@ use crate::state::{CurvePoint, LoadSteps, StopReason};
 /// load the body was seen to carry, the next increment one it did not.
 #[derive(Debug, Default)]
 pub struct LoadControl;
-
-/// Sets the point loads of `load` to `fraction` of their full value.
-fn set<D: Dim>(ctx: &Context<D>, load: &LoadSteps, fraction: f64) {
-    for arch in points_with::<PointLoad<D::Vec>>(&ctx.world) {
-        let ids = col::<PointId>(arch);
-        let mut f = col_mut::<PointLoad<D::Vec>>(arch);
-        for (id, f) in ids.iter().zip(f.iter_mut()) {
-            if let Ok(k) = load.points.binary_search_by_key(&id.0, |p| p.0) {
-                f.0 = D::vec_from(load.points[k].1.map(|c| c * fraction));
-            }
-        }
-    }
-}
 
 /// Mean displacement of the loaded points along the load (m).
 fn settlement<D: Dim>(ctx: &Context<D>, load: &LoadSteps) -> f64 {
@@ -66,7 +54,7 @@ impl<D: Dim> System<D> for LoadControl {
         ctx.state.load_increments.resize(n, 0);
         for (load, &done) in ctx.settings.load_steps.iter().zip(&ctx.state.load_increments) {
             let k = (done + 1).min(load.increments);
-            set(ctx, load, k as f64 / load.increments as f64);
+            set_point_loads(ctx, &load.points, k as f64 / load.increments as f64);
         }
         Ok(())
     }
@@ -99,7 +87,7 @@ impl<D: Dim> System<D> for LoadControl {
             s.load_increments[k] = done + 1;
             s.milestone = true;
             if done + 1 < load.increments {
-                set(ctx, load, (done + 2) as f64 / load.increments as f64);
+                set_point_loads(ctx, &load.points, (done + 2) as f64 / load.increments as f64);
                 more = true;
             }
         }

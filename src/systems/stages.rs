@@ -3,13 +3,14 @@
 //! Mohr-Coulomb strength), gravity, point loads and tractions when it begins, and may zero
 //! the displacements.
 
-use crate::columns::{col, col_mut, nodes, points_with};
+use crate::columns::{col_mut, nodes, points_with};
 use crate::components::*;
 use crate::context::Context;
 use crate::dim::{Dim, Vector};
 use crate::error::StepError;
 use crate::schedule::System;
 use crate::state::{Gravity, LoadStage, StageResult, StopReason};
+use crate::systems::point_loads::set_point_loads;
 
 /// Moves to the next stage at each static state until the last: records the finished
 /// stage (`stages.csv`), applies the next one's changes and lets the run go on from the
@@ -39,18 +40,7 @@ fn apply<D: Dim>(ctx: &mut Context<D>, stage: &LoadStage, start: f64) {
     for (id, model) in &stage.materials {
         ctx.materials[*id as usize] = model.clone();
     }
-    if stage.loads.is_empty() {
-        return;
-    }
-    for arch in points_with::<PointLoad<D::Vec>>(&ctx.world) {
-        let ids = col::<PointId>(arch);
-        let mut f = col_mut::<PointLoad<D::Vec>>(arch);
-        for (id, f) in ids.iter().zip(f.iter_mut()) {
-            if let Ok(k) = stage.loads.binary_search_by_key(&id.0, |l| l.0) {
-                f.0 = D::vec_from(stage.loads[k].1);
-            }
-        }
-    }
+    set_point_loads(ctx, &stage.loads, 1.0);
 }
 
 impl<D: Dim> System<D> for Stages {
