@@ -45,6 +45,7 @@ impl<D: Dim> System<D> for Integrate {
         // Plain slices: the column guards cannot be shared with the pool.
         let (nm, np, nf, fix) = (&*nm, &*np, &*nf, &*fix);
         let drives = &ctx.state.drives[..];
+        let driven = !drives.is_empty();
         let mut na = col_mut::<NodeAcceleration<D::Vec>>(n);
         let mut nv = col_mut::<NodeVelocity<D::Vec>>(n);
         let grid = &ctx.grid;
@@ -66,8 +67,10 @@ impl<D: Dim> System<D> for Integrate {
                 }
                 let mut a = f * (1.0 / grid.inertia(i, m, floor));
                 let mut v = np[i].0 * (1.0 / m) + a * dt;
-                if fix[i].0 != 0 {
-                    // Held components stay held whatever the damping force did.
+                if driven && fix[i].0 != 0 {
+                    // A driven component's momentum is m·v̄, so viscous damping would pull
+                    // it off v̄: held components stay held. (A fixed component has no
+                    // momentum and no force here, so it stays at zero without this.)
                     constrain(&mut v, fix[i], D::N, drives);
                     constrain(&mut a, NodeFixity(fix[i].0 & 0b111), D::N, drives);
                 }
