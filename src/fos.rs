@@ -18,7 +18,7 @@ use crate::dim::Dim;
 use crate::error::SceneError;
 use crate::measure::max_displacements;
 use crate::output::dir::write_atomic;
-use crate::output::{OutputDir, Recorder};
+use crate::output::{Outcome, OutputDir, Recorder};
 use crate::scene::{build, LoadedScene, MaterialSpec, StrengthReductionSpec};
 use crate::simulation::Simulation;
 use crate::state::StopReason;
@@ -35,8 +35,8 @@ pub struct Trial {
     pub factor: f64,
     /// True when the trial found no static state.
     pub failed: bool,
-    /// How the run ended (summary.json's `outcome`).
-    pub outcome: String,
+    /// How the run ended.
+    pub outcome: Outcome,
     /// The largest point displacement at the end (m).
     pub max_displacement: f64,
     /// Steps taken.
@@ -204,7 +204,7 @@ fn run_trial(
             .map_err(|e| FosError::Output(path.clone(), e))?;
         Ok(Trial {
             factor,
-            failed: outcome != "converged" || max_u > spec.failure_displacement,
+            failed: outcome != Outcome::Converged || max_u > spec.failure_displacement,
             outcome,
             max_displacement: max_u,
             steps,
@@ -221,7 +221,7 @@ fn trial_run<D: Dim>(
     spec: &StrengthReductionSpec,
     dir: &OutputDir,
     start: Instant,
-) -> std::io::Result<(u64, String, f64)> {
+) -> std::io::Result<(u64, Outcome, f64)> {
     let output = &scene.scene.output;
     let recorder = Recorder::attach(sim, dir, output.history_every, output.snapshots, None)?;
     let (every, limit) = (spec.check_every, spec.failure_displacement);
@@ -238,11 +238,11 @@ fn trial_run<D: Dim>(
     let error = result.err().map(|e| e.to_string());
     let wall = start.elapsed().as_secs_f64();
     let (summary, _) = recorder.finish(sim, dir, &scene.path.display().to_string(), wall, error)?;
-    let outcome = serde_json::to_value(summary.outcome)
-        .ok()
-        .and_then(|v| v.as_str().map(str::to_string))
-        .unwrap_or_default();
-    Ok((summary.steps, outcome, summary.max_displacement.unwrap_or(0.0)))
+    Ok((
+        summary.steps,
+        summary.outcome,
+        summary.max_displacement.unwrap_or(0.0),
+    ))
 }
 
 /// `fos.csv`, `fos.svg` and `summary.json` of the analysis.
@@ -255,7 +255,13 @@ fn write_report(fos: &FosReport, out: &Path) -> std::io::Result<()> {
             writeln!(
                 w,
                 "{},{},{},{:.9e},{},{:.3},{}",
-                t.factor, t.failed, t.outcome, t.max_displacement, t.steps, t.wall_seconds, t.dir
+                t.factor,
+                t.failed,
+                t.outcome.name(),
+                t.max_displacement,
+                t.steps,
+                t.wall_seconds,
+                t.dir
             )?;
         }
         Ok(())

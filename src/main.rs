@@ -187,6 +187,15 @@ fn main() -> ExitCode {
     }
 }
 
+/// The output directory when none is given: `out/<prefix><file stem>` (`fallback` for a
+/// path without a stem).
+fn default_out(path: &Path, prefix: &str, fallback: &str) -> PathBuf {
+    let stem = path
+        .file_stem()
+        .map_or(fallback.into(), |s| s.to_string_lossy().into_owned());
+    Path::new("out").join(format!("{prefix}{stem}"))
+}
+
 /// Sizes the global thread pool when `--threads` is given.
 fn start_threads(threads: Option<std::num::NonZeroUsize>) -> Result<(), ExitCode> {
     if let Some(n) = threads {
@@ -269,10 +278,7 @@ fn run(path: &Path, out: Option<PathBuf>, overrides: &[String], profile: bool, q
                 return ExitCode::from(BAD_INPUT);
             }
         };
-    let stem = path
-        .file_stem()
-        .map_or("scene".into(), |s| s.to_string_lossy().into_owned());
-    let out = out.unwrap_or_else(|| Path::new("out").join(&stem));
+    let out = out.unwrap_or_else(|| default_out(path, "", "scene"));
     let dir = match OutputDir::claim(&out) {
         Ok(d) => d,
         Err(e) => {
@@ -480,17 +486,14 @@ fn run_fos(path: &Path, out: Option<PathBuf>, overrides: &[String], quiet: bool)
             return ExitCode::from(BAD_INPUT);
         }
     };
-    let stem = path
-        .file_stem()
-        .map_or("scene".into(), |s| s.to_string_lossy().into_owned());
-    let out = out.unwrap_or_else(|| Path::new("out").join(format!("fos-{stem}")));
+    let out = out.unwrap_or_else(|| default_out(path, "fos-", "scene"));
     let result = kdmpm::fos::strength_reduction(&loaded, &out, |t| {
         if !quiet {
             eprintln!(
                 "F = {:.4}: {} ({}), largest displacement {:.3e} m, {} steps, {:.1} s",
                 t.factor,
                 if t.failed { "fails" } else { "stands" },
-                t.outcome,
+                t.outcome.name(),
                 t.max_displacement,
                 t.steps,
                 t.wall_seconds
@@ -560,10 +563,7 @@ fn run_study(
             return ExitCode::from(BAD_INPUT);
         }
     };
-    let stem = path
-        .file_stem()
-        .map_or("study".into(), |s| s.to_string_lossy().into_owned());
-    let out = out.unwrap_or_else(|| Path::new("out").join(format!("study-{stem}")));
+    let out = out.unwrap_or_else(|| default_out(path, "study-", "study"));
     let dir = match OutputDir::claim(&out) {
         Ok(d) => d,
         Err(e) => {

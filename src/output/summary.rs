@@ -126,6 +126,20 @@ pub enum Outcome {
     Failed,
 }
 
+impl Outcome {
+    /// The name `summary.json` writes (`fos.csv` too).
+    pub fn name(self) -> &'static str {
+        match self {
+            Outcome::Converged => "converged",
+            Outcome::MaxSteps => "max_steps",
+            Outcome::MaxTime => "max_time",
+            Outcome::DisplacementLimit => "displacement_limit",
+            Outcome::Interrupted => "interrupted",
+            Outcome::Failed => "failed",
+        }
+    }
+}
+
 /// A ratio K_F or K_E: its value, or `"undefined"` where its denominator was zero.
 fn ratio<S: serde::Serializer>(r: &f64, s: S) -> Result<S::Ok, S::Error> {
     if is_defined(*r) {
@@ -232,4 +246,24 @@ pub fn peak_memory_bytes() -> Option<u64> {
     let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
     let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
     Some(kib * 1024)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Outcome;
+
+    #[test]
+    fn outcome_names_are_the_ones_summary_json_writes() {
+        use Outcome::*;
+        for o in [
+            Converged,
+            MaxSteps,
+            MaxTime,
+            DisplacementLimit,
+            Interrupted,
+            Failed,
+        ] {
+            assert_eq!(serde_json::to_value(o).unwrap(), o.name());
+        }
+    }
 }
