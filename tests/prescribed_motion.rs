@@ -3,9 +3,7 @@
 
 mod common;
 
-use common::{rel, run};
-use kdmpm::scene::{build, LoadedScene};
-use std::path::Path;
+use common::{refusal, rel, run, run_text};
 
 /// An elastic column between rollers, its top pushed down by δ = 1 mm in one increment:
 /// the static state is uniaxial strain ε = δ/H, σ_yy = −M δ/H with
@@ -24,12 +22,7 @@ const COLUMN: &str = r#"Scene(
 
 #[test]
 fn a_column_pushed_down_by_its_top_carries_m_delta_over_h() {
-    let loaded = LoadedScene::from_text(Path::new("column.ron"), COLUMN, &[]).expect("scene loads");
-    let (mut sim, _) = build(&loaded).expect("scene builds");
-    let summary = kdmpm::with_simulation!(&mut sim, s => {
-        let result = s.run(|_| {});
-        kdmpm::output::Summary::collect("column", s, 0.0, result.err().map(|e| e.to_string()))
-    });
+    let summary = run_text("column.ron", COLUMN);
     assert!(summary.converged, "{:?}", summary.error);
     let (e, nu, delta, h) = (1.0e7, 0.3, 0.001, 4.0);
     let m = e * (1.0 - nu) / ((1.0 + nu) * (1.0 - 2.0 * nu));
@@ -69,15 +62,13 @@ fn a_column_pushed_down_by_its_top_carries_m_delta_over_h() {
 #[test]
 fn a_motion_moving_sideways_off_its_axes_is_refused() {
     let bad = COLUMN.replace("velocity: [None, Some(-0.001)]", "velocity: [None, None]");
-    let loaded = LoadedScene::from_text(Path::new("column.ron"), &bad, &[]).expect("scene parses");
-    let e = build(&loaded).err().expect("refused").to_string();
+    let e = refusal(&bad);
     assert!(
         e.contains("motions[0].velocity") && e.contains("must move"),
         "{e}"
     );
     let bad = COLUMN.replace("travel: 0.001", "travel: 0.001, increment: 0.002");
-    let loaded = LoadedScene::from_text(Path::new("column.ron"), &bad, &[]).expect("scene parses");
-    let e = build(&loaded).err().expect("refused").to_string();
+    let e = refusal(&bad);
     assert!(e.contains("motions[0].increment"), "{e}");
 }
 

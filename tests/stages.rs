@@ -2,7 +2,7 @@
 
 mod common;
 
-use common::{rel, run};
+use common::{rel, run, run_text};
 
 /// The bar (the paper's example 1, linear elastic) loaded with F = 0.001 and then, in a
 /// second stage, 0.002: the second static state is the analytic one for 0.002,
@@ -107,23 +107,14 @@ fn a_stage_that_frees_a_side_ends_where_a_run_under_the_final_conditions_does() 
         traced: [(name: "mid", position: [0.375, 1.875])],
         solver: (time_step: Courant(0.5), tolerance: 1e-5, max_time: 60.0),
     )"#;
-    let run_text = |text: &str| {
-        let loaded =
-            kdmpm::scene::LoadedScene::from_text(std::path::Path::new("free.ron"), text, &[]).unwrap();
-        let (mut sim, _) = kdmpm::scene::build(&loaded).unwrap();
-        kdmpm::with_simulation!(&mut sim, s => {
-            let result = s.run(|_| {});
-            kdmpm::output::Summary::collect("free", s, 0.0, result.err().map(|e| e.to_string()))
-        })
-    };
-    let staged = run_text(text);
+    let staged = run_text("free.ron", text);
     let a = text.find("        stages: [").unwrap();
     let b = a + text[a..].find("        ],\n").unwrap() + "        ],\n".len();
     let direct = format!("{}{}", &text[..a], &text[b..]).replace(
         "(face: XMin, condition: Roller), (face: XMax, condition: Roller), (face: YMin, condition: Fixed)",
         "(face: XMin, condition: Roller), (face: YMin, condition: Roller)",
     );
-    let direct = run_text(&direct);
+    let direct = run_text("free.ron", &direct);
     assert!(
         staged.converged && direct.converged,
         "{:?} {:?}",

@@ -2,19 +2,7 @@
 
 mod common;
 
-use common::rel;
-use kdmpm::output::Summary;
-use kdmpm::scene::{build, LoadedScene};
-use std::path::Path;
-
-fn run(text: &str) -> Summary {
-    let loaded = LoadedScene::from_text(Path::new("traction.ron"), text, &[]).expect("scene loads");
-    let (mut sim, _) = build(&loaded).expect("scene builds");
-    kdmpm::with_simulation!(&mut sim, s => {
-        let result = s.run(|_| {});
-        Summary::collect("traction", s, 0.0, result.err().map(|e| e.to_string()))
-    })
-}
+use common::{refusal, rel, run_text};
 
 /// An elastic column between rollers under a uniform pressure p = 10 kPa on its top:
 /// uniaxial strain, σ_yy = −p throughout and a settlement of p y/M at height y, with
@@ -37,7 +25,7 @@ fn m(e: f64, nu: f64) -> f64 {
 
 #[test]
 fn a_pressure_on_a_plane_strain_column_gives_its_stress_and_settlement() {
-    let s = run(COLUMN_2D);
+    let s = run_text("traction.ron", COLUMN_2D);
     assert!(s.converged, "{:?}", s.error);
     let (p, m) = (10.0e3, m(1.0e7, 0.3));
     // Inside the column; the loaded points themselves carry only part of the load in
@@ -74,7 +62,7 @@ fn a_pressure_on_a_3d_column_gives_its_stress() {
         traced: [(name: "mid", position: [0.375, 0.375, 1.875])],
         solver: (time_step: Courant(0.5), tolerance: 1e-5, max_time: 60.0),
     )"#;
-    let s = run(text);
+    let s = run_text("traction.ron", text);
     assert!(s.converged, "{:?}", s.error);
     let t = &s.traced[0];
     assert!(rel(t.stress.zz, -10.0e3).abs() < 0.01, "σ_zz {}", t.stress.zz);
@@ -92,8 +80,7 @@ fn a_traction_whose_box_holds_no_point_is_refused() {
         "min: [0.0, 3.5], max: [1.0, 4.0]",
         "min: [2.0, 3.5], max: [3.0, 4.0]",
     );
-    let loaded = LoadedScene::from_text(Path::new("traction.ron"), &bad, &[]).unwrap();
-    let e = build(&loaded).err().expect("refused").to_string();
+    let e = refusal(&bad);
     assert!(e.contains("tractions[0].min") && e.contains("no point"), "{e}");
 }
 
@@ -126,7 +113,7 @@ fn a_stage_that_doubles_the_pressure_doubles_the_stress_and_settlement() {
         r#"    stages: [(name: "first"), (name: "doubled", tractions: {"p": [0.0, -20.0e3]})],
     traced:"#,
     );
-    let s = run(&staged);
+    let s = run_text("traction.ron", &staged);
     assert!(s.converged, "{:?}", s.error);
     assert_eq!(s.stages.len(), 2);
     let mid = &s.traced[0];

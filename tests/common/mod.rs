@@ -15,7 +15,23 @@ pub fn scene(name: &str) -> std::path::PathBuf {
 pub fn run(name: &str, overrides: &[&str]) -> Summary {
     let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
     let loaded = LoadedScene::from_file(&scene(name), &overrides).expect("scene loads");
-    let (mut sim, _) = build(&loaded).expect("scene builds");
+    run_loaded(name, &loaded)
+}
+
+/// Runs the scene `text` (called `name` in messages) to its stop and returns the summary.
+pub fn run_text(name: &str, text: &str) -> Summary {
+    let loaded = LoadedScene::from_text(Path::new(name), text, &[]).expect("scene loads");
+    run_loaded(name, &loaded)
+}
+
+/// The error that building the scene `text` gives.
+pub fn refusal(text: &str) -> String {
+    let loaded = LoadedScene::from_text(Path::new("refused.ron"), text, &[]).expect("scene parses");
+    build(&loaded).err().expect("refused").to_string()
+}
+
+fn run_loaded(name: &str, loaded: &LoadedScene) -> Summary {
+    let (mut sim, _) = build(loaded).expect("scene builds");
     with_simulation!(&mut sim, s => {
         let start = std::time::Instant::now();
         let result = s.run(|_| {});
