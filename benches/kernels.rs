@@ -3,7 +3,7 @@
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use kdmpm::lanes::LANES;
-use kdmpm::materials::{Material, MohrCoulomb};
+use kdmpm::materials::{Material, MohrCoulomb, PlasticStrain};
 use kdmpm::scene::{build, LoadedScene};
 use kdmpm::shape::QuadraticBSpline;
 use kdmpm::systems::{Convergence, G2p, GridReset, P2g, P2gPart};
@@ -61,8 +61,8 @@ fn kernels(c: &mut Criterion) {
     c.bench_function("Mohr-Coulomb update (plastic, plane strain)", |b| {
         b.iter(|| {
             let mut s = std::hint::black_box(start);
-            let mut eps = 0.0;
-            mc.update(&mut s, &de, Some(&mut eps));
+            let mut eps = PlasticStrain(0.0);
+            mc.update(&mut s, &de, &mut eps);
             (s, eps)
         })
     });
@@ -76,9 +76,9 @@ fn kernels(c: &mut Criterion) {
     c.bench_function("Mohr-Coulomb update (4 elastic points, one by one)", |b| {
         b.iter(|| {
             let mut s = std::hint::black_box(at_rest);
-            let mut eps = [0.0; LANES];
+            let mut eps = [PlasticStrain(0.0); LANES];
             for (s, eps) in s.iter_mut().zip(&mut eps) {
-                mc.update(s, &de, Some(eps));
+                mc.update(s, &de, eps);
             }
             (s, eps)
         })
@@ -87,8 +87,8 @@ fn kernels(c: &mut Criterion) {
     c.bench_function("Mohr-Coulomb update (4 elastic points, in lanes)", |b| {
         b.iter(|| {
             let mut s = std::hint::black_box(at_rest4);
-            let mut eps = [0.0; LANES];
-            mc.update4(&mut s, &de4, Some(eps.each_mut()));
+            let mut eps = [PlasticStrain(0.0); LANES];
+            mc.update4(&mut s, &de4, eps.each_mut());
             (s, eps)
         })
     });

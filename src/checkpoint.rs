@@ -26,7 +26,7 @@ use thiserror::Error;
 /// The first bytes of a checkpoint file.
 const MAGIC: &[u8; 8] = b"KDMPMCK\0";
 /// Format version; a file of another version is refused.
-const VERSION: u32 = 5;
+const VERSION: u32 = 6;
 /// The file's name in an output directory.
 pub const FILE_NAME: &str = "checkpoint.kdc";
 
@@ -79,19 +79,22 @@ pub fn encode<D: Dim>(sim: &Simulation<D>, header: &Header) -> Vec<u8> {
     w.u64(archs.len() as u64);
     for arch in archs {
         w.u64(arch.len() as u64);
+        // The archetype's columns by name: a column is found again by its type, so the
+        // list of point components (and of the materials' states) may grow.
+        macro_rules! count {
+            ($($t:ty),*) => { 0 $(+ arch.has::<$t>() as u64)* };
+        }
+        w.u64(point_components!(D, count));
         macro_rules! save {
             ($($t:ty),*) => {$(
-                match arch.get::<&$t>() {
-                    Some(c) => {
-                        w.u8(1);
-                        // SAFETY: every point component is a plain struct of f64, u32 or u16
-                        // fields without padding (`point_components_have_no_padding`), so each
-                        // of its bytes is initialised.
-                        let bytes = unsafe { as_bytes(&c) };
-                        w.u64(bytes.len() as u64);
-                        w.0.extend_from_slice(bytes);
-                    }
-                    None => w.u8(0),
+                if let Some(c) = arch.get::<&$t>() {
+                    w.str(std::any::type_name::<$t>());
+                    // SAFETY: every point component is a plain struct of f64, u32 or u16
+                    // fields without padding (`point_components_have_no_padding`, and the
+                    // `Pod` bound of a material's state), so each of its bytes is initialised.
+                    let bytes = unsafe { as_bytes(&c) };
+                    w.u64(bytes.len() as u64);
+                    w.0.extend_from_slice(bytes);
                 }
             )*};
         }
@@ -126,29 +129,38 @@ pub fn restore<D: Dim>(
         if r.u64()? != arch.len() as u64 {
             return Err(r.fault("a point archetype's row count differs from the saved one".into()));
         }
+        let columns = r.u64()?;
+        let mut saved = Vec::new();
+        for _ in 0..columns {
+            let name = r.str()?;
+            let n = r.u64()? as usize;
+            saved.push((name, r.take(n)?));
+        }
         macro_rules! load {
             ($($t:ty),*) => {$(
-                let saved = r.u8()? == 1;
-                match arch.get::<&mut $t>() {
-                    Some(mut c) if saved => {
-                        let n = r.u64()? as usize;
-                        let src = r.take(n)?;
-                        if n != std::mem::size_of_val(&*c) {
-                            return Err(r.fault(format!("column {} has another length", stringify!($t))));
-                        }
-                        // SAFETY: `c` is exactly `n` bytes long (checked above) and its type is a
-                        // plain struct of f64, u32 or u16 fields without padding, for which every
-                        // bit pattern is a valid value; `src` is a distinct allocation.
-                        unsafe {
-                            std::ptr::copy_nonoverlapping(src.as_ptr(), c.as_mut_ptr().cast::<u8>(), n)
-                        };
+                if let Some(mut c) = arch.get::<&mut $t>() {
+                    let name = std::any::type_name::<$t>();
+                    let at = saved
+                        .iter()
+                        .position(|(s, _)| s == name)
+                        .ok_or_else(|| r.fault(format!("column {name} is not saved")))?;
+                    let (_, src) = saved.swap_remove(at);
+                    if src.len() != std::mem::size_of_val(&*c) {
+                        return Err(r.fault(format!("column {name} has another length")));
                     }
-                    None if !saved => {}
-                    _ => return Err(r.fault(format!("column {} is not in both", stringify!($t)))),
+                    // SAFETY: `c` is exactly `src.len()` bytes long (checked above) and its
+                    // type is a plain struct of f64, u32 or u16 fields without padding, for
+                    // which every bit pattern is a valid value; `src` is a distinct allocation.
+                    unsafe {
+                        std::ptr::copy_nonoverlapping(src.as_ptr(), c.as_mut_ptr().cast::<u8>(), src.len())
+                    };
                 }
             )*};
         }
         point_components!(D, load);
+        if let Some((name, _)) = saved.first() {
+            return Err(r.fault(format!("column {name} is saved but the scene's points lack it")));
+        }
     }
     if r.at != bytes.len() {
         return Err(r.fault("bytes left after the last column".into()));
@@ -406,7 +418,7 @@ mod tests {
         fn fields<D: Dim>() -> Vec<usize> {
             let (v, m) = (8 * D::N, 8 * D::N * D::N);
             let s = if D::N == 2 { 32 } else { 48 };
-            vec![v, v, v, v, m, 8, 8, s, 2, 8, 4]
+            vec![v, v, v, v, m, 8, 8, s, 2, 4]
         }
         fn sizes<D: Dim>() -> Vec<usize> {
             macro_rules! size {
@@ -414,7 +426,9 @@ mod tests {
             }
             point_components!(D, size)
         }
-        assert_eq!(sizes::<Dim2>(), fields::<Dim2>());
-        assert_eq!(sizes::<Dim3>(), fields::<Dim3>());
+        // The fixed columns; the materials' states that follow them are `bytemuck::Pod`
+        // (a bound of `MaterialState`), which rules out padding.
+        assert_eq!(sizes::<Dim2>()[..10], fields::<Dim2>());
+        assert_eq!(sizes::<Dim3>()[..10], fields::<Dim3>());
     }
 }

@@ -2,9 +2,9 @@
 //!
 //! Material points and grid nodes are entities of one `hecs::World`. Each component below is
 //! one column; systems borrow whole columns of an archetype as plain slices
-//! ([`columns`](crate::columns)). A point carries only what its material and loads need: a
-//! [`PlasticStrain`] column exists only for plastic materials, a [`PointLoad`] only on points
-//! that carry a load. Grid nodes all share one archetype, spawned in id order, so a node
+//! ([`columns`](crate::columns)). A point carries only what its material and loads need: its
+//! material's state column ([`crate::materials::Material::State`]) only where the model has
+//! state, a [`PointLoad`] only on points that carry a load. Grid nodes all share one archetype, spawned in id order, so a node
 //! column slice is indexed by node id.
 
 /// Current position of a material point (m).
@@ -59,10 +59,6 @@ impl PointId {
 /// Index of the point's material in the simulation's material table.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct MaterialId(pub u16);
-
-/// Accumulated equivalent plastic strain (dimensionless); only on plastic points.
-#[derive(Clone, Copy, Debug, PartialEq, Default)]
-pub struct PlasticStrain(pub f64);
 
 /// A concentrated force carried by a point, applied to the grid each step (N).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -129,11 +125,22 @@ impl NodeFixity {
 
 /// Calls macro `$mac` with the list of every component type a point can carry in dimension
 /// `$d`: the one list that the spatial sort (which moves them all) and checkpoints (which
-/// save them all) work from. A new point component is added here.
+/// save them all) work from. A new point component is added here; the materials' state
+/// columns come from the material registry ([`materials!`](crate::materials!)).
 #[macro_export]
 #[doc(hidden)]
 macro_rules! point_components {
     ($d:ty, $mac:ident) => {
+        $crate::materials!([$crate::point_components_and_states] [$d, $mac])
+    };
+}
+
+/// [`point_components!`] with the registry's materials: the fixed columns, then each
+/// material's state (`()`, which no point carries, for a model without state).
+#[macro_export]
+#[doc(hidden)]
+macro_rules! point_components_and_states {
+    ([$d:ty, $mac:ident] $($variant:ident($spec:ty)),* $(,)?) => {
         $mac!(
             Position<<$d as Dim>::Vec>,
             Velocity<<$d as Dim>::Vec>,
@@ -144,8 +151,8 @@ macro_rules! point_components {
             Volume,
             Stress<<$d as Dim>::Stress>,
             MaterialId,
-            PlasticStrain,
             PointId
+            $(, <<$spec as $crate::materials::SceneMaterial>::Model as $crate::materials::Material>::State)*
         )
     };
 }

@@ -19,7 +19,7 @@ use crate::error::SceneError;
 use crate::measure::max_displacements;
 use crate::output::dir::write_atomic;
 use crate::output::{Outcome, OutputDir, Recorder};
-use crate::scene::{build, LoadedScene, MaterialSpec, StrengthReductionSpec};
+use crate::scene::{build, LoadedScene, StrengthReductionSpec};
 use crate::simulation::Simulation;
 use crate::state::StopReason;
 use crate::with_simulation;
@@ -85,26 +85,12 @@ pub enum FosError {
     Output(PathBuf, std::io::Error),
 }
 
-/// The scene with every Mohr-Coulomb strength divided by `factor`.
+/// The scene with the strength of every material that has one divided by `factor`
+/// ([`crate::materials::SceneMaterial::reduce_strength`]).
 pub fn reduced(loaded: &LoadedScene, factor: f64) -> LoadedScene {
     let mut l = loaded.clone();
-    let reduce = |deg: f64| (deg.to_radians().tan() / factor).atan().to_degrees();
     for m in l.scene.materials.values_mut() {
-        if let MaterialSpec::MohrCoulomb {
-            cohesion,
-            friction_angle,
-            dilatancy_angle,
-            tension_cutoff,
-            ..
-        } = m
-        {
-            *cohesion /= factor;
-            *friction_angle = reduce(*friction_angle);
-            *dilatancy_angle = reduce(*dilatancy_angle);
-            if let Some(t) = tension_cutoff {
-                *t /= factor;
-            }
-        }
+        m.reduce_strength(factor);
     }
     l
 }
@@ -126,10 +112,11 @@ pub fn strength_reduction(
         .scene
         .materials
         .values()
-        .any(|m| matches!(m, MaterialSpec::MohrCoulomb { .. }))
+        .any(|m| m.clone().reduce_strength(1.0))
     {
         return Err(FosError::NotAnAnalysis(format!(
-            "{}: no Mohr-Coulomb material: there is no strength to reduce",
+            "{}: no material with a strength (such as MohrCoulomb): there is no strength \
+             to reduce",
             loaded.path.display()
         )));
     }

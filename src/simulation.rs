@@ -1,6 +1,6 @@
 //! A simulation: the ECS world, grid, materials and solver state, stepped by a schedule.
 
-use crate::columns::{col, points_with};
+use crate::columns::{col, first_non_finite_state, points_with};
 use crate::components::*;
 use crate::context::Context;
 use crate::dim::{Dim, Dim2, Dim3};
@@ -168,10 +168,8 @@ impl<D: Dim> Simulation<D> {
                     return bad("volume", r);
                 }
             }
-            if let Some(e) = arch.get::<&PlasticStrain>() {
-                if let Some(r) = e.iter().position(|e| !e.0.is_finite()) {
-                    return bad("plastic strain", r);
-                }
+            if let Some(r) = first_non_finite_state(arch) {
+                return bad("material state", r);
             }
         }
         None

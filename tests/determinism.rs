@@ -3,7 +3,8 @@
 //! the scatters share their grouping of points or group them anew.
 
 use kdmpm::columns::{col, points_with};
-use kdmpm::components::{PlasticStrain, Position, Stress, Velocity};
+use kdmpm::components::{Position, Stress, Velocity};
+use kdmpm::materials::PlasticStrain;
 use kdmpm::scene::{build, LoadedScene};
 use kdmpm::tensor::{PlanarSym3, StoredSym};
 use kdmpm::{AnySimulation, Context, Dim2, FnSystem, StepError};

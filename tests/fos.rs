@@ -3,6 +3,7 @@
 mod common;
 
 use kdmpm::fos::{reduced, strength_reduction};
+use kdmpm::materials::MohrCoulombSpec;
 use kdmpm::scene::{LoadedScene, MaterialSpec};
 
 fn slope() -> LoadedScene {
@@ -12,12 +13,12 @@ fn slope() -> LoadedScene {
 #[test]
 fn strength_reduction_divides_cohesion_and_the_tangents_of_the_angles() {
     let l = reduced(&slope(), 1.5);
-    let MaterialSpec::MohrCoulomb {
+    let MaterialSpec::MohrCoulomb(MohrCoulombSpec {
         cohesion,
         friction_angle,
         dilatancy_angle,
         ..
-    } = l.scene.materials["soil"]
+    }) = l.scene.materials["soil"]
     else {
         panic!("Mohr-Coulomb soil")
     };

@@ -4,7 +4,8 @@
 //! uses; 2D scenes store 2-vectors and the four stress components of plane strain.
 
 use kdmpm::columns::points_with;
-use kdmpm::components::{PlasticStrain, PointLoad, Position, Stress};
+use kdmpm::components::{PointLoad, Position, Stress};
+use kdmpm::materials::PlasticStrain;
 use kdmpm::scene::{build, LoadedScene};
 use kdmpm::tensor::{PlanarSym3, Sym3};
 use kdmpm::{AnySimulation, Dim2, Dim3};

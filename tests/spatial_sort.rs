@@ -6,6 +6,7 @@
 use glam::{DMat2, DVec2};
 use kdmpm::columns::{col, points_with};
 use kdmpm::components::*;
+use kdmpm::materials::PlasticStrain;
 use kdmpm::measure::{max_movement, positions};
 use kdmpm::systems::SpatialSort;
 use kdmpm::tensor::{PlanarSym3, StoredSym};

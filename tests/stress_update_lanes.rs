@@ -6,8 +6,9 @@
 
 use glam::DMat3;
 use kdmpm::columns::{col, col_mut, points_with};
-use kdmpm::components::{MaterialId, PlasticStrain, Stress, VelocityGradient};
-use kdmpm::materials::Material;
+use kdmpm::components::{MaterialId, Stress, VelocityGradient};
+use kdmpm::materials::PlasticStrain;
+
 use kdmpm::scene::{build, LoadedScene};
 use kdmpm::systems::StressUpdate;
 use kdmpm::tensor::Sym3;
@@ -80,9 +81,13 @@ fn points_updated_four_at_a_time_get_the_bits_of_points_updated_one_at_a_time() 
             };
             let (de, w) = Dim3::strain_spin(|i, j| Dim3::mat_entry(&l[p].0, i, j), dt);
             let mut alone = Dim3::jaumann_rotate(&s[p].0, w);
-            let mut e = eps.as_deref_mut().map(|e| e[p].0);
-            ctx.materials[ids[p] as usize].update(&mut alone, &de, e.as_mut());
-            expected.push((alone, e));
+            let mut e = eps.as_deref_mut().map(|e| e[p]);
+            let material = &ctx.materials[ids[p] as usize];
+            match e.as_mut() {
+                Some(e) => material.update(&mut alone, &de, e),
+                None => material.update(&mut alone, &de, &mut ()),
+            }
+            expected.push((alone, e.map(|e| e.0)));
         }
     }
     assert!(

@@ -4,6 +4,7 @@
 use glam::DVec2;
 use kdmpm::columns::{col, points_with};
 use kdmpm::components::*;
+use kdmpm::materials::PlasticStrain;
 use kdmpm::output::vtk::write_points;
 use kdmpm::tensor::{PlanarSym3, StoredSym};
 use kdmpm::{Dim2, Simulation};

@@ -1,8 +1,32 @@
 //! Linear isotropic elasticity (Hooke's law in rate form).
 
-use super::{Elasticity, Material};
+use super::{Elasticity, Material, SceneMaterial};
 use crate::lanes::LANES;
 use crate::tensor::{Sym3, Sym3x4};
+use serde::{Deserialize, Serialize};
+
+/// Scene entry `LinearElastic(density, youngs_modulus, poisson_ratio)`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, rename = "LinearElastic")]
+pub struct LinearElasticSpec {
+    /// ρ (kg/m³), > 0.
+    pub density: f64,
+    /// E (Pa), > 0.
+    pub youngs_modulus: f64,
+    /// ν, in [0, 0.5).
+    pub poisson_ratio: f64,
+}
+
+impl SceneMaterial for LinearElasticSpec {
+    type Model = LinearElastic;
+    fn model(&self, at: &dyn Fn(&str) -> String) -> Result<LinearElastic, (String, String)> {
+        let elasticity = Elasticity::checked(at, self.density, self.youngs_modulus, self.poisson_ratio)?;
+        Ok(LinearElastic {
+            density: self.density,
+            elasticity,
+        })
+    }
+}
 
 /// Linear elastic material: Δσ = λ tr(Δε) I + 2G Δε.
 #[derive(Clone, Debug, PartialEq)]
@@ -24,21 +48,19 @@ impl LinearElastic {
 }
 
 impl Material for LinearElastic {
+    type State = ();
     fn density(&self) -> f64 {
         self.density
     }
     fn p_wave_modulus(&self) -> f64 {
         self.elasticity.p_wave()
     }
-    fn is_plastic(&self) -> bool {
-        false
-    }
     #[inline(always)]
-    fn update(&self, stress: &mut Sym3, de: &Sym3, _plastic: Option<&mut f64>) {
+    fn update(&self, stress: &mut Sym3, de: &Sym3, _state: &mut ()) {
         *stress += self.elasticity.stress_increment(de);
     }
     #[inline(always)]
-    fn update4(&self, stress: &mut Sym3x4, de: &Sym3x4, _plastic: Option<[&mut f64; LANES]>) {
+    fn update4(&self, stress: &mut Sym3x4, de: &Sym3x4, _state: [&mut (); LANES]) {
         *stress += self.elasticity.stress_increment(de);
     }
 }

@@ -1,4 +1,12 @@
-//! Constitutive models, one per file, behind the [`Material`] trait.
+//! Constitutive models, one per file, and the registry that names them to scenes.
+//!
+//! A material's file holds all of it: its scene entry (a serde struct, the schema, with the
+//! checks of [`SceneMaterial::model`]), the model ([`Material`]) and the model's internal
+//! state ([`Material::State`], one column of the points that carry it). The registry
+//! ([`materials!`](crate::materials!)) lists the scene entries; the scene's material enum
+//! ([`MaterialSpec`]), the model enum ([`MaterialModel`]) and the list of point columns that
+//! the spatial sort and checkpoints move are derived from it. A new material is its file and
+//! one line there.
 //!
 //! The stress update system applies the Jaumann rotation first and then hands each point's
 //! strain increment to its material, so a material only integrates σ̇ = C : ε̇ (eq. 7) in a
@@ -7,59 +15,276 @@
 mod linear_elastic;
 mod mohr_coulomb;
 
-pub use linear_elastic::LinearElastic;
-pub use mohr_coulomb::MohrCoulomb;
+pub use linear_elastic::{LinearElastic, LinearElasticSpec};
+pub use mohr_coulomb::{MohrCoulomb, MohrCoulombSpec, PlasticStrain, Return};
 
 use crate::lanes::{Lanes, LANES};
 use crate::tensor::{Sym, Sym3, Sym3x4};
+use serde::{de::DeserializeOwned, Deserialize, Serialize};
+use std::any::Any;
+use std::fmt::Debug;
+
+/// The material registry: calls `$mac!([args] Variant(SceneEntry), ...)` with every material
+/// a scene can name, as `Variant(field: value, ...)` in its `materials` map. A new material is
+/// one line here (its file and its [`SceneMaterial`] impl do the rest).
+#[macro_export]
+#[doc(hidden)]
+macro_rules! materials {
+    ([$($mac:tt)*] [$($arg:tt)*]) => {
+        $($mac)*! {[$($arg)*]
+            LinearElastic($crate::materials::LinearElasticSpec),
+            MohrCoulomb($crate::materials::MohrCoulombSpec),
+        }
+    };
+}
+
+/// A model's internal state at a point, beyond its stress: `()` for a model without one. It
+/// is a point column (only on points whose material has it), moved by the spatial sort and
+/// saved by checkpoints byte for byte, so it must be a plain struct of `f64` without padding.
+pub trait MaterialState: bytemuck::Pod + Default + PartialEq + Debug + Send + Sync {
+    /// Accumulated equivalent plastic strain (dimensionless), written as `plastic_strain`.
+    fn plastic_strain(&self) -> f64;
+    /// True when every value is finite.
+    fn is_finite(&self) -> bool;
+}
+
+impl MaterialState for () {
+    fn plastic_strain(&self) -> f64 {
+        0.0
+    }
+    fn is_finite(&self) -> bool {
+        true
+    }
+}
 
 /// A constitutive model.
 pub trait Material: Send + Sync {
+    /// The internal state each point carries, `()` when none.
+    type State: MaterialState;
     /// Mass density ρ (kg/m³).
     fn density(&self) -> f64;
     /// P-wave (constrained) modulus M = K + 4G/3 (Pa), for the wave speed and time step.
     fn p_wave_modulus(&self) -> f64;
-    /// True when the model carries plastic state ([`crate::components::PlasticStrain`]).
-    fn is_plastic(&self) -> bool;
     /// Integrates the stress over one strain increment `de` (dimensionless, already in the
-    /// rotated frame). `plastic` is the point's accumulated plastic strain when the model is
-    /// plastic.
-    fn update(&self, stress: &mut Sym3, de: &Sym3, plastic: Option<&mut f64>);
+    /// rotated frame), updating the point's state.
+    fn update(&self, stress: &mut Sym3, de: &Sym3, state: &mut Self::State);
     /// [`Material::update`] for four points of this material side by side, one per lane,
     /// with the same bits for each as `update` would give it. By default lane by lane; linear
     /// elasticity does all four at once; Mohr-Coulomb tests all four for yield in lanes and
     /// returns one by one only the points that fail the test.
     #[inline(always)]
-    fn update4(&self, stress: &mut Sym3x4, de: &Sym3x4, plastic: Option<[&mut f64; LANES]>) {
-        update_lane_by_lane(stress, de, plastic, |_, s, de, eps| self.update(s, de, eps));
+    fn update4(&self, stress: &mut Sym3x4, de: &Sym3x4, state: [&mut Self::State; LANES]) {
+        update_lane_by_lane(stress, de, state, |_, s, de, st| self.update(s, de, st));
     }
 }
 
-/// Calls `update(lane, stress, de, plastic)` with each lane's stress, strain increment and
-/// plastic strain in turn, and puts the stresses back into their lanes.
+/// A material as a scene gives it: the serde struct is its schema.
+pub trait SceneMaterial: Clone + PartialEq + Debug + Serialize + DeserializeOwned {
+    /// The model it describes.
+    type Model: Material + Clone + PartialEq + Debug;
+    /// The model, each field checked; an error names the field (through `at`, which makes a
+    /// field's dotted path) and the rule it breaks.
+    fn model(&self, at: &dyn Fn(&str) -> String) -> Result<Self::Model, (String, String)>;
+    /// Divides the strength by `factor` for a strength-reduction analysis (c and tan φ, and
+    /// what else the model holds as strength); false for a model without strength.
+    fn reduce_strength(&mut self, _factor: f64) -> bool {
+        false
+    }
+}
+
+/// Something done with one state type, chosen at run time (see [`visit_states`] and
+/// [`MaterialModel::visit_state`]).
+pub trait StateVisitor {
+    /// Called with the state type `S`.
+    fn visit<S: MaterialState>(&mut self);
+}
+
+/// Calls `update(lane, stress, de, state)` with each lane's stress, strain increment and
+/// state in turn, and puts the stresses back into their lanes.
 #[inline(always)]
-pub fn update_lane_by_lane(
+pub fn update_lane_by_lane<S>(
     stress: &mut Sym3x4,
     de: &Sym3x4,
-    plastic: Option<[&mut f64; LANES]>,
-    mut update: impl FnMut(usize, &mut Sym3, &Sym3, Option<&mut f64>),
+    state: [&mut S; LANES],
+    mut update: impl FnMut(usize, &mut Sym3, &Sym3, &mut S),
 ) {
     let (mut s, de) = (stress.lanes(), de.lanes());
-    // One loop each, so that an elastic material's loop carries no plastic strain.
-    match plastic {
-        Some(eps) => {
-            for (lane, ((s, de), eps)) in s.iter_mut().zip(&de).zip(eps).enumerate() {
-                update(lane, s, de, Some(eps));
-            }
-        }
-        None => {
-            for (lane, (s, de)) in s.iter_mut().zip(&de).enumerate() {
-                update(lane, s, de, None);
-            }
-        }
+    for (lane, ((s, de), st)) in s.iter_mut().zip(&de).zip(state).enumerate() {
+        update(lane, s, de, st);
     }
     *stress = Sym3x4::gather(|l| s[l]);
 }
+
+/// The model's own state behind a state of type `S`: the same value when `S` is the model's
+/// state type; a throw-away default for a model without state (an elastic stage of a body
+/// that carries plastic state keeps it untouched).
+#[inline(always)]
+fn with_state<M: Material, S: MaterialState, R>(state: &mut S, f: impl FnOnce(&mut M::State) -> R) -> R {
+    match (state as &mut dyn Any).downcast_mut::<M::State>() {
+        Some(own) => f(own),
+        None => f(&mut stateless::<M>()),
+    }
+}
+
+/// Four states of type `S` as the model's (see [`with_state`]).
+#[inline(always)]
+fn with_states<M: Material, S: MaterialState, R>(
+    state: [&mut S; LANES],
+    f: impl FnOnce([&mut M::State; LANES]) -> R,
+) -> R {
+    if std::any::TypeId::of::<S>() == std::any::TypeId::of::<M::State>() {
+        f(state.map(|s| (s as &mut dyn Any).downcast_mut::<M::State>().expect("same type")))
+    } else {
+        let mut none: [M::State; LANES] = std::array::from_fn(|_| stateless::<M>());
+        f(none.each_mut())
+    }
+}
+
+/// The default state of a model that has none; a model with state reached here is a point
+/// spawned without its material's state column, which the scene's set-up never does.
+#[inline(always)]
+fn stateless<M: Material>() -> M::State {
+    assert!(
+        std::mem::size_of::<M::State>() == 0,
+        "a point's state column is not its material's {}: a point must be spawned with the \
+         state of every material it takes",
+        std::any::type_name::<M::State>()
+    );
+    M::State::default()
+}
+
+/// Derives the scene's material enum, the model enum and their dispatch from the registry.
+macro_rules! define_materials {
+    ([] $($variant:ident($spec:ty)),* $(,)?) => {
+        /// A material, by model, as a scene's `materials` map gives it:
+        /// `Model(field: value, ...)`.
+        #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+        pub enum MaterialSpec {
+            $(
+                #[doc = concat!("See [`", stringify!($variant), "`](", stringify!($spec), ").")]
+                $variant($spec),
+            )*
+        }
+
+        /// The model of each material a scene can name.
+        #[derive(Clone, Debug, PartialEq)]
+        pub enum MaterialModel {
+            $(
+                #[doc = concat!("See [`", stringify!($variant), "`](", stringify!($spec), ").")]
+                $variant(<$spec as SceneMaterial>::Model),
+            )*
+        }
+
+        impl MaterialSpec {
+            /// The model, each field checked, and its wave speed; an error names the field
+            /// (through `at`) and the rule.
+            pub fn model(&self, at: &dyn Fn(&str) -> String) -> Result<MaterialModel, (String, String)> {
+                let model = match self {
+                    $(MaterialSpec::$variant(s) => MaterialModel::$variant(s.model(at)?),)*
+                };
+                // The P-wave speed sets the time step: it must be a finite number > 0 (an E
+                // near the largest double overflows M, a density near the smallest overflows
+                // M/ρ).
+                let speed = (model.p_wave_modulus() / model.density()).sqrt();
+                if !(speed > 0.0 && speed.is_finite()) {
+                    return Err((
+                        at("youngs_modulus"),
+                        format!(
+                            "M = {} Pa with ρ = {} kg/m³ gives a P-wave speed of {speed} m/s, not \
+                             a finite number > 0",
+                            model.p_wave_modulus(),
+                            model.density()
+                        ),
+                    ));
+                }
+                Ok(model)
+            }
+
+            /// Divides the strength by `factor` (see [`SceneMaterial::reduce_strength`]).
+            pub fn reduce_strength(&mut self, factor: f64) -> bool {
+                match self {
+                    $(MaterialSpec::$variant(s) => s.reduce_strength(factor),)*
+                }
+            }
+        }
+
+        impl MaterialModel {
+            /// Mass density ρ (kg/m³).
+            pub fn density(&self) -> f64 {
+                match self {
+                    $(MaterialModel::$variant(m) => m.density(),)*
+                }
+            }
+
+            /// P-wave modulus M (Pa).
+            pub fn p_wave_modulus(&self) -> f64 {
+                match self {
+                    $(MaterialModel::$variant(m) => m.p_wave_modulus(),)*
+                }
+            }
+
+            /// Calls `v` with this model's state type.
+            pub fn visit_state(&self, v: &mut impl StateVisitor) {
+                match self {
+                    $(MaterialModel::$variant(_) => v.visit::<<<$spec as SceneMaterial>::Model as Material>::State>(),)*
+                }
+            }
+
+            /// The name of this model's state type, `None` when it has no state.
+            pub fn state_name(&self) -> Option<&'static str> {
+                struct Name(Option<&'static str>);
+                impl StateVisitor for Name {
+                    fn visit<S: MaterialState>(&mut self) {
+                        self.0 = (std::mem::size_of::<S>() > 0).then(std::any::type_name::<S>);
+                    }
+                }
+                let mut name = Name(None);
+                self.visit_state(&mut name);
+                name.0
+            }
+
+            /// Bytes of this model's state a point.
+            pub fn state_bytes(&self) -> usize {
+                struct Size(usize);
+                impl StateVisitor for Size {
+                    fn visit<S: MaterialState>(&mut self) {
+                        self.0 = std::mem::size_of::<S>();
+                    }
+                }
+                let mut size = Size(0);
+                self.visit_state(&mut size);
+                size.0
+            }
+
+            /// [`Material::update`] of one point whose state column is of type `S`.
+            #[inline(always)]
+            pub fn update<S: MaterialState>(&self, stress: &mut Sym3, de: &Sym3, state: &mut S) {
+                // Static dispatch on the enum keeps the per-point call inlinable.
+                match self {
+                    $(MaterialModel::$variant(m) => with_state::<<$spec as SceneMaterial>::Model, S, _>(state, |st| m.update(stress, de, st)),)*
+                }
+            }
+
+            /// [`Material::update4`] of four points of this material whose state column is of
+            /// type `S`.
+            #[inline(always)]
+            pub fn update4<S: MaterialState>(&self, stress: &mut Sym3x4, de: &Sym3x4, state: [&mut S; LANES]) {
+                match self {
+                    $(MaterialModel::$variant(m) => {
+                        with_states::<<$spec as SceneMaterial>::Model, S, _>(state, |st| m.update4(stress, de, st))
+                    })*
+                }
+            }
+        }
+
+        /// Calls `v` with the state type of every registered material (`()` included).
+        pub fn visit_states(v: &mut impl StateVisitor) {
+            $(v.visit::<<<$spec as SceneMaterial>::Model as Material>::State>();)*
+        }
+    };
+}
+
+materials!([define_materials] []);
 
 /// Isotropic elastic stiffness from Young's modulus and Poisson's ratio.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -78,6 +303,33 @@ impl Elasticity {
             shear: e / (2.0 * (1.0 + nu)),
             lambda: e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)),
         }
+    }
+
+    /// Checked E (Pa, > 0) and ν (in [0, 0.5)) with the density ρ (kg/m³, > 0) of the same
+    /// scene entry; an error names the field (through `at`) and the rule.
+    pub fn checked(
+        at: &dyn Fn(&str) -> String,
+        density: f64,
+        youngs_modulus: f64,
+        poisson_ratio: f64,
+    ) -> Result<Self, (String, String)> {
+        let positive = |x: f64| x > 0.0 && x.is_finite();
+        if !positive(density) {
+            return Err((at("density"), format!("must be > 0 kg/m³, found {density}")));
+        }
+        if !positive(youngs_modulus) {
+            return Err((
+                at("youngs_modulus"),
+                format!("must be > 0 Pa, found {youngs_modulus}"),
+            ));
+        }
+        if !(0.0..0.5).contains(&poisson_ratio) {
+            return Err((
+                at("poisson_ratio"),
+                format!("must be in [0, 0.5), found {poisson_ratio}"),
+            ));
+        }
+        Ok(Elasticity::new(youngs_modulus, poisson_ratio))
     }
 
     /// Bulk modulus K (Pa).
@@ -106,47 +358,44 @@ impl Elasticity {
     }
 }
 
-/// The materials a scene can name.
-#[derive(Clone, Debug, PartialEq)]
-pub enum MaterialModel {
-    /// Linear elastic.
-    LinearElastic(LinearElastic),
-    /// Mohr-Coulomb elastic perfectly plastic.
-    MohrCoulomb(MohrCoulomb),
-}
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::any::TypeId;
 
-impl MaterialModel {
-    fn inner(&self) -> &dyn Material {
-        match self {
-            MaterialModel::LinearElastic(m) => m,
-            MaterialModel::MohrCoulomb(m) => m,
+    #[test]
+    fn every_registered_state_is_its_own_type_or_none() {
+        // The spatial sort and checkpoints move each listed state column once: two models
+        // sharing a state type would move it twice.
+        struct Seen(Vec<TypeId>);
+        impl StateVisitor for Seen {
+            fn visit<S: MaterialState>(&mut self) {
+                if std::mem::size_of::<S>() > 0 {
+                    assert!(
+                        !self.0.contains(&TypeId::of::<S>()),
+                        "{} is the state of two models",
+                        std::any::type_name::<S>()
+                    );
+                    self.0.push(TypeId::of::<S>());
+                }
+            }
         }
+        visit_states(&mut Seen(Vec::new()));
     }
-}
 
-impl Material for MaterialModel {
-    fn density(&self) -> f64 {
-        self.inner().density()
-    }
-    fn p_wave_modulus(&self) -> f64 {
-        self.inner().p_wave_modulus()
-    }
-    fn is_plastic(&self) -> bool {
-        self.inner().is_plastic()
-    }
-    #[inline]
-    fn update(&self, stress: &mut Sym3, de: &Sym3, plastic: Option<&mut f64>) {
-        // Static dispatch on the enum keeps the per-point call inlinable.
-        match self {
-            MaterialModel::LinearElastic(m) => m.update(stress, de, plastic),
-            MaterialModel::MohrCoulomb(m) => m.update(stress, de, plastic),
-        }
-    }
-    #[inline(always)]
-    fn update4(&self, stress: &mut Sym3x4, de: &Sym3x4, plastic: Option<[&mut f64; LANES]>) {
-        match self {
-            MaterialModel::LinearElastic(m) => m.update4(stress, de, plastic),
-            MaterialModel::MohrCoulomb(m) => m.update4(stress, de, plastic),
-        }
+    #[test]
+    fn an_elastic_stage_leaves_a_plastic_state_as_it_was() {
+        let elastic = MaterialSpec::LinearElastic(LinearElasticSpec {
+            density: 2000.0,
+            youngs_modulus: 1e7,
+            poisson_ratio: 0.3,
+        })
+        .model(&|f| f.to_string())
+        .unwrap();
+        let mut state = PlasticStrain(0.25);
+        let mut stress = Sym3::ZERO;
+        elastic.update(&mut stress, &Sym3::diagonal(1e-3, 0.0, 0.0), &mut state);
+        assert_eq!(state, PlasticStrain(0.25));
+        assert!(stress.xx > 0.0);
     }
 }

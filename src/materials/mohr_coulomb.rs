@@ -15,10 +15,122 @@
 //! In compression-positive terms the plane f = 0 is the classical
 //! σ1' = σ3' (1 + sin φ)/(1 − sin φ) + 2c cos φ/(1 − sin φ).
 
-use super::{update_lane_by_lane, Elasticity, Material};
+use super::{update_lane_by_lane, Elasticity, Material, MaterialState, SceneMaterial};
 use crate::lanes::{gather, F64x4, Lanes, LANES};
 use crate::tensor::{Sym, Sym3, Sym3x4};
 use glam::DVec3;
+use serde::{Deserialize, Serialize};
+
+/// Scene entry `MohrCoulomb(density, youngs_modulus, poisson_ratio, cohesion,
+/// friction_angle, dilatancy_angle, tension_cutoff)`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, rename = "MohrCoulomb")]
+pub struct MohrCoulombSpec {
+    /// ρ (kg/m³), > 0.
+    pub density: f64,
+    /// E (Pa), > 0.
+    pub youngs_modulus: f64,
+    /// ν, in [0, 0.5).
+    pub poisson_ratio: f64,
+    /// c (Pa), ≥ 0.
+    pub cohesion: f64,
+    /// φ (degrees), in [0, 90).
+    pub friction_angle: f64,
+    /// ψ (degrees), in [0, φ].
+    #[serde(default)]
+    pub dilatancy_angle: f64,
+    /// Largest tensile principal stress (Pa); default and upper bound c·cot φ.
+    #[serde(default)]
+    pub tension_cutoff: Option<f64>,
+}
+
+/// Checks the strength of a Mohr-Coulomb entry: c (Pa) ≥ 0, φ in [0°, 90°), ψ in [0°, φ],
+/// a cut-off (Pa) ≥ 0, and some strength (c > 0 when φ = 0); fields named through `at`.
+pub(super) fn check_strength(
+    at: &dyn Fn(&str) -> String,
+    (c, phi, psi): (f64, f64, f64),
+    tension_cutoff: Option<f64>,
+) -> Result<(), (String, String)> {
+    let non_negative = |x: f64| x >= 0.0 && x.is_finite();
+    if !non_negative(c) {
+        return Err((at("cohesion"), format!("must be ≥ 0 Pa, found {c}")));
+    }
+    if !(0.0..90.0).contains(&phi) {
+        return Err((
+            at("friction_angle"),
+            format!("must be in [0°, 90°), found {phi}°"),
+        ));
+    }
+    if !(non_negative(psi) && psi <= phi) {
+        return Err((
+            at("dilatancy_angle"),
+            format!("must be in [0°, φ = {phi}°], found {psi}°"),
+        ));
+    }
+    if let Some(t) = tension_cutoff {
+        if !non_negative(t) {
+            return Err((
+                at("tension_cutoff"),
+                format!("must be a finite stress ≥ 0 Pa (at most c·cot φ), found {t}"),
+            ));
+        }
+    }
+    if phi == 0.0 && c == 0.0 {
+        return Err((
+            at("cohesion"),
+            "with φ = 0 the cohesion must be > 0 (no strength at all)".into(),
+        ));
+    }
+    Ok(())
+}
+
+/// An angle (degrees) whose tangent is divided by `factor`.
+pub(super) fn reduce_angle(deg: f64, factor: f64) -> f64 {
+    (deg.to_radians().tan() / factor).atan().to_degrees()
+}
+
+impl SceneMaterial for MohrCoulombSpec {
+    type Model = MohrCoulomb;
+    fn model(&self, at: &dyn Fn(&str) -> String) -> Result<MohrCoulomb, (String, String)> {
+        Elasticity::checked(at, self.density, self.youngs_modulus, self.poisson_ratio)?;
+        let strength = (self.cohesion, self.friction_angle, self.dilatancy_angle);
+        check_strength(at, strength, self.tension_cutoff)?;
+        Ok(MohrCoulomb::new(
+            self.density,
+            self.youngs_modulus,
+            self.poisson_ratio,
+            self.cohesion,
+            self.friction_angle,
+            self.dilatancy_angle,
+            self.tension_cutoff,
+        ))
+    }
+    /// c, tan φ, tan ψ and an explicit cut-off, each divided by `factor`.
+    fn reduce_strength(&mut self, factor: f64) -> bool {
+        self.cohesion /= factor;
+        self.friction_angle = reduce_angle(self.friction_angle, factor);
+        self.dilatancy_angle = reduce_angle(self.dilatancy_angle, factor);
+        if let Some(t) = &mut self.tension_cutoff {
+            *t /= factor;
+        }
+        true
+    }
+}
+
+/// Accumulated equivalent plastic strain sqrt(2/3 Δεp_dev : Δεp_dev) summed over the steps
+/// (dimensionless): the state of a Mohr-Coulomb point.
+#[derive(Clone, Copy, Debug, PartialEq, Default, bytemuck::Pod, bytemuck::Zeroable)]
+#[repr(transparent)]
+pub struct PlasticStrain(pub f64);
+
+impl MaterialState for PlasticStrain {
+    fn plastic_strain(&self) -> f64 {
+        self.0
+    }
+    fn is_finite(&self) -> bool {
+        self.0.is_finite()
+    }
+}
 
 /// Every lane's bit of a four-lane mask.
 const ALL_LANES: u32 = (1 << LANES) - 1;
@@ -317,23 +429,21 @@ impl MohrCoulomb {
 }
 
 impl Material for MohrCoulomb {
+    type State = PlasticStrain;
     fn density(&self) -> f64 {
         self.density
     }
     fn p_wave_modulus(&self) -> f64 {
         self.elasticity.p_wave()
     }
-    fn is_plastic(&self) -> bool {
-        true
-    }
     // Always: with a hint alone the one-point update was not inlined into its callers
     // (`cargo bench --bench kernels -- Mohr`: 99 against 91 ns a plastic point).
     #[inline(always)]
-    fn update(&self, stress: &mut Sym3, de: &Sym3, plastic: Option<&mut f64>) {
+    fn update(&self, stress: &mut Sym3, de: &Sym3, plastic: &mut PlasticStrain) {
         let (settled, correction) = self.settle(*stress + self.elasticity.stress_increment(de));
         *stress = settled;
-        if let (Some(eps), Some(ds)) = (plastic, correction) {
-            *eps += self.plastic_strain_increment(ds);
+        if let Some(ds) = correction {
+            plastic.0 += self.plastic_strain_increment(ds);
         }
     }
 
@@ -342,14 +452,14 @@ impl Material for MohrCoulomb {
     /// plastic strains of those that yielded are found together in lanes (a chain of two
     /// divisions and a square root each). Every point gets the bits `update` gives it.
     #[inline(always)]
-    fn update4(&self, stress: &mut Sym3x4, de: &Sym3x4, plastic: Option<[&mut f64; LANES]>) {
+    fn update4(&self, stress: &mut Sym3x4, de: &Sym3x4, plastic: [&mut PlasticStrain; LANES]) {
         *stress += self.elasticity.stress_increment(de);
         let elastic = self.elastic_lanes(stress);
         if elastic == ALL_LANES {
             return;
         }
         let (mut ds, mut yielded) = ([[0.0; 3]; LANES], 0u32);
-        update_lane_by_lane(stress, de, None, |lane, s, _, _| {
+        update_lane_by_lane(stress, de, [(); LANES].each_mut(), |lane, s, _, _| {
             if elastic & (1 << lane) == 0 {
                 let (settled, correction) = self.settle(*s);
                 *s = settled;
@@ -358,13 +468,13 @@ impl Material for MohrCoulomb {
                 }
             }
         });
-        if let (Some(eps), true) = (plastic, yielded != 0) {
+        if yielded != 0 {
             let inc = self
                 .plastic_strain_increment(std::array::from_fn(|i| gather(|lane| ds[lane][i])))
                 .to_array();
-            for (lane, eps) in eps.into_iter().enumerate() {
+            for (lane, eps) in plastic.into_iter().enumerate() {
                 if yielded & (1 << lane) != 0 {
-                    *eps += inc[lane];
+                    eps.0 += inc[lane];
                 }
             }
         }
@@ -557,12 +667,12 @@ mod tests {
     /// solving for the lateral strain increment (bisection). Returns the principal stresses.
     fn triaxial(mc: &MohrCoulomb, confinement: f64, de_axial: f64, steps: usize) -> [f64; 3] {
         let mut s = Sym3::diagonal(confinement, confinement, confinement);
-        let mut eps = 0.0;
+        let mut eps = PlasticStrain(0.0);
         for _ in 0..steps {
             let attempt = |e: f64| {
                 let mut t = s;
                 let mut p = eps;
-                mc.update(&mut t, &Sym3::diagonal(e, e, de_axial), Some(&mut p));
+                mc.update(&mut t, &Sym3::diagonal(e, e, de_axial), &mut p);
                 (t, p)
             };
             let (mut lo, mut hi) = (-1e-3, 1e-3);
@@ -642,11 +752,11 @@ mod tests {
             let stress: [Sym3; LANES] =
                 std::array::from_fn(|q| tensor(30e3, [-120e3, -200e3, -120e3], planar[q]));
             let de: [Sym3; LANES] = std::array::from_fn(|q| tensor(strain, [0.0; 3], planar[q]));
-            let eps0: [f64; LANES] = std::array::from_fn(|q| q as f64 * 1e-3);
+            let eps0: [PlasticStrain; LANES] = std::array::from_fn(|q| PlasticStrain(q as f64 * 1e-3));
             let mut alone = stress;
             let mut eps_alone = eps0;
             for q in 0..LANES {
-                mc.update(&mut alone[q], &de[q], Some(&mut eps_alone[q]));
+                mc.update(&mut alone[q], &de[q], &mut eps_alone[q]);
             }
             let mut lanes = Sym3x4::gather(|q| stress[q]);
             let mut eps_lanes = eps0;
@@ -656,11 +766,11 @@ mod tests {
                 0 if group % 3 == 2 => mixed_planes += 1,
                 _ => some_yield += 1,
             }
-            mc.update4(&mut lanes, &Sym3x4::gather(|q| de[q]), Some(eps_lanes.each_mut()));
-            let bits = |s: &[Sym3], e: &[f64]| -> Vec<u64> {
+            mc.update4(&mut lanes, &Sym3x4::gather(|q| de[q]), eps_lanes.each_mut());
+            let bits = |s: &[Sym3], e: &[PlasticStrain]| -> Vec<u64> {
                 s.iter()
                     .flat_map(|s| s.to_array())
-                    .chain(e.iter().copied())
+                    .chain(e.iter().map(|e| e.0))
                     .map(f64::to_bits)
                     .collect()
             };

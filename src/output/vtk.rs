@@ -1,7 +1,7 @@
 //! Material points as a VTK XML unstructured grid (`.vtu`) with raw binary arrays, readable
 //! by ParaView, VisIt, meshio and pyvista.
 
-use crate::columns::{col, points_with};
+use crate::columns::{col, extend_plastic_strain, points_with};
 use crate::components::*;
 use crate::dim::Dim;
 use crate::simulation::Simulation;
@@ -217,10 +217,17 @@ impl<D: Dim> Source for Columns<'_, D> {
             }),
             Field::Volume => each::<Volume>(archs, order, out, |out, v| f64s(out, &[v.0])),
             Field::PlasticStrain => {
-                let plastic: Vec<_> = archs.iter().map(|a| a.get::<&PlasticStrain>()).collect();
+                let plastic: Vec<Vec<f64>> = archs
+                    .iter()
+                    .map(|a| {
+                        let mut e = Vec::new();
+                        extend_plastic_strain(a, &mut e);
+                        e
+                    })
+                    .collect();
                 order
                     .points()
-                    .try_for_each(|(_, a, r)| f64s(out, &[plastic[a].as_ref().map_or(0.0, |e| e[r].0)]))
+                    .try_for_each(|(_, a, r)| f64s(out, &[plastic[a][r]]))
             }
         }
     }
@@ -287,11 +294,7 @@ impl Frame {
             copy::<Velocity<D::Vec>, _>(arch, &mut self.velocity, |v| D::vec_to3(v.0));
             copy::<Stress<D::Stress>, _>(arch, &mut self.stress, voigt::<D>);
             copy::<Volume, _>(arch, &mut self.volume, |v| v.0);
-            let rows = arch.len() as usize;
-            match arch.get::<&PlasticStrain>() {
-                Some(e) => self.plastic_strain.extend(e.iter().map(|e| e.0)),
-                None => self.plastic_strain.resize(self.plastic_strain.len() + rows, 0.0),
-            }
+            extend_plastic_strain(arch, &mut self.plastic_strain);
         }
         self.displacement = displacements.then_some(u);
     }

@@ -1,16 +1,15 @@
 //! Building a simulation from a valid scene: grid nodes, material points, loads, tracing
 //! and the schedule. Only what the scene uses is created.
 
-use super::validate::{self, material_model, Checked, Derived};
-use super::{pad3, BoundarySpec, Condition, LoadedScene, MaterialSpec, Region, Scene};
+use super::validate::{self, carried_state, Checked, Derived};
+use super::{pad3, BoundarySpec, Condition, LoadedScene, Region, Scene};
 use crate::columns::{col, points_with};
 use crate::components::*;
 use crate::context::Context;
 use crate::dim::{Dim, Dim2, Dim3, Vector};
 use crate::error::SceneError;
 use crate::grid::Grid;
-use crate::materials::Material;
-use crate::materials::MaterialModel;
+use crate::materials::{MaterialModel, MaterialState, StateVisitor};
 use crate::parallel::SlabCache;
 use crate::shape::{for_each_node, Linear, QuadraticBSpline, ShapeKind, UniformGimp};
 use crate::simulation::{AnySimulation, Simulation, TracedPoint};
@@ -141,6 +140,26 @@ fn fill<T: hecs::Component>(batch: &ColumnBatchBuilder, values: impl Iterator<It
     }
 }
 
+/// Adds the column of a material's state to a point batch (none for a model without one).
+struct AddState<'a>(&'a mut ColumnBatchType);
+
+impl StateVisitor for AddState<'_> {
+    fn visit<S: MaterialState>(&mut self) {
+        if std::mem::size_of::<S>() > 0 {
+            self.0.add::<S>();
+        }
+    }
+}
+
+/// Fills a batch's column of a material's state with `count` default (initial) states.
+struct FillState<'a>(&'a ColumnBatchBuilder, usize);
+
+impl StateVisitor for FillState<'_> {
+    fn visit<S: MaterialState>(&mut self) {
+        fill(self.0, std::iter::repeat_n(S::default(), self.1));
+    }
+}
+
 /// An iterator that knows its length, so that `spawn_batch` reserves the columns once.
 #[derive(Clone)]
 struct Counted<I> {
@@ -195,7 +214,9 @@ fn stages<D: Dim>(
         let mut materials = Vec::new();
         for (name, spec) in &st.materials {
             let at = |f: &str| format!("stages[{k}].materials.{name}.{f}");
-            let model = material_model(&at, spec).map_err(|(field, rule)| loaded.invalid(&field, rule))?;
+            let model = spec
+                .model(&at)
+                .map_err(|(field, rule)| loaded.invalid(&field, rule))?;
             let id = table.iter().position(|(n, _)| n == name).expect("validated");
             materials.push((id as u16, model));
         }
@@ -325,14 +346,8 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
             .position(|(name, _)| *name == body.material)
             .expect("validated");
         let model = &table[mat].1;
-        // A material a later stage makes plastic carries plastic state from the start.
-        let plastic = model.is_plastic()
-            || s.stages.iter().any(|st| {
-                matches!(
-                    st.materials.get(&body.material),
-                    Some(MaterialSpec::MohrCoulomb { .. })
-                )
-            });
+        // The points carry the state of every model their material takes, from the start.
+        let state = carried_state(loaded, &table, &body.material).expect("validated");
         let volume = cell_volume / body.points_per_cell.iter().product::<usize>() as f64;
         let mass = model.density() * volume;
         full_node_mass = full_node_mass.min(model.density() * cell_volume);
@@ -347,8 +362,8 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
                 )
             })?;
         body_ids.push(first..next_id);
-        // One column batch: the columns every point has, then the optional ones, plastic
-        // state only where the material needs it and displacements only when asked for.
+        // One column batch: the columns every point has, then the optional ones, the
+        // material's state only where it has one and displacements only when asked for.
         // A new point column is one more `add` and one fill here. The spawned entities are
         // not kept: points are found again through the columns, which keeps the set-up's
         // peak memory near the run's.
@@ -363,9 +378,7 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
             VelocityGradient<D::Mat>,
             MaterialId,
         )>();
-        if plastic {
-            columns.add::<PlasticStrain>();
-        }
+        state.visit_state(&mut AddState(&mut columns));
         if s.output.displacements {
             columns.add::<Displacement<D::Vec>>();
         }
@@ -378,7 +391,7 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         fill(&batch, std::iter::repeat_n(Stress(D::Stress::default()), count));
         fill(&batch, std::iter::repeat_n(VelocityGradient(D::MAT_ZERO), count));
         fill(&batch, std::iter::repeat_n(MaterialId(mat as u16), count));
-        fill(&batch, std::iter::repeat_n(PlasticStrain(0.0), count));
+        state.visit_state(&mut FillState(&batch, count));
         fill(&batch, std::iter::repeat_n(Displacement(z), count));
         world.spawn_column_batch(batch.build().expect("every column of the batch is filled"));
     }

@@ -8,6 +8,7 @@ pub mod locate;
 mod tractions;
 mod validate;
 
+pub use crate::materials::MaterialSpec;
 pub use build::build;
 use build::{cell_span, region_bounds};
 pub use validate::{check, Checked, Derived, Estimate};
@@ -78,40 +79,6 @@ pub struct GridSpec {
     pub cell_size: f64,
     /// Number of cells per axis, ≥ 1.
     pub cells: Vec<usize>,
-}
-
-/// A material, by model.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub enum MaterialSpec {
-    /// Linear elastic.
-    LinearElastic {
-        /// ρ (kg/m³), > 0.
-        density: f64,
-        /// E (Pa), > 0.
-        youngs_modulus: f64,
-        /// ν, in [0, 0.5).
-        poisson_ratio: f64,
-    },
-    /// Mohr-Coulomb elastic perfectly plastic.
-    MohrCoulomb {
-        /// ρ (kg/m³), > 0.
-        density: f64,
-        /// E (Pa), > 0.
-        youngs_modulus: f64,
-        /// ν, in [0, 0.5).
-        poisson_ratio: f64,
-        /// c (Pa), ≥ 0.
-        cohesion: f64,
-        /// φ (degrees), in [0, 90).
-        friction_angle: f64,
-        /// ψ (degrees), in [0, φ].
-        #[serde(default)]
-        dilatancy_angle: f64,
-        /// Largest tensile principal stress (Pa); default and upper bound c·cot φ.
-        #[serde(default)]
-        tension_cutoff: Option<f64>,
-    },
 }
 
 /// A region filled with material points.
@@ -476,7 +443,11 @@ pub struct LoadedScene {
 }
 
 fn ron_options() -> ron::Options {
-    ron::Options::default().with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME)
+    use ron::extensions::Extensions;
+    // A material is a newtype variant around its model's entry (`crate::materials`), written
+    // `MohrCoulomb(density: ..)` as if the variant held the fields.
+    ron::Options::default()
+        .with_default_extension(Extensions::IMPLICIT_SOME | Extensions::UNWRAP_VARIANT_NEWTYPES)
 }
 
 impl LoadedScene {

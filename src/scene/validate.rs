@@ -1,10 +1,10 @@
 //! Rules a scene must satisfy before anything is built or written, and the figures derived
 //! from it.
 
-use super::{BoundarySpec, LoadedScene, MaterialSpec, Region, TimeStep};
+use super::{BoundarySpec, LoadedScene, Region, TimeStep};
 use crate::components::NodeFixity;
 use crate::error::SceneError;
-use crate::materials::{LinearElastic, Material, MaterialModel, MohrCoulomb};
+use crate::materials::MaterialModel;
 use crate::shape::ShapeKind;
 use crate::state::Scheme;
 use serde::Serialize;
@@ -86,7 +86,7 @@ fn node_bytes(n: u64) -> u64 {
 /// Bytes of a point's components: position, velocity, displacement (when kept), mass,
 /// volume, stress (4 or 6 components), velocity gradient, material and point ids, and the
 /// plastic strain of plastic materials.
-fn point_bytes(n: u64, displacements: bool, plastic: bool) -> u64 {
+fn point_bytes(n: u64, displacements: bool, state_bytes: u64) -> u64 {
     let vector = 8 * n;
     let stress = if n == 2 { 32 } else { 48 };
     3 * vector - if displacements { 0 } else { vector }
@@ -96,8 +96,30 @@ fn point_bytes(n: u64, displacements: bool, plastic: bool) -> u64 {
         + vector * n
         + 2
         + 4
-        + if plastic { 8 } else { 0 }
+        + state_bytes
         + POINT_OVERHEAD
+}
+
+/// The model whose state the points of material `name` carry: the first of the scene's
+/// model and the models its stages give it that has state (the points carry it from the
+/// start, so that a later stage finds it), the scene's model when none has. `None` when the
+/// scene has no such material.
+pub(super) fn carried_state(
+    loaded: &LoadedScene,
+    table: &[(String, MaterialModel)],
+    name: &str,
+) -> Option<MaterialModel> {
+    let own = table.iter().find(|(n, _)| n == name)?.1.clone();
+    let staged = loaded
+        .scene
+        .stages
+        .iter()
+        .filter_map(|st| st.materials.get(name))
+        .filter_map(|spec| spec.model(&|f: &str| f.to_string()).ok());
+    let first = std::iter::once(own.clone())
+        .chain(staged)
+        .find(|m| m.state_name().is_some());
+    Some(first.unwrap_or(own))
 }
 
 /// The machine's memory (bytes), from `/proc/meminfo`; `None` where it cannot be read.
@@ -139,15 +161,12 @@ fn estimate(loaded: &LoadedScene, table: &[(String, MaterialModel)]) -> Result<E
                 .and_then(|c| count.checked_mul(c))
                 .ok_or_else(|| too_many(&field, "the point count"))?;
         }
-        let plastic = table
-            .iter()
-            .find(|(name, _)| *name == body.material)
-            .is_some_and(|(_, m)| m.is_plastic());
+        let state_bytes = carried_state(loaded, table, &body.material).map_or(0, |m| m.state_bytes());
         points = points
             .checked_add(count)
             .ok_or_else(|| too_many(&field, "the point count"))?;
         bytes = count
-            .checked_mul(point_bytes(n as u64, s.output.displacements, plastic))
+            .checked_mul(point_bytes(n as u64, s.output.displacements, state_bytes as u64))
             .and_then(|b| bytes.checked_add(b))
             .ok_or_else(|| too_many(&field, "the points' memory"))?;
     }
@@ -218,91 +237,6 @@ fn positive(x: f64) -> bool {
 /// True for a finite number ≥ 0 (NaN fails).
 fn non_negative(x: f64) -> bool {
     x >= 0.0 && x.is_finite()
-}
-
-/// The model of material `m`, checked field by field; an error names the field (by `at`)
-/// and the rule.
-pub(super) fn material_model(
-    at: &dyn Fn(&str) -> String,
-    m: &MaterialSpec,
-) -> Result<MaterialModel, (String, String)> {
-    let (rho, e, nu) = match m {
-        MaterialSpec::LinearElastic {
-            density,
-            youngs_modulus,
-            poisson_ratio,
-        }
-        | MaterialSpec::MohrCoulomb {
-            density,
-            youngs_modulus,
-            poisson_ratio,
-            ..
-        } => (*density, *youngs_modulus, *poisson_ratio),
-    };
-    if !positive(rho) {
-        return Err((at("density"), format!("must be > 0 kg/m³, found {rho}")));
-    }
-    if !positive(e) {
-        return Err((at("youngs_modulus"), format!("must be > 0 Pa, found {e}")));
-    }
-    if !(0.0..0.5).contains(&nu) {
-        return Err((at("poisson_ratio"), format!("must be in [0, 0.5), found {nu}")));
-    }
-    let model = match m {
-        MaterialSpec::LinearElastic { .. } => MaterialModel::LinearElastic(LinearElastic::new(rho, e, nu)),
-        MaterialSpec::MohrCoulomb {
-            cohesion,
-            friction_angle,
-            dilatancy_angle,
-            tension_cutoff,
-            ..
-        } => {
-            let (c, phi, psi) = (*cohesion, *friction_angle, *dilatancy_angle);
-            if !non_negative(c) {
-                return Err((at("cohesion"), format!("must be ≥ 0 Pa, found {c}")));
-            }
-            if !(0.0..90.0).contains(&phi) {
-                return Err((
-                    at("friction_angle"),
-                    format!("must be in [0°, 90°), found {phi}°"),
-                ));
-            }
-            if !(non_negative(psi) && psi <= phi) {
-                return Err((
-                    at("dilatancy_angle"),
-                    format!("must be in [0°, φ = {phi}°], found {psi}°"),
-                ));
-            }
-            if let Some(t) = tension_cutoff {
-                if !non_negative(*t) {
-                    return Err((
-                        at("tension_cutoff"),
-                        format!("must be a finite stress ≥ 0 Pa (at most c·cot φ), found {t}"),
-                    ));
-                }
-            }
-            if phi == 0.0 && c == 0.0 {
-                return Err((
-                    at("cohesion"),
-                    "with φ = 0 the cohesion must be > 0 (no strength at all)".into(),
-                ));
-            }
-            MaterialModel::MohrCoulomb(MohrCoulomb::new(rho, e, nu, c, phi, psi, *tension_cutoff))
-        }
-    };
-    // The P-wave speed sets the time step: it must be a finite number > 0 (an E near
-    // the largest double overflows M, a density near the smallest overflows M/ρ).
-    let speed = (model.p_wave_modulus() / model.density()).sqrt();
-    if !positive(speed) {
-        return Err((
-            at("youngs_modulus"),
-            format!(
-                "E = {e} Pa with ρ = {rho} kg/m³ and ν = {nu} gives a P-wave speed of {speed} m/s, \
-                 not a finite number > 0"
-            ),
-        ));
-    }
-    Ok(model)
 }
 
 /// Checks a list of face conditions (`field`: where it is in the scene): faces of the
@@ -412,7 +346,9 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
     let mut table = Vec::new();
     for (name, m) in &s.materials {
         let at = |f: &str| format!("materials.{name}.{f}");
-        let model = material_model(&at, m).map_err(|(field, rule)| loaded.invalid(&field, rule))?;
+        let model = m
+            .model(&at)
+            .map_err(|(field, rule)| loaded.invalid(&field, rule))?;
         table.push((name.clone(), model));
     }
     if !positive(s.solver.tolerance) {
@@ -813,7 +749,23 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
                 );
             }
             let at = |f: &str| format!("stages[{k}].materials.{name}.{f}");
-            let model = material_model(&at, spec).map_err(|(field, rule)| loaded.invalid(&field, rule))?;
+            let model = spec
+                .model(&at)
+                .map_err(|(field, rule)| loaded.invalid(&field, rule))?;
+            // A point carries one model's state for the whole run.
+            let carried = carried_state(loaded, &table, name).and_then(|m| m.state_name());
+            if let (Some(carried), Some(own)) = (carried, model.state_name()) {
+                if carried != own {
+                    return bad(
+                        &format!("stages[{k}].materials.{name}"),
+                        format!(
+                            "a model whose state ({own}) is not the {carried} that \"{name}\" \
+                             carries: a stage may change a material to a model with the same \
+                             state, or none"
+                        ),
+                    );
+                }
+            }
             let speed = (model.p_wave_modulus() / model.density()).sqrt();
             if speed > c_p * (1.0 + 1e-12) {
                 return bad(

@@ -162,7 +162,7 @@ fn has_foreign_component<D: Dim>(arch: &Archetype) -> bool {
 fn reorder_columns<D: Dim>(arch: &Archetype, order: &[u32]) {
     macro_rules! borrow_all {
         (@push $g:ident $jobs:ident; $($t:ty),*) => {
-            borrow_all!(@zip $g $jobs; [0 1 2 3 4 5 6 7 8 9 10] [$($t),*])
+            borrow_all!(@zip $g $jobs; [0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15] [$($t),*])
         };
         (@zip $g:ident $jobs:ident; [$i:tt $($is:tt)*] [$t:ty $(, $ts:ty)*]) => {
             if let Some(c) = $g.$i.as_deref_mut() {

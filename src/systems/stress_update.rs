@@ -6,11 +6,13 @@ use crate::context::Context;
 use crate::dim::Dim;
 use crate::error::StepError;
 use crate::lanes::{gather, F64x4, LANES};
-use crate::materials::{update_lane_by_lane, Material, MaterialModel};
+use crate::materials::{update_lane_by_lane, visit_states, MaterialModel, MaterialState, StateVisitor};
 use crate::parallel::CHUNK;
 use crate::schedule::System;
 use crate::tensor::{StoredSym, Sym3x4};
+use hecs::{Archetype, ArchetypeColumnMut};
 use rayon::prelude::*;
+use std::marker::PhantomData;
 
 /// For each point: Δε = sym(L)Δt and ΔW = skew(L)Δt; the stress is first rotated by ΔW
 /// (objective Jaumann term) and then integrated by the point's material over Δε.
@@ -31,23 +33,64 @@ impl<D: Dim> System<D> for StressUpdate {
         let Some(dt) = ctx.state.motion_dt() else {
             return Ok(());
         };
-        let materials = &ctx.materials;
+        for arch in points_with::<Stress<D::Stress>>(&ctx.world) {
+            // Each archetype carries one material state column, or none (`()`).
+            let mut update = ArchetypeUpdate::<D> {
+                arch,
+                materials: &ctx.materials,
+                dt,
+                done: false,
+                dim: PhantomData,
+            };
+            visit_states(&mut update);
+            if !update.done {
+                update.run::<()>(None);
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The stress update of one archetype, with the state column it carries.
+struct ArchetypeUpdate<'a, D> {
+    arch: &'a Archetype,
+    materials: &'a [MaterialModel],
+    dt: f64,
+    /// True once the archetype's state column was found and the update ran.
+    done: bool,
+    dim: PhantomData<D>,
+}
+
+impl<D: Dim> StateVisitor for ArchetypeUpdate<'_, D> {
+    fn visit<S: MaterialState>(&mut self) {
+        if !self.done && std::mem::size_of::<S>() > 0 {
+            if let Some(states) = self.arch.get::<&mut S>() {
+                self.run(Some(states));
+                self.done = true;
+            }
+        }
+    }
+}
+
+impl<D: Dim> ArchetypeUpdate<'_, D> {
+    /// Updates every point of the archetype, in chunks across threads; `states` is its
+    /// state column, `None` for points without state (then `S` is `()`).
+    fn run<S: MaterialState>(&self, states: Option<ArchetypeColumnMut<'_, S>>) {
+        let (materials, dt) = (self.materials, self.dt);
         let kernel = |stress: &mut [Stress<D::Stress>],
                       l: &[VelocityGradient<D::Mat>],
                       mat: &[MaterialId],
-                      mut plastic: Option<&mut [PlasticStrain]>| {
+                      state: &mut [S]| {
             let full = stress.len() / LANES * LANES;
             for g in (0..full).step_by(LANES) {
                 let at = g..g + LANES;
-                update_group::<D>(
+                update_group::<D, S>(
                     materials,
                     dt,
                     (&mut stress[at.clone()]).try_into().expect("four points"),
                     l[at.clone()].try_into().expect("four points"),
                     mat[at.clone()].try_into().expect("four points"),
-                    plastic
-                        .as_mut()
-                        .map(|e| (&mut e[at]).try_into().expect("four points")),
+                    (&mut state[at]).try_into().expect("four points"),
                 );
             }
             let n = stress.len() - full;
@@ -58,54 +101,50 @@ impl<D: Dim> System<D> for StressUpdate {
                 let mut s4: [Stress<D::Stress>; LANES] = std::array::from_fn(|q| stress[at(q)]);
                 let l4 = std::array::from_fn(|q| l[at(q)]);
                 let m4 = std::array::from_fn(|q| mat[at(q)]);
-                let mut e4: Option<[PlasticStrain; LANES]> =
-                    plastic.as_ref().map(|e| std::array::from_fn(|q| e[at(q)]));
-                update_group::<D>(materials, dt, &mut s4, &l4, &m4, e4.as_mut());
+                let mut e4: [S; LANES] = std::array::from_fn(|q| state[at(q)]);
+                update_group::<D, S>(materials, dt, &mut s4, &l4, &m4, &mut e4);
                 stress[full..].copy_from_slice(&s4[..n]);
-                if let (Some(e), Some(e4)) = (plastic, e4) {
-                    e[full..].copy_from_slice(&e4[..n]);
-                }
+                state[full..].copy_from_slice(&e4[..n]);
             }
         };
-        for arch in points_with::<Stress<D::Stress>>(&ctx.world) {
-            let (lg, mg) = (col::<VelocityGradient<D::Mat>>(arch), col::<MaterialId>(arch));
-            let mut sg = col_mut::<Stress<D::Stress>>(arch);
-            let chunks = sg
-                .par_chunks_mut(CHUNK)
-                .zip(lg.par_chunks(CHUNK))
-                .zip(mg.par_chunks(CHUNK));
-            // Plastic state exists only on plastic points.
-            match arch.get::<&mut PlasticStrain>() {
-                Some(mut pg) => chunks
-                    .zip(pg.par_chunks_mut(CHUNK))
-                    .for_each(|(((s, l), m), e)| kernel(s, l, m, Some(e))),
-                None => chunks.for_each(|((s, l), m)| kernel(s, l, m, None)),
-            }
+        let arch = self.arch;
+        let (lg, mg) = (col::<VelocityGradient<D::Mat>>(arch), col::<MaterialId>(arch));
+        let mut sg = col_mut::<Stress<D::Stress>>(arch);
+        let chunks = sg
+            .par_chunks_mut(CHUNK)
+            .zip(lg.par_chunks(CHUNK))
+            .zip(mg.par_chunks(CHUNK));
+        match states {
+            Some(mut e) => chunks
+                .zip(e.par_chunks_mut(CHUNK))
+                .for_each(|(((s, l), m), e)| kernel(s, l, m, e)),
+            None => chunks.for_each(|((s, l), m)| {
+                // A state of no size: the slice costs no memory.
+                kernel(s, l, m, &mut vec![S::default(); s.len()])
+            }),
         }
-        Ok(())
     }
 }
 
 /// Four points: strain and spin increments, the Jaumann rotation in lanes, and the material
 /// update, in lanes when the four share a material and point by point otherwise.
 #[inline(always)]
-fn update_group<D: Dim>(
+fn update_group<D: Dim, S: MaterialState>(
     materials: &[MaterialModel],
     dt: f64,
     stress: &mut [Stress<D::Stress>; LANES],
     l: &[VelocityGradient<D::Mat>; LANES],
     mat: &[MaterialId; LANES],
-    plastic: Option<&mut [PlasticStrain; LANES]>,
+    state: &mut [S; LANES],
 ) {
     let (de, w) = D::strain_spin(|i, j| gather(|q| D::mat_entry(&l[q].0, i, j)), F64x4::splat(dt));
     let mut s = D::jaumann_rotate(&Sym3x4::gather(|q| stress[q].0.to_sym3()), w);
     let id = mat[0].0;
-    let eps = plastic.map(|e| e.each_mut().map(|e| &mut e.0));
     if mat.iter().all(|m| m.0 == id) {
-        materials[id as usize].update4(&mut s, &de, eps);
+        materials[id as usize].update4(&mut s, &de, state.each_mut());
     } else {
-        update_lane_by_lane(&mut s, &de, eps, |q, s, de, eps| {
-            materials[mat[q].0 as usize].update(s, de, eps)
+        update_lane_by_lane(&mut s, &de, state.each_mut(), |q, s, de, st| {
+            materials[mat[q].0 as usize].update(s, de, st)
         });
     }
     for (stress, s) in stress.iter_mut().zip(&s.lanes()) {
