@@ -223,6 +223,13 @@ macro_rules! define_materials {
                 }
             }
 
+            /// The model's name, as a scene writes it.
+            pub fn name(&self) -> &'static str {
+                match self {
+                    $(MaterialModel::$variant(_) => stringify!($variant),)*
+                }
+            }
+
             /// Calls `v` with this model's state type.
             pub fn visit_state(&self, v: &mut impl StateVisitor) {
                 match self {

@@ -753,17 +753,20 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
                 .model(&at)
                 .map_err(|(field, rule)| loaded.invalid(&field, rule))?;
             // A point carries one model's state for the whole run.
-            let carried = carried_state(loaded, &table, name).and_then(|m| m.state_name());
-            if let (Some(carried), Some(own)) = (carried, model.state_name()) {
-                if carried != own {
-                    return bad(
-                        &format!("stages[{k}].materials.{name}"),
-                        format!(
-                            "a model whose state ({own}) is not the {carried} that \"{name}\" \
-                             carries: a stage may change a material to a model with the same \
-                             state, or none"
-                        ),
-                    );
+            if let Some(carried) = carried_state(loaded, &table, name) {
+                if let (Some(a), Some(b)) = (carried.state_name(), model.state_name()) {
+                    if a != b {
+                        return bad(
+                            &format!("stages[{k}].materials.{name}"),
+                            format!(
+                                "{} has another internal state than {}, which \"{name}\" takes \
+                                 in the scene or an earlier stage: a stage may change a material \
+                                 to a model with the same state, or with none",
+                                model.name(),
+                                carried.name()
+                            ),
+                        );
+                    }
                 }
             }
             let speed = (model.p_wave_modulus() / model.density()).sqrt();
