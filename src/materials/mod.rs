@@ -14,9 +14,11 @@
 
 mod linear_elastic;
 mod mohr_coulomb;
+mod mohr_coulomb_softening;
 
 pub use linear_elastic::{LinearElastic, LinearElasticSpec};
 pub use mohr_coulomb::{MohrCoulomb, MohrCoulombSpec, PlasticStrain, Return};
+pub use mohr_coulomb_softening::{MohrCoulombSoftening, MohrCoulombSofteningSpec, SofteningStrain};
 
 use crate::lanes::{Lanes, LANES};
 use crate::tensor::{Sym, Sym3, Sym3x4};
@@ -34,6 +36,7 @@ macro_rules! materials {
         $($mac)*! {[$($arg)*]
             LinearElastic($crate::materials::LinearElasticSpec),
             MohrCoulomb($crate::materials::MohrCoulombSpec),
+            MohrCoulombSoftening($crate::materials::MohrCoulombSofteningSpec),
         }
     };
 }

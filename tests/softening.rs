@@ -1,0 +1,84 @@
+//! Mohr-Coulomb with strain softening (`MohrCoulombSoftening`) in whole runs.
+
+mod common;
+
+use kdmpm::fos::strength_reduction;
+use kdmpm::scene::LoadedScene;
+
+/// The Griffiths–Lane soil (ρ, E, ν of scenes/slope_fos.ron) with peak c = 10 kPa,
+/// φ = 20° and the given residual strength, reached at κ = `kappa_r`.
+fn softening(c_r: f64, phi_r: f64, kappa_r: f64) -> String {
+    format!(
+        "materials.soil=MohrCoulombSoftening(density: 2038.74, youngs_modulus: 100.0e6, \
+         poisson_ratio: 0.3, cohesion: 10.0e3, friction_angle: 20.0, residual_cohesion: {c_r:?}, \
+         residual_friction_angle: {phi_r:?}, softening_strain: {kappa_r:?})"
+    )
+}
+
+fn slope(overrides: &[String]) -> LoadedScene {
+    LoadedScene::from_file(&common::scene("slope_fos.ron"), overrides).expect("scene loads")
+}
+
+#[test]
+fn a_softening_soil_whose_residual_is_its_peak_runs_as_mohr_coulomb_bit_for_bit() {
+    let scene = common::scene("slope_fos.ron");
+    let scene = scene.to_str().expect("a UTF-8 path");
+    let (plain, soft) = (
+        common::scratch("softening", "plain"),
+        common::scratch("softening", "soft"),
+    );
+    let same = softening(10.0e3, 20.0, 0.01);
+    for (out, extra) in [(&plain, None), (&soft, Some(same.as_str()))] {
+        let mut args = vec!["run", scene, "--quiet", "--out", out.to_str().expect("UTF-8")];
+        if let Some(set) = extra {
+            args.extend(["--set", set]);
+        }
+        let o = common::kdmpm(&args);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    }
+    // The state column, its sort and its output (`plastic_strain`) included.
+    for file in ["history.csv", "points.vtu"] {
+        let (a, b) = (std::fs::read(plain.join(file)), std::fs::read(soft.join(file)));
+        assert!(a.expect(file) == b.expect(file), "{file} differs");
+    }
+}
+
+/// Softening lowers the factor of safety of the Griffiths–Lane slope below the one of its
+/// peak strength (1.4, pinned in tests/fos.rs), and not as far as the one of its residual
+/// strength alone: failure progresses from the points that yield first, while the others
+/// keep their peak.
+#[test]
+fn softening_puts_the_factor_of_safety_between_the_residual_and_the_peak() {
+    let wide = "strength_reduction.bracket=[0.5, 2.0]".to_string();
+    let fos = |name: &str, overrides: Vec<String>| {
+        let out = common::scratch("softening", name);
+        strength_reduction(&slope(&overrides), &out, |_| {})
+            .expect("the bracket holds the factor")
+            .factor_of_safety
+    };
+    let peak = fos("peak", vec![wide.clone()]);
+    let residual_only = "materials.soil=MohrCoulomb(density: 2038.74, youngs_modulus: 100.0e6, \
+                         poisson_ratio: 0.3, cohesion: 2.0e3, friction_angle: 16.0)"
+        .to_string();
+    let residual = fos("residual", vec![wide.clone(), residual_only]);
+    let soft = fos("soft", vec![wide, softening(2.0e3, 16.0, 0.01)]);
+    assert!(
+        residual + 0.1 < soft && soft < peak - 0.05,
+        "residual {residual}, softening {soft}, peak {peak}"
+    );
+}
+
+#[test]
+fn a_stage_may_not_give_a_material_a_model_with_another_state() {
+    let text = std::fs::read_to_string(common::scene("slope_fos.ron")).expect("scene");
+    let stage = "stages: [(name: \"soft\", materials: {\"soil\": MohrCoulombSoftening(density: 2038.74, \
+                 youngs_modulus: 100.0e6, poisson_ratio: 0.3, cohesion: 10.0e3, friction_angle: 20.0, \
+                 residual_cohesion: 2.0e3, residual_friction_angle: 16.0, softening_strain: 0.01)})],";
+    let bad = text.replacen("    solver: (", &format!("    {stage}\n    solver: ("), 1);
+    let e = common::refusal(&bad);
+    assert!(e.contains("stages[0].materials.soil"), "{e}");
+    assert!(
+        e.contains("MohrCoulombSoftening has another internal state than MohrCoulomb"),
+        "{e}"
+    );
+}
