@@ -23,7 +23,7 @@ pub use mohr_coulomb_softening::{MohrCoulombSoftening, MohrCoulombSofteningSpec,
 use crate::lanes::{Lanes, LANES};
 use crate::tensor::{Sym, Sym3, Sym3x4};
 use serde::{de::DeserializeOwned, Deserialize, Serialize};
-use std::any::Any;
+use std::any::TypeId;
 use std::fmt::Debug;
 
 /// The material registry: calls `$mac!([args] Variant(SceneEntry), ...)` with every material
@@ -118,28 +118,26 @@ pub fn update_lane_by_lane<S>(
     *stress = Sym3x4::gather(|l| s[l]);
 }
 
-/// The model's own state behind a state of type `S`: the same value when `S` is the model's
-/// state type; a throw-away default for a model without state (an elastic stage of a body
-/// that carries plastic state keeps it untouched).
+/// `state` as a `T`, when `S` is `T`.
 #[inline(always)]
-fn with_state<M: Material, S: MaterialState, R>(state: &mut S, f: impl FnOnce(&mut M::State) -> R) -> R {
-    match (state as &mut dyn Any).downcast_mut::<M::State>() {
-        Some(own) => f(own),
-        None => f(&mut stateless::<M>()),
+fn same_type<S: MaterialState, T: MaterialState>(state: &mut S) -> Option<&mut T> {
+    // Two constants once monomorphised: the test costs nothing per point.
+    if TypeId::of::<S>() == TypeId::of::<T>() {
+        // SAFETY: `S` and `T` have the same `TypeId`, so they are the same type and the
+        // pointer is a valid, unique `&mut T` for the borrow's lifetime.
+        Some(unsafe { &mut *(state as *mut S).cast::<T>() })
+    } else {
+        None
     }
 }
 
-/// Four states of type `S` as the model's (see [`with_state`]).
+/// Four states of type `S` as `T`s, when `S` is `T`.
 #[inline(always)]
-fn with_states<M: Material, S: MaterialState, R>(
-    state: [&mut S; LANES],
-    f: impl FnOnce([&mut M::State; LANES]) -> R,
-) -> R {
-    if std::any::TypeId::of::<S>() == std::any::TypeId::of::<M::State>() {
-        f(state.map(|s| (s as &mut dyn Any).downcast_mut::<M::State>().expect("same type")))
+fn same_types<S: MaterialState, T: MaterialState>(state: [&mut S; LANES]) -> Option<[&mut T; LANES]> {
+    if TypeId::of::<S>() == TypeId::of::<T>() {
+        Some(state.map(|s| same_type::<S, T>(s).expect("the same type")))
     } else {
-        let mut none: [M::State; LANES] = std::array::from_fn(|_| stateless::<M>());
-        f(none.each_mut())
+        None
     }
 }
 
@@ -271,7 +269,12 @@ macro_rules! define_materials {
             pub fn update<S: MaterialState>(&self, stress: &mut Sym3, de: &Sym3, state: &mut S) {
                 // Static dispatch on the enum keeps the per-point call inlinable.
                 match self {
-                    $(MaterialModel::$variant(m) => with_state::<<$spec as SceneMaterial>::Model, S, _>(state, |st| m.update(stress, de, st)),)*
+                    // A model's own state, or a throw-away one for a model without state
+                    // (an elastic stage of a body that carries plastic state keeps it).
+                    $(MaterialModel::$variant(m) => match same_type(state) {
+                        Some(own) => m.update(stress, de, own),
+                        None => m.update(stress, de, &mut stateless::<<$spec as SceneMaterial>::Model>()),
+                    },)*
                 }
             }
 
@@ -280,9 +283,14 @@ macro_rules! define_materials {
             #[inline(always)]
             pub fn update4<S: MaterialState>(&self, stress: &mut Sym3x4, de: &Sym3x4, state: [&mut S; LANES]) {
                 match self {
-                    $(MaterialModel::$variant(m) => {
-                        with_states::<<$spec as SceneMaterial>::Model, S, _>(state, |st| m.update4(stress, de, st))
-                    })*
+                    // Calls, not closures: the model's update is inlined into the loop.
+                    $(MaterialModel::$variant(m) => match same_types(state) {
+                        Some(own) => m.update4(stress, de, own),
+                        None => {
+                            let mut none = [stateless::<<$spec as SceneMaterial>::Model>(); LANES];
+                            m.update4(stress, de, none.each_mut())
+                        }
+                    },)*
                 }
             }
         }
@@ -371,7 +379,6 @@ impl Elasticity {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::any::TypeId;
 
     #[test]
     fn every_registered_state_is_its_own_type_or_none() {
