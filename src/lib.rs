@@ -15,8 +15,10 @@
 pub mod alloc;
 pub mod checkpoint;
 pub mod columns;
+pub mod comm;
 pub mod components;
 pub mod context;
+pub mod decomposition;
 pub mod dim;
 pub mod error;
 pub mod fos;

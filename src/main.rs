@@ -2,6 +2,7 @@
 
 use clap::{Parser, Subcommand};
 use kdmpm::checkpoint;
+use kdmpm::comm::Comm;
 use kdmpm::output::{Outcome, OutputDir, Progress, Recorder, Summary};
 use kdmpm::scene::{build, CheckpointEvery, LoadedScene};
 use kdmpm::state::StopReason;
@@ -128,7 +129,28 @@ const BAD_INPUT: u8 = 2;
 const RUN_FAILED: u8 = 1;
 
 fn main() -> ExitCode {
-    match Cli::parse().command {
+    let cli = Cli::parse();
+    // MPI starts before any thread pool; without `mpirun` (or the `mpi` feature) this is
+    // one rank.
+    let comm = match Comm::world() {
+        Ok(c) => c,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(RUN_FAILED);
+        }
+    };
+    if comm.size() > 1 {
+        // The collectives and the decomposition exist; the step does not use them yet.
+        if comm.is_root() {
+            eprintln!(
+                "error: kdmpm was started on {} ranks; a run is not yet split across ranks, so \
+                 every rank would solve the whole scene: start it without mpirun",
+                comm.size()
+            );
+        }
+        return ExitCode::from(RUN_FAILED);
+    }
+    match cli.command {
         Command::Check { scene, overrides } => check(&scene, &overrides),
         Command::Plot { dir } => match kdmpm::output::plots::draw(&dir) {
             Ok((written, skipped)) => {
