@@ -4,6 +4,7 @@
 //! rank's values and adds them in rank order on every rank, so all ranks hold the same bits
 //! and a rerun gives them again. Nothing depends on message arrival order.
 
+use std::sync::atomic::{AtomicU64, Ordering};
 #[cfg(feature = "mpi")]
 use std::sync::Mutex;
 
@@ -11,6 +12,8 @@ use std::sync::Mutex;
 pub struct Comm {
     rank: usize,
     size: usize,
+    /// Bytes this rank has sent to others (exchanges and its part of the gathers).
+    sent: AtomicU64,
     #[cfg(feature = "mpi")]
     mpi: Option<Mpi>,
 }
@@ -50,6 +53,7 @@ impl Comm {
         Comm {
             rank: 0,
             size: 1,
+            sent: AtomicU64::new(0),
             #[cfg(feature = "mpi")]
             mpi: None,
         }
@@ -75,6 +79,7 @@ impl Comm {
             Ok(Comm {
                 rank,
                 size,
+                sent: AtomicU64::new(0),
                 mpi: Some(Mpi {
                     world: Mutex::new(world),
                     _universe: universe,
@@ -95,6 +100,12 @@ impl Comm {
         self.size
     }
 
+    /// Bytes this rank has sent to the others so far: its values in every gather (once for
+    /// each other rank) and its exchanges.
+    pub fn sent_bytes(&self) -> u64 {
+        self.sent.load(Ordering::Relaxed)
+    }
+
     /// True on rank 0, which writes the run's shared files.
     pub fn is_root(&self) -> bool {
         self.rank == 0
@@ -106,6 +117,8 @@ impl Comm {
         #[cfg(feature = "mpi")]
         if let Some(m) = &self.mpi {
             use mpi::collective::CommunicatorCollectives;
+            let bytes = 8 * values.len() * (self.size - 1);
+            self.sent.fetch_add(bytes as u64, Ordering::Relaxed);
             let mut all = vec![0.0; values.len() * self.size];
             let world = m.world.lock().expect("MPI calls never panic midway");
             world.all_gather_into(values, &mut all[..]);
@@ -149,6 +162,25 @@ impl Comm {
         }
     }
 
+    /// Completes a list indexed by point id in which each rank filled its own points and
+    /// left the others NaN (see [`crate::measure::positions`]): every rank gets every
+    /// point's entry. The lists may differ in length (ids above a rank's last point).
+    pub fn merge_by_id(&self, list: &mut Vec<[f64; 3]>) {
+        if self.size == 1 {
+            return;
+        }
+        let mut len = [list.len() as f64];
+        self.max(&mut len);
+        list.resize(len[0] as usize, [f64::NAN; 3]);
+        let n = list.len() * 3;
+        let all = self.gather_all(list.as_flattened());
+        for (i, v) in list.as_flattened_mut().iter_mut().enumerate() {
+            if let Some(found) = (0..self.size).map(|r| all[r * n + i]).find(|x| !x.is_nan()) {
+                *v = found;
+            }
+        }
+    }
+
     /// Sends `send` to rank `to` and receives what rank `from` sends this rank, of any
     /// length. Every rank calls it in the same pattern, so that sends meet receives.
     pub fn exchange(&self, to: Option<usize>, send: &[f64], from: Option<usize>) -> Vec<f64> {
@@ -156,6 +188,10 @@ impl Comm {
         if let Some(m) = &self.mpi {
             use mpi::point_to_point::{Destination, Source};
             use mpi::topology::Communicator;
+            if to.is_some() {
+                self.sent
+                    .fetch_add(8 * (send.len() as u64 + 1), Ordering::Relaxed);
+            }
             let world = m.world.lock().expect("MPI calls never panic midway");
             // Lengths first, then the values; a rank without a partner skips its half.
             let mut out = Vec::new();

@@ -1,11 +1,15 @@
 //! What every system reads and writes.
 
+use crate::comm::Comm;
+use crate::decomposition::Decomposition;
 use crate::dim::Dim;
 use crate::grid::Grid;
 use crate::materials::MaterialModel;
 use crate::parallel::SlabCache;
 use crate::state::{Settings, SolverState};
 use hecs::World;
+use std::ops::Range;
+use std::sync::Arc;
 
 /// Everything the systems read and write: the world (points and nodes), the grid, the
 /// material table and the solver-wide state.
@@ -22,4 +26,24 @@ pub struct Context<D: Dim> {
     pub state: SolverState,
     /// Points grouped by slab of cells for the scatters, kept until points move.
     pub slabs: SlabCache,
+    /// The ranks of the run (one without MPI).
+    pub comm: Arc<Comm>,
+    /// This rank's cell and node layers (one rank: all of them).
+    pub decomposition: Decomposition,
+    /// Node columns already summed over the ranks this step (bits of
+    /// [`crate::systems::exchange`]); cleared by the grid reset.
+    pub exchanged: u8,
+}
+
+impl<D: Dim> Context<D> {
+    /// The node ids this rank owns when the run has several ranks (each node is owned by
+    /// one rank, so sums over owned nodes add up over the ranks); `None` with one rank.
+    pub fn owned_node_ids(&self) -> Option<Range<usize>> {
+        if self.comm.size() == 1 {
+            return None;
+        }
+        let layers = self.decomposition.owned_nodes();
+        let layer = self.grid.layer();
+        Some(layers.start * layer..layers.end * layer)
+    }
 }

@@ -19,14 +19,17 @@ pub struct Decomposition {
     pub bounds: Vec<usize>,
     /// This rank.
     pub rank: usize,
+    /// Nodes per axis in a point's support (the shape functions').
+    pub support: usize,
 }
 
 impl Decomposition {
     /// One rank owning every one of `layers` cell layers.
-    pub fn whole(layers: usize) -> Decomposition {
+    pub fn whole(layers: usize, support: usize) -> Decomposition {
         Decomposition {
             bounds: vec![0, layers],
             rank: 0,
+            support,
         }
     }
 
@@ -49,7 +52,11 @@ impl Decomposition {
             // Everything on rank 0; the others hold nothing.
             let mut bounds = vec![0, layers];
             bounds.extend(std::iter::repeat_n(layers, ranks - 1));
-            return Ok(Decomposition { bounds, rank });
+            return Ok(Decomposition {
+                bounds,
+                rank,
+                support,
+            });
         }
         let mut bounds = vec![0];
         let mut prefix = 0u64;
@@ -69,7 +76,11 @@ impl Decomposition {
         bounds.push(layers);
         // Ranks beyond the busy ones hold nothing (at the top).
         bounds.extend(std::iter::repeat_n(layers, ranks - busy));
-        Ok(Decomposition { bounds, rank })
+        Ok(Decomposition {
+            bounds,
+            rank,
+            support,
+        })
     }
 
     /// The number of ranks.
@@ -125,6 +136,19 @@ impl Decomposition {
     /// layer `at`, for shapes reaching `support` nodes: `at − 1 .. at + support`.
     pub fn band(at: usize, support: usize) -> Range<usize> {
         at.saturating_sub(1)..at + support
+    }
+
+    /// The bands this rank shares with its neighbours below and above, as (neighbour, node
+    /// layers), clipped to the grid's node layers.
+    pub fn bands(&self) -> [Option<(usize, Range<usize>)>; 2] {
+        let (below, above) = self.neighbours();
+        let top = *self.bounds.last().expect("bounds are never empty") + 1;
+        let clip = |r: Range<usize>| r.start..r.end.min(top);
+        let cells = self.cells();
+        [
+            below.map(|b| (b, clip(Self::band(cells.start, self.support)))),
+            above.map(|a| (a, clip(Self::band(cells.end, self.support)))),
+        ]
     }
 
     /// Largest point count of a rank over the mean (1 is perfect balance).
@@ -196,6 +220,7 @@ mod tests {
     #[test]
     fn each_node_layer_has_one_owner_and_each_cell_one_rank() {
         let all = ranks_of(&[7; 30], 3, 3);
+        assert_eq!(all[1].bands(), [Some((0, 9..13)), Some((2, 19..23))]);
         let mut owners = vec![0; 31];
         for d in &all {
             for k in d.owned_nodes() {

@@ -20,6 +20,7 @@ pub mod components;
 pub mod context;
 pub mod decomposition;
 pub mod dim;
+pub mod distributed;
 pub mod error;
 pub mod fos;
 pub mod grid;

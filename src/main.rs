@@ -12,6 +12,7 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 use std::time::Instant;
 
 /// Large blocks coloured, so that the columns a kernel uses together never share their
@@ -139,16 +140,16 @@ fn main() -> ExitCode {
             return ExitCode::from(RUN_FAILED);
         }
     };
-    if comm.size() > 1 {
-        // The collectives and the decomposition exist; the step does not use them yet.
+    let comm = Arc::new(comm);
+    if comm.size() > 1 && !matches!(cli.command, Command::Run { .. }) {
         if comm.is_root() {
             eprintln!(
-                "error: kdmpm was started on {} ranks; a run is not yet split across ranks, so \
-                 every rank would solve the whole scene: start it without mpirun",
+                "error: kdmpm was started on {} ranks; only `kdmpm run` is split across ranks: \
+                 start the other commands without mpirun",
                 comm.size()
             );
         }
-        return ExitCode::from(RUN_FAILED);
+        return ExitCode::from(BAD_INPUT);
     }
     match cli.command {
         Command::Check { scene, overrides } => check(&scene, &overrides),
@@ -202,7 +203,7 @@ fn main() -> ExitCode {
                 }
             };
             match start_threads(stepping.threads) {
-                Ok(()) => run(&scene, out, &overrides, stepping.profile, stepping.quiet),
+                Ok(()) => run(&scene, out, &overrides, stepping.profile, stepping.quiet, comm),
                 Err(code) => code,
             }
         }
@@ -291,16 +292,34 @@ fn check(path: &Path, overrides: &[String]) -> ExitCode {
     }
 }
 
-fn run(path: &Path, out: Option<PathBuf>, overrides: &[String], profile: bool, quiet: bool) -> ExitCode {
+fn run(
+    path: &Path,
+    out: Option<PathBuf>,
+    overrides: &[String],
+    profile: bool,
+    quiet: bool,
+    comm: Arc<Comm>,
+) -> ExitCode {
     let (loaded, mut sim) =
         match LoadedScene::from_file(path, overrides).and_then(|l| build(&l).map(|(s, _)| (l, s))) {
             Ok(v) => v,
             Err(e) => {
-                eprintln!("error: {e}");
+                // Every rank finds the same error; one reports it.
+                if comm.is_root() {
+                    eprintln!("error: {e}");
+                }
                 return ExitCode::from(BAD_INPUT);
             }
         };
     let out = out.unwrap_or_else(|| default_out(path, "", "scene"));
+    if comm.size() > 1 {
+        let options = Options {
+            profile,
+            quiet,
+            ranks: comm.size(),
+        };
+        return with_simulation!(&mut sim, s => run_ranks(s, &loaded, path, &out, options, comm));
+    }
     let dir = match OutputDir::claim(&out) {
         Ok(d) => d,
         Err(e) => {
@@ -323,8 +342,98 @@ fn run(path: &Path, out: Option<PathBuf>, overrides: &[String], profile: bool, q
         history_bytes: 0,
         wall_seconds: 0.0,
     };
-    let options = Options { profile, quiet };
+    let options = Options {
+        profile,
+        quiet,
+        ranks: 1,
+    };
     with_simulation!(&mut sim, s => drive(s, &loaded, &dir, None, header, options))
+}
+
+/// `kdmpm run` over MPI ranks: each rank steps its part of the scene; rank 0 writes
+/// history.csv, summary.json (the ranks' figures) and points.pvtu, every rank its own
+/// `points_<rank>.vtu`.
+fn run_ranks<D: Dim>(
+    sim: &mut Simulation<D>,
+    loaded: &LoadedScene,
+    path: &Path,
+    out: &Path,
+    options: Options,
+    comm: Arc<Comm>,
+) -> ExitCode {
+    let refuse = |what: String| {
+        if comm.is_root() {
+            eprintln!("error: {}: {what}", path.display());
+        }
+        ExitCode::from(BAD_INPUT)
+    };
+    if loaded.scene.solver.checkpoint_every.is_some() || loaded.scene.output.snapshots.is_some() {
+        return refuse(format!(
+            "a run over {} ranks does not yet write checkpoints or snapshots: remove \
+             solver.checkpoint_every and output.snapshots, or run on one rank",
+            comm.size()
+        ));
+    }
+    if let Err(e) = kdmpm::distributed::decompose(sim, comm.clone()) {
+        return refuse(e);
+    }
+    // Every rank gathers the traced points for rank 0's history, before it is written.
+    let gather = kdmpm::output::TracedGather::new(&sim.traced);
+    sim.schedule.push(gather);
+    let dir = if comm.is_root() {
+        match OutputDir::claim(out) {
+            Ok(d) => Some(d),
+            Err(e) => {
+                eprintln!("error: {e}");
+                None
+            }
+        }
+    } else {
+        None
+    };
+    // Whether rank 0 holds the directory: the others write into it.
+    if comm.any(comm.is_root() && dir.is_none()) {
+        return ExitCode::from(BAD_INPUT);
+    }
+    if let Some(dir) = dir {
+        let header = checkpoint::Header {
+            scene_path: path.to_path_buf(),
+            scene_text: loaded.text.clone(),
+            history_bytes: 0,
+            wall_seconds: 0.0,
+        };
+        return drive(sim, loaded, &dir, None, header, options);
+    }
+    let start = Instant::now();
+    let result = sim.run(|_| {});
+    let part = out.join(format!("points_{}.vtu", comm.rank()));
+    let written = match sim.first_non_finite() {
+        None => kdmpm::output::vtk::write_points(sim, &part),
+        Some(_) => Ok(()),
+    };
+    // The summary's figures are collectives: this rank takes part, rank 0 writes them.
+    let error = result.as_ref().err().map(|e| e.to_string());
+    let _ = Summary::collect(
+        &path.display().to_string(),
+        sim,
+        start.elapsed().as_secs_f64(),
+        error,
+    );
+    match (result, written) {
+        (Ok(()), Ok(())) => ExitCode::SUCCESS,
+        (Err(e), _) => {
+            eprintln!("error: rank {}: {e}", comm.rank());
+            ExitCode::from(RUN_FAILED)
+        }
+        (_, Err(e)) => {
+            eprintln!(
+                "error: rank {}: cannot write {}: {e}",
+                comm.rank(),
+                part.display()
+            );
+            ExitCode::from(RUN_FAILED)
+        }
+    }
 }
 
 /// Continues the run whose checkpoint is in `dir`.
@@ -355,7 +464,11 @@ fn resume(dir_path: &Path, profile: bool, quiet: bool) -> ExitCode {
         Ok(d) => d,
         Err(e) => return fail(&e),
     };
-    let options = Options { profile, quiet };
+    let options = Options {
+        profile,
+        quiet,
+        ranks: 1,
+    };
     with_simulation!(&mut sim, s => {
         if let Err(e) = checkpoint::restore(s, &bytes, &file) {
             return fail(&e);
@@ -370,6 +483,9 @@ fn resume(dir_path: &Path, profile: bool, quiet: bool) -> ExitCode {
 struct Options {
     profile: bool,
     quiet: bool,
+    /// Ranks of the run: with more than one, Ctrl-C is left to mpirun (a checkpoint would
+    /// be rank 0's alone).
+    ranks: usize,
 }
 
 /// Set by Ctrl-C: the run checkpoints and stops after the step under way.
@@ -400,11 +516,13 @@ fn drive<D: Dim>(
     let rows = recorder.rows().clone();
     // A second Ctrl-C while the first is being honoured ends the process at once; every
     // file is written whole or not at all, so nothing torn is left.
-    let _ = ctrlc::set_handler(|| {
-        if INTERRUPTED.swap(true, Ordering::SeqCst) {
-            std::process::exit(INTERRUPTED_EXIT.into());
-        }
-    });
+    if options.ranks == 1 {
+        let _ = ctrlc::set_handler(|| {
+            if INTERRUPTED.swap(true, Ordering::SeqCst) {
+                std::process::exit(INTERRUPTED_EXIT.into());
+            }
+        });
+    }
     if !options.quiet {
         eprintln!(
             "{}: {} points, {}D, Δt = {:.4e} s{}",

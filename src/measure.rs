@@ -38,6 +38,26 @@ pub fn surface_angle<D: Dim>(sim: &Simulation<D>) -> Option<SurfaceAngle> {
             }
         }
     }
+    // Over MPI each rank found the tops of its own points: the highest of the ranks' tops
+    // (the lowest rank's on a tie) is the column's. A collective.
+    let comm = &sim.ctx.comm;
+    if comm.size() > 1 {
+        let mine: Vec<f64> = top
+            .iter()
+            .flat_map(|t| t.map_or([f64::NAN; 2], |(x, y)| [x, y]))
+            .collect();
+        let all = comm.gather_all(&mine);
+        let n = mine.len();
+        for (c, t) in top.iter_mut().enumerate() {
+            *t = None;
+            for r in 0..comm.size() {
+                let (x, y) = (all[r * n + 2 * c], all[r * n + 2 * c + 1]);
+                if !y.is_nan() && t.is_none_or(|(_, ty)| y > ty) {
+                    *t = Some((x, y));
+                }
+            }
+        }
+    }
     let max_height = top
         .iter()
         .flatten()

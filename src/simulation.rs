@@ -27,9 +27,15 @@ pub struct TracedPoint {
 impl TracedPoint {
     /// The entity that holds the point now.
     pub fn current_entity(&self, world: &World) -> Entity {
+        self.find(world).expect("traced point exists")
+    }
+
+    /// The entity that holds the point now, `None` when this rank does not hold it (over
+    /// MPI).
+    pub fn find(&self, world: &World) -> Option<Entity> {
         match world.get::<&PointId>(self.entity) {
-            Ok(id) if *id == self.id => self.entity,
-            _ => find_point(world, self.id).expect("traced point exists"),
+            Ok(id) if *id == self.id => Some(self.entity),
+            _ => find_point(world, self.id),
         }
     }
 
@@ -99,7 +105,9 @@ impl<D: Dim> Simulation<D> {
         let result = self.schedule.run(&mut self.ctx);
         if self.ctx.state.points_reordered {
             for t in &mut self.traced {
-                t.entity = t.current_entity(&self.ctx.world);
+                if let Some(e) = t.find(&self.ctx.world) {
+                    t.entity = e;
+                }
             }
         }
         result
@@ -189,26 +197,42 @@ impl<D: Dim> Simulation<D> {
             .sum()
     }
 
-    /// Current displacement and stress of every traced point.
+    /// Current displacement and stress of every traced point. Over MPI a collective: each
+    /// point's values come from the rank that holds it, and every rank gets them.
     pub fn traced_results(&self) -> Vec<TracedResult> {
+        // Per point: displacement (3) and stress (6), zero on the ranks that lack it.
+        let mut values = Vec::with_capacity(self.traced.len() * 9);
+        for t in &self.traced {
+            match t.find(&self.ctx.world) {
+                Some(entity) => {
+                    let e = self.ctx.world.entity(entity).expect("found above");
+                    let s = e
+                        .get::<&Stress<D::Stress>>()
+                        .map(|s| s.0.to_sym3())
+                        .unwrap_or_default();
+                    values.extend(t.displacement::<D>(&self.ctx.world));
+                    values.extend([s.xx, s.yy, s.zz, s.xy, s.yz, s.zx]);
+                }
+                None => values.extend([0.0; 9]),
+            }
+        }
+        // One rank holds each point: the others add zeros, which leaves its value.
+        self.ctx.comm.sum(&mut values);
         self.traced
             .iter()
-            .map(|t| {
-                let e = self
-                    .ctx
-                    .world
-                    .entity(t.current_entity(&self.ctx.world))
-                    .expect("traced point exists");
-                let stress = e
-                    .get::<&Stress<D::Stress>>()
-                    .map(|s| s.0.to_sym3())
-                    .unwrap_or_default();
-                TracedResult {
-                    name: t.name.clone(),
-                    initial_position: t.initial_position,
-                    displacement: t.displacement::<D>(&self.ctx.world),
-                    stress,
-                }
+            .zip(values.chunks(9))
+            .map(|(t, v)| TracedResult {
+                name: t.name.clone(),
+                initial_position: t.initial_position,
+                displacement: [v[0], v[1], v[2]],
+                stress: Sym3 {
+                    xx: v[3],
+                    yy: v[4],
+                    zz: v[5],
+                    xy: v[6],
+                    yz: v[7],
+                    zx: v[8],
+                },
             })
             .collect()
     }

@@ -386,6 +386,13 @@ pub struct SolverState {
     ///
     /// [`PointId`]: crate::components::PointId
     pub points_reordered: bool,
+    /// Over MPI, the traced points' displacements (m) gathered from the ranks that hold
+    /// them this step (`output::history::TracedGather`); empty with one rank.
+    pub traced_displacements: Vec<[f64; 3]>,
+    /// Over MPI, the points this rank sent to another so far.
+    pub migrations: u64,
+    /// Over MPI, how many times the cell layers were split again.
+    pub rebalances: u64,
     /// Every peak at which velocities were reset.
     pub peaks: Vec<Peak>,
     /// Set when the run should stop after this step.

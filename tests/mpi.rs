@@ -1,11 +1,15 @@
-//! Collectives over MPI ranks (`cargo test --release --features mpi --test mpi`; needs the
-//! system's MPI, see the README). Each test starts this test binary again under
-//! `mpirun -n N`, which runs the `ranks_*` body on every rank; the ranks' exit codes are
-//! the verdict.
+//! Runs over MPI ranks (`cargo test --release --features mpi --test mpi`; needs the
+//! system's MPI, see the README). The collectives' tests start this test binary again under
+//! `mpirun -n N`, which runs the `ranks_*` body on every rank; the scene tests run
+//! `mpirun -n N kdmpm run` and compare what rank 0 writes with a run on one rank.
 #![cfg(feature = "mpi")]
+
+mod common;
 
 use kdmpm::comm::Comm;
 use kdmpm::decomposition::Decomposition;
+use serde_json::Value;
+use std::path::{Path, PathBuf};
 use std::process::Command;
 
 /// Set in the ranks that `mpirun` starts.
@@ -106,4 +110,164 @@ fn ranks_find_the_same_decomposition() {
     let all = comm.gather_all(&bounds);
     assert!(all.chunks(bounds.len()).all(|b| b == &bounds[..]), "{all:?}");
     assert_eq!(d.rank, comm.rank());
+}
+
+/// `kdmpm run SCENE` on `ranks` ranks (one thread each) into a scratch directory; its
+/// summary.json.
+fn run_on(scene: &str, ranks: usize, name: &str, overrides: &[&str]) -> (PathBuf, Value) {
+    let out = common::scratch("mpi", &format!("{name}-{ranks}"));
+    let path = common::scene(scene);
+    let mut cmd = Command::new("mpirun");
+    cmd.args(["--allow-run-as-root", "--oversubscribe", "-n", &ranks.to_string()])
+        .arg(env!("CARGO_BIN_EXE_kdmpm"))
+        .args([
+            "run",
+            path.to_str().expect("UTF-8"),
+            "--quiet",
+            "--threads",
+            "1",
+            "--out",
+        ])
+        .arg(&out);
+    for o in overrides {
+        cmd.args(["--set", o]);
+    }
+    let o = cmd.output().expect("mpirun starts");
+    assert!(
+        o.status.success(),
+        "{scene} on {ranks} ranks: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let summary = std::fs::read_to_string(out.join("summary.json")).expect("summary.json");
+    (out, serde_json::from_str(&summary).expect("JSON"))
+}
+
+/// Relative difference of two summary numbers.
+fn rel(a: &Value, b: &Value) -> f64 {
+    let (a, b) = (a.as_f64().expect("a number"), b.as_f64().expect("a number"));
+    if a == b {
+        return 0.0;
+    }
+    (a - b).abs() / a.abs().max(b.abs())
+}
+
+/// The state figures of a summary that must agree across rank counts.
+const STATE: [&str; 6] = [
+    "kinetic_energy",
+    "external_work",
+    "force_ratio_max",
+    "force_ratio_mean",
+    "energy_ratio",
+    "time",
+];
+
+/// Same steps and resets as one rank, and every state figure and traced value within
+/// `tolerance` of it.
+fn agrees(one: &Value, many: &Value, tolerance: f64, what: &str) {
+    assert_eq!(one["steps"], many["steps"], "{what}: steps");
+    assert_eq!(one["kinetic_resets"], many["kinetic_resets"], "{what}: resets");
+    assert_eq!(one["outcome"], many["outcome"], "{what}: outcome");
+    assert_eq!(one["particles"], many["particles"], "{what}: points");
+    for k in STATE {
+        assert!(
+            rel(&one[k], &many[k]) <= tolerance,
+            "{what}: {k} {} against {}",
+            many[k],
+            one[k]
+        );
+    }
+    for (a, b) in one["traced"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .zip(many["traced"].as_array().unwrap())
+    {
+        for c in 0..3 {
+            let (x, y) = (&a["displacement"][c], &b["displacement"][c]);
+            assert!(
+                rel(x, y) <= tolerance.max(1e-300),
+                "{what}: traced {x} against {y}"
+            );
+        }
+    }
+}
+
+/// Elastic scenes (the paper's bar, the benchmark block) on 2 and 4 ranks follow one rank
+/// step for step: the partial sums of shared nodes and the reductions change only the
+/// order of additions.
+#[test]
+fn the_bar_and_the_block_on_2_and_4_ranks_agree_with_one_rank_to_1e_10() {
+    for (scene, name) in [("bar.ron", "bar"), ("block_10k.ron", "block")] {
+        let (_, one) = run_on(scene, 1, name, &[]);
+        for ranks in [2, 4] {
+            let (dir, many) = run_on(scene, ranks, name, &[]);
+            agrees(&one, &many, 1e-10, &format!("{name} on {ranks} ranks"));
+            assert!(rel(&one["total_mass"], &many["total_mass"]) <= 1e-14);
+            assert!(
+                dir.join("points.pvtu").exists() && dir.join(format!("points_{}.vtu", ranks - 1)).exists()
+            );
+        }
+    }
+}
+
+/// The fast 3D slope's settings (scenes/slope_fast.ron's three on scenes/slope_3d.ron).
+const FAST_3D: [&str; 4] = [
+    "solver.scheme=Usf",
+    "solver.time_step=Courant(0.8)",
+    "solver.static_check=(window: 2.0, max_displacement: 0.01)",
+    "output.snapshots=None",
+];
+
+/// The fast slope, in 2D and in 3D (two cells thick), fails and runs out across the rank
+/// boundaries (points migrate, the split is made again as they pile up at the toe) and
+/// stops by itself at the angle one rank finds.
+#[test]
+fn the_failing_slope_in_2d_and_3d_on_2_and_4_ranks_comes_to_rest_at_the_angle_of_one_rank() {
+    for (scene, name, overrides) in [
+        ("slope_fast.ron", "slope", &[][..]),
+        ("slope_3d.ron", "slope3d", &FAST_3D[..]),
+    ] {
+        let (_, one) = run_on(scene, 1, name, overrides);
+        for ranks in [2, 4] {
+            let (_, many) = run_on(scene, ranks, name, overrides);
+            let what = format!("{name} on {ranks} ranks");
+            assert_eq!(many["outcome"], "converged", "{what}");
+            let angle = |s: &Value| s["surface_angle"]["degrees"].as_f64().expect("an angle");
+            assert!(
+                (angle(&one) - angle(&many)).abs() <= 0.05,
+                "{what}: {} against {}",
+                angle(&many),
+                angle(&one)
+            );
+            assert!(
+                rel(&one["total_mass"], &many["total_mass"]) <= 1e-12,
+                "{what}: mass"
+            );
+            assert!(
+                many["ranks"]["migrations"].as_u64().expect("a count") > 0,
+                "{what}: no point moved rank"
+            );
+            let held: u64 = many["ranks"]["points"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|p| p.as_u64().unwrap())
+                .sum();
+            assert_eq!(held, one["particles"].as_u64().unwrap(), "{what}: points");
+        }
+    }
+}
+
+/// Two runs on the same ranks write the same bits.
+#[test]
+fn two_runs_on_the_same_ranks_give_the_same_bits() {
+    let files = |dir: &Path| -> Vec<Vec<u8>> {
+        ["history.csv", "points_0.vtu", "points_1.vtu"]
+            .iter()
+            .map(|f| std::fs::read(dir.join(f)).expect(f))
+            .collect()
+    };
+    let (a, _) = run_on("slope_fast.ron", 2, "again-a", &["solver.max_time=3.0"]);
+    let (b, _) = run_on("slope_fast.ron", 2, "again-b", &["solver.max_time=3.0"]);
+    assert!(files(&a) == files(&b), "the runs differ");
 }

@@ -130,9 +130,13 @@ impl<D: Dim> System<D> for History<D> {
             ratio_text(s.energy_ratio, 9),
             s.resets.to_string(),
         ];
-        for t in &self.traced {
-            // A handful of traced points: an entity lookup is fine here.
-            let u = t.displacement::<D>(&ctx.world);
+        for (k, t) in self.traced.iter().enumerate() {
+            // Over MPI the point may be on another rank: [`TracedGather`] brought it here.
+            // With one rank, a handful of traced points: an entity lookup is fine here.
+            let u = match ctx.state.traced_displacements.get(k) {
+                Some(u) => *u,
+                None => t.displacement::<D>(&ctx.world),
+            };
             row.extend(u.iter().take(D::N).map(|c| format!("{c:.9e}")));
         }
         for d in &s.drives {
@@ -144,6 +148,44 @@ impl<D: Dim> System<D> for History<D> {
         if last {
             rows.flush()?;
         }
+        Ok(())
+    }
+}
+
+/// Over MPI, gathers the traced points' displacements from the ranks that hold them into
+/// [`crate::state::SolverState::traced_displacements`] each step, on every rank, for
+/// [`History`] to write on rank 0. Runs on every rank, before `history`.
+pub struct TracedGather {
+    traced: Vec<TracedPoint>,
+}
+
+impl TracedGather {
+    /// Gathers these points.
+    pub fn new(traced: &[TracedPoint]) -> Self {
+        TracedGather {
+            traced: traced.to_vec(),
+        }
+    }
+}
+
+impl<D: Dim> System<D> for TracedGather {
+    fn name(&self) -> &str {
+        "traced_gather"
+    }
+    fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
+        let mut values = Vec::with_capacity(3 * self.traced.len());
+        for t in &mut self.traced {
+            match t.find(&ctx.world) {
+                Some(e) => {
+                    t.entity = e;
+                    values.extend(t.displacement::<D>(&ctx.world));
+                }
+                None => values.extend([0.0; 3]),
+            }
+        }
+        // One rank holds each point; the others add zeros.
+        ctx.comm.sum(&mut values);
+        ctx.state.traced_displacements = values.chunks(3).map(|u| [u[0], u[1], u[2]]).collect();
         Ok(())
     }
 }

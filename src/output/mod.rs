@@ -11,7 +11,7 @@ pub mod summary;
 pub mod vtk;
 
 pub use dir::{OutputDir, RowFile};
-pub use history::History;
+pub use history::{History, TracedGather};
 pub use progress::Progress;
 pub use recorder::Recorder;
 pub use snapshots::{SnapshotSpec, SnapshotWriter, Snapshots};

@@ -7,7 +7,7 @@ use crate::output::dir::OutputDir;
 use crate::output::history::{self, History};
 use crate::output::snapshots::{SnapshotSpec, SnapshotWriter, Snapshots};
 use crate::output::summary::Summary;
-use crate::output::vtk::write_points;
+use crate::output::vtk::{write_parallel_points, write_points};
 use crate::output::RowFile;
 use crate::simulation::Simulation;
 use crate::state::{CurvePoint, StageResult};
@@ -128,8 +128,18 @@ impl Recorder {
         history::lock(&self.rows).flush()?;
         let series = self.snapshots.map(SnapshotWriter::finish).transpose()?;
         let mut notes = Notes::default();
+        // Over MPI each rank writes its own points, and points.pvtu ties them together.
+        let comm = &sim.ctx.comm;
+        let points = match comm.size() {
+            1 => "points.vtu".to_string(),
+            _ => format!("points_{}.vtu", comm.rank()),
+        };
+        if comm.size() > 1 {
+            let parts: Vec<String> = (0..comm.size()).map(|r| format!("points_{r}.vtu")).collect();
+            write_parallel_points(sim, &dir.file("points.pvtu"), &parts)?;
+        }
         match sim.first_non_finite() {
-            None => write_points(sim, &dir.file("points.vtu"))?,
+            None => write_points(sim, &dir.file(&points))?,
             Some(what) => notes.0.push(format!(
                 "points.vtu not written: the state holds a non-finite {what}{}",
                 if dir.file(crate::checkpoint::FILE_NAME).exists() {

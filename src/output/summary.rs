@@ -106,6 +106,28 @@ pub struct Summary {
     /// The static state that ended each loading stage (`stages.csv`).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub stages: Vec<StageResult>,
+    /// Over MPI: the ranks, and how many times a point moved to another rank.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ranks: Option<Ranks>,
+}
+
+/// The ranks of a run over MPI.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Ranks {
+    /// Number of ranks.
+    pub count: usize,
+    /// Points each rank holds at the end.
+    pub points: Vec<u64>,
+    /// Moves of a point to another rank over the run (a point crossing two ranks counts
+    /// twice).
+    pub migrations: u64,
+    /// Times the cell layers were split again because the ranks' loads drifted apart.
+    pub rebalances: u64,
+    /// Each rank's first cell layer, and the end of the last (the final split).
+    pub bounds: Vec<usize>,
+    /// Bytes the ranks sent each other, all ranks together, per step (exchanges of shared
+    /// nodes and of moving points, and the reductions).
+    pub bytes_per_step: f64,
 }
 
 /// How a run ended, as `summary.json` writes it (snake case).
@@ -159,8 +181,30 @@ impl Summary {
     ) -> Self {
         let s = &sim.ctx.state;
         let st = &sim.ctx.settings;
-        let particles = sim.point_count();
+        // Over MPI every figure here is the ranks' (each call below is a collective, made
+        // by every rank in this order).
+        let comm = &sim.ctx.comm;
+        let mut totals = [sim.point_count() as f64, sim.total_mass()];
+        comm.sum(&mut totals);
+        let [particles, total_mass] = totals;
+        let particles = particles as usize;
         let max_u = max_displacements(sim);
+        let mut largest = max_u.map_or([f64::NEG_INFINITY; 2], |u| [u.0, u.1]);
+        comm.max(&mut largest);
+        let max_u = (largest[0] >= 0.0).then_some((largest[0], largest[1]));
+        let ranks = (comm.size() > 1).then(|| {
+            let points = comm.gather_all(&[sim.point_count() as f64]);
+            let mut migrations = [s.migrations as f64, comm.sent_bytes() as f64];
+            comm.sum(&mut migrations);
+            Ranks {
+                count: comm.size(),
+                points: points.iter().map(|&p| p as u64).collect(),
+                migrations: migrations[0] as u64,
+                rebalances: s.rebalances,
+                bounds: sim.ctx.decomposition.bounds.clone(),
+                bytes_per_step: migrations[1] / s.step.max(1) as f64,
+            }
+        });
         // Under load control a static state may follow a collapse (the body rests again on
         // what it heaved): the largest pressure is a limit only under displacement control.
         let displacement_control: Vec<CurvePoint> = s
@@ -198,7 +242,7 @@ impl Summary {
             kinetic_energy: s.kinetic_energy,
             external_work: s.external_work,
             particles,
-            total_mass: sim.total_mass(),
+            total_mass,
             wall_seconds,
             particle_steps_per_second: if wall_seconds > 0.0 {
                 particles as f64 * s.step as f64 / wall_seconds
@@ -221,6 +265,7 @@ impl Summary {
             last_increment_rise: last_increment_rise(&displacement_control),
             curve: s.curve.clone(),
             stages: s.stages.clone(),
+            ranks,
         }
     }
 }

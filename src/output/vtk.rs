@@ -144,6 +144,39 @@ pub fn write_points<D: Dim>(sim: &Simulation<D>, path: &Path) -> std::io::Result
     crate::output::dir::write_atomic(path, |out| write_arrays(out, columns.len(), &arrays))
 }
 
+/// Writes `points.pvtu`, the file that ties together the pieces `parts` (file names next to
+/// it) that the ranks of a run over MPI each wrote with [`write_points`], with the arrays
+/// those pieces hold. Cells are not listed: a reader takes them from each piece.
+pub fn write_parallel_points<D: Dim>(
+    sim: &Simulation<D>,
+    path: &Path,
+    parts: &[String],
+) -> std::io::Result<()> {
+    let columns = Columns::<D>::of(&sim.ctx.world);
+    let arrays = arrays(&columns);
+    crate::output::dir::write_atomic(path, |out| {
+        out.write_all(b"<?xml version=\"1.0\"?>\n<VTKFile type=\"PUnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n<PUnstructuredGrid GhostLevel=\"0\">\n")?;
+        for (section, part) in [("PPoints", Part::Points), ("PPointData", Part::PointData)] {
+            writeln!(out, "<{section}>")?;
+            for a in arrays.iter().filter(|a| a.part == part) {
+                writeln!(
+                    out,
+                    "<PDataArray type=\"{}\" Name=\"{}\" NumberOfComponents=\"{}\"/>",
+                    a.kind.name(),
+                    a.name,
+                    a.components
+                )?;
+            }
+            writeln!(out, "</{section}>")?;
+        }
+        for p in parts {
+            writeln!(out, "<Piece Source=\"{p}\"/>")?;
+        }
+        out.write_all(b"</PUnstructuredGrid>\n</VTKFile>\n")?;
+        out.flush()
+    })
+}
+
 /// Writes a [`Frame`] as [`write_points`] writes the live points.
 pub fn write_frame(frame: &Frame, path: &Path) -> std::io::Result<()> {
     let arrays = arrays(frame);

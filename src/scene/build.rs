@@ -6,6 +6,7 @@ use super::{pad3, BoundarySpec, Condition, LoadedScene, Region, Scene};
 use crate::columns::{col, points_with};
 use crate::components::*;
 use crate::context::Context;
+use crate::decomposition::Decomposition;
 use crate::dim::{Dim, Dim2, Dim3, Vector};
 use crate::error::SceneError;
 use crate::grid::Grid;
@@ -545,6 +546,7 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         ..SolverState::default()
     };
     let materials = table.into_iter().map(|(_, m)| m).collect();
+    let decomposition = Decomposition::whole(grid.axes[grid.slab_axis].cells, s.shape.support());
     let ctx = Context {
         world,
         grid,
@@ -552,6 +554,9 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         settings,
         state,
         slabs: SlabCache::default(),
+        comm: Default::default(),
+        decomposition,
+        exchanged: 0,
     };
     Ok((
         Simulation {

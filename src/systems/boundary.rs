@@ -9,6 +9,7 @@ use crate::error::StepError;
 use crate::parallel::{grid_pass, Disjoint};
 use crate::schedule::System;
 use crate::state::Drive;
+use crate::systems::exchange::{exchange, EXTERNAL, FORCE, MASS, MOMENTUM};
 
 /// Holds the constrained components of every node: momentum m·v̄ (v̄ = 0 on a fixed face,
 /// the motion's velocity on a driven node) and no force, so that the node moves at v̄.
@@ -25,6 +26,8 @@ impl<D: Dim> System<D> for Boundary {
         "boundary"
     }
     fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
+        // Over MPI: every force is mapped by now; the shared nodes get their whole sums.
+        exchange(ctx, MASS | MOMENTUM | FORCE | EXTERNAL);
         let n = nodes(&ctx.world);
         let (fix, nm) = (col::<NodeFixity>(n), col::<NodeMass>(n));
         // Plain slices: the column guards cannot be shared with the pool.

@@ -60,12 +60,15 @@ pub fn force_ratios<D: Dim>(ctx: &Context<D>) -> ForceRatios {
     let (nm, nf, ne, fix) = (&*nm, &*nf, &*ne, &*fix);
     let drives = &ctx.state.drives[..];
     let grid = &ctx.grid;
+    // Over MPI each rank sums the nodes it owns; the ranks' parts are combined below.
+    let owned = ctx.owned_node_ids();
+    let owned = owned.as_ref();
     // Per group of node layers: max|F_unb|, max|F_ext|, Σ|F_unb|, Σ|F_ext|, combined in node
     // order below.
     let parts = grid_pass(grid, ctx.state.active_nodes, &(), |b, (), _| {
         let (mut max_u, mut max_e, mut sum_u, mut sum_e) = (0.0f64, 0.0f64, 0.0, 0.0);
         for i in b.rows(grid).flatten() {
-            if !grid.carries(i, nm[i].0, min_mass) {
+            if !grid.carries(i, nm[i].0, min_mass) || owned.is_some_and(|o| !o.contains(&i)) {
                 continue;
             }
             for a in 0..D::N {
@@ -86,9 +89,15 @@ pub fn force_ratios<D: Dim>(ctx: &Context<D>) -> ForceRatios {
         }
         [max_u, max_e, sum_u, sum_e]
     });
-    let [max_u, max_e, sum_u, sum_e] = parts.iter().fold([0.0f64; 4], |t, p| {
+    let [mut max_u, mut max_e, mut sum_u, mut sum_e] = parts.iter().fold([0.0f64; 4], |t, p| {
         [t[0].max(p[0]), t[1].max(p[1]), t[2] + p[2], t[3] + p[3]]
     });
+    if ctx.comm.size() > 1 {
+        let (mut largest, mut sums) = ([max_u, max_e], [sum_u, sum_e]);
+        ctx.comm.max(&mut largest);
+        ctx.comm.sum(&mut sums);
+        [max_u, max_e, sum_u, sum_e] = [largest[0], largest[1], sums[0], sums[1]];
+    }
     let ratio = |u: f64, e: f64| if e > 0.0 { u / e } else { UNDEFINED };
     ForceRatios {
         max_norm: ratio(max_u, max_e),
@@ -120,6 +129,7 @@ impl Convergence {
             Some(start) if now >= start + check.window * (1.0 - 1e-12) => {
                 let mut current = Vec::with_capacity(ctx.state.static_window_snapshot.len());
                 positions::<D>(&ctx.world, &mut current);
+                ctx.comm.merge_by_id(&mut current);
                 let moved = max_movement(&ctx.state.static_window_snapshot, &current);
                 ctx.state.static_window_movement = Some(moved);
                 ctx.state.static_window_start = None;
@@ -138,6 +148,7 @@ impl Convergence {
                 if met {
                     ctx.state.static_window_start = Some(now);
                     positions::<D>(&ctx.world, &mut ctx.state.static_window_snapshot);
+                    ctx.comm.merge_by_id(&mut ctx.state.static_window_snapshot);
                 }
                 false
             }
@@ -157,14 +168,22 @@ impl<D: Dim> System<D> for Convergence {
             let nv = col::<NodeVelocity<D::Vec>>(n);
             let (ne, nv) = (&*ne, &*nv);
             let grid = &ctx.grid;
+            // Over MPI each node's power counts on the rank that owns it.
+            let owned = ctx.owned_node_ids();
+            let owned = owned.as_ref();
             let power: f64 = grid_pass(grid, ctx.state.active_nodes, &(), |b, (), _| {
                 b.rows(grid)
-                    .map(|r| r.map(|i| ne[i].0.dot(nv[i].0)).sum::<f64>())
+                    .map(|r| match owned {
+                        None => r.map(|i| ne[i].0.dot(nv[i].0)).sum::<f64>(),
+                        Some(o) => r.filter(|i| o.contains(i)).map(|i| ne[i].0.dot(nv[i].0)).sum(),
+                    })
                     .sum::<f64>()
             })
             .iter()
             .sum();
-            power * dt
+            let mut power = [power];
+            ctx.comm.sum(&mut power);
+            power[0] * dt
         } else {
             0.0
         };

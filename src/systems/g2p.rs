@@ -85,6 +85,11 @@ impl<D: Dim, S: Shape> System<D> for G2p<D, S> {
         // A NaN or infinite velocity shows in the energy's sum. Stop here, before any point
         // moves with it: positions, stresses and the solver state stay those of the last
         // finite step.
+        // Over MPI the energy is the ranks' sum (a NaN on one rank reaches all, so that every
+        // rank stops alike).
+        let mut twice_ek = [twice_ek];
+        ctx.comm.sum(&mut twice_ek);
+        let [twice_ek] = twice_ek;
         if !twice_ek.is_finite() {
             return Err(StepError::NonFinite {
                 step: ctx.state.step,

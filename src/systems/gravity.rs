@@ -30,8 +30,12 @@ impl<D: Dim> System<D> for Gravity {
         let mut nf = col_mut::<NodeForce<D::Vec>>(n);
         let mut ne = col_mut::<NodeExternalForce<D::Vec>>(n);
         let target = (Disjoint::new(&mut nf), Disjoint::new(&mut ne));
+        // Over MPI the node mass is already whole (summed after the mapping) and the forces
+        // are summed next: each node gets its weight from the rank that owns it only.
+        let owned = ctx.owned_node_ids();
+        let own = |i: usize| owned.as_ref().is_none_or(|o| o.contains(&i));
         for_each_box_node(&ctx.grid, ctx.state.active_nodes, &target, |i, k, (nf, ne)| {
-            if nm[i].0 > 0.0 {
+            if nm[i].0 > 0.0 && own(i) {
                 let w = gv * nm[i].0;
                 nf[k].0 += w;
                 ne[k].0 += w;

@@ -38,6 +38,7 @@ impl<D: Dim> System<D> for GridReset {
         );
         fill_box(grid, b, &mut col_mut::<NodeVelocity<D::Vec>>(n), NodeVelocity(z));
         ctx.state.active_nodes = NodeBox::default();
+        ctx.exchanged = 0;
         Ok(())
     }
 }

@@ -16,6 +16,7 @@
 
 pub mod boundary;
 pub mod convergence;
+pub mod exchange;
 pub mod g2p;
 pub mod gravity;
 pub mod grid_reset;
@@ -23,6 +24,7 @@ pub mod integrate;
 pub mod kinematics;
 pub mod load_steps;
 pub mod mass_scaling;
+pub mod migrate;
 pub mod nodal_velocity;
 pub mod p2g;
 pub mod peak_watch;

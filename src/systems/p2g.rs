@@ -9,6 +9,7 @@ use crate::lanes::F64x4;
 use crate::parallel::{scatter, Disjoint};
 use crate::schedule::System;
 use crate::shape::{for_each_node, from_lanes, Shape, StressColumns};
+use crate::systems::exchange::{exchange, MASS, MOMENTUM};
 use crate::tensor::StoredSym;
 use std::marker::PhantomData;
 
@@ -53,6 +54,19 @@ impl<D: Dim, S: Shape> System<D> for P2g<D, S> {
     }
 
     fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
+        self.map(ctx);
+        // Over MPI: the nodal mass and momentum are whole before anything reads them (the
+        // internal force is summed with the external ones, before `boundary`).
+        if self.part != P2gPart::InternalForce {
+            exchange(ctx, MASS | MOMENTUM);
+        }
+        Ok(())
+    }
+}
+
+impl<D: Dim, S: Shape> P2g<D, S> {
+    /// The scatter of this pass's part into the nodes.
+    fn map(&self, ctx: &mut Context<D>) {
         let grid = &ctx.grid;
         let mut reached = ctx.state.active_nodes;
         let n = nodes(&ctx.world);
@@ -132,7 +146,6 @@ impl<D: Dim, S: Shape> System<D> for P2g<D, S> {
             ));
         }
         ctx.state.active_nodes = reached;
-        Ok(())
     }
 }
 #[cfg(test)]

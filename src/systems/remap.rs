@@ -9,6 +9,7 @@ use crate::error::StepError;
 use crate::parallel::{fill_box, scatter, Disjoint};
 use crate::schedule::System;
 use crate::shape::{for_each_node, Shape};
+use crate::systems::exchange::{exchange_again, MOMENTUM};
 use std::marker::PhantomData;
 
 /// p_i = Σ_p w_ip m_p v_p with the new v_p, then v_i = p_i/m_i with boundary conditions.
@@ -72,6 +73,7 @@ impl<D: Dim, S: Shape> System<D> for Remap<D, S> {
             }
             ctx.state.active_nodes = reached;
         }
+        exchange_again(ctx, MOMENTUM);
         velocity_from_momentum(ctx);
         Ok(())
     }

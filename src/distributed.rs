@@ -1,0 +1,86 @@
+//! Splitting a built simulation across MPI ranks ([`crate::decomposition`]).
+//!
+//! Every rank builds the whole scene (the same points with the same ids), counts the points
+//! of each cell layer along the slab axis, finds the same [`Decomposition`] and keeps the
+//! points of its own layers. From then on the step maps into shared node bands and sums them
+//! ([`crate::systems::exchange`]), reduces the global figures in rank order, and moves points
+//! that leave a rank to its neighbour ([`crate::systems::migrate`]).
+
+use crate::columns::{col, points_with};
+use crate::comm::Comm;
+use crate::components::Position;
+use crate::decomposition::Decomposition;
+use crate::dim::Dim;
+use crate::simulation::Simulation;
+use crate::systems::migrate::Migrate;
+use hecs::Entity;
+use std::sync::Arc;
+
+/// What a run over several ranks does not do yet, as the reason, or `None` when the scene
+/// can be split.
+pub fn unsupported<D: Dim>(sim: &Simulation<D>) -> Option<&'static str> {
+    let s = &sim.ctx.settings;
+    if !s.motions.is_empty() {
+        Some("prescribed motions (their reaction is not yet summed over the ranks)")
+    } else if !s.stages.is_empty() {
+        Some("stages")
+    } else if !s.load_steps.is_empty() {
+        Some("tractions applied in increments")
+    } else if s.volumetric_smoothing {
+        Some("volumetric smoothing (its cell averages are not yet summed over the ranks)")
+    } else if s.inertia_factors.iter().any(|&f| f != 1.0) {
+        Some("mass scaling")
+    } else {
+        None
+    }
+}
+
+/// Gives `sim` its part of the run: the decomposition of its points over `comm`'s ranks,
+/// and only the points of this rank's cell layers. With one rank nothing changes.
+pub fn decompose<D: Dim>(sim: &mut Simulation<D>, comm: Arc<Comm>) -> Result<(), String> {
+    let ctx = &mut sim.ctx;
+    let (axis, layers) = (ctx.grid.slab_axis, ctx.grid.axes[ctx.grid.slab_axis].cells);
+    let support = ctx.decomposition.support;
+    if comm.size() > 1 {
+        if let Some(what) = unsupported(sim) {
+            return Err(format!(
+                "this scene uses {what}, which a run over {} ranks does not do yet: run it \
+                 on one rank",
+                comm.size()
+            ));
+        }
+    }
+    let ctx = &mut sim.ctx;
+    let mut counts = vec![0u64; layers];
+    for arch in points_with::<Position<D::Vec>>(&ctx.world) {
+        for x in col::<Position<D::Vec>>(arch).iter() {
+            counts[ctx.grid.clamped_cell_along(x.0, axis)] += 1;
+        }
+    }
+    let d = Decomposition::balanced(&counts, comm.size(), comm.rank(), support)?;
+    let cells = d.cells();
+    let away: Vec<Entity> = ctx
+        .world
+        .query::<(Entity, &Position<D::Vec>)>()
+        .iter()
+        .filter(|(_, x)| !cells.contains(&ctx.grid.clamped_cell_along(x.0, axis)))
+        .map(|(e, _)| e)
+        .collect();
+    for e in away {
+        ctx.world.despawn(e).expect("a point found above");
+    }
+    ctx.decomposition = d;
+    // Points that leave a rank move at the end of every step.
+    if comm.size() > 1 {
+        sim.schedule.push(Migrate);
+    }
+    let ctx = &mut sim.ctx;
+    ctx.comm = comm;
+    ctx.slabs.invalidate();
+    for t in &mut sim.traced {
+        if let Some(e) = t.find(&sim.ctx.world) {
+            t.entity = e;
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,157 @@
+//! Sums of node columns over the ranks that share nodes (runs over MPI).
+//!
+//! Two neighbouring ranks both map into the band of node layers around the cell layer where
+//! their ranges meet ([`crate::decomposition`]); each holds a partial sum there. Each sends
+//! its band to the other, and both then hold lower rank's part + upper rank's part, added in
+//! that order: the same bits on both, so both update those nodes alike and their points read
+//! the same field. Sends go up the ranks, then down, so no rank waits on a chain.
+//!
+//! With one rank every function here returns at once.
+
+use crate::columns::{col_mut, nodes};
+use crate::components::*;
+use crate::context::Context;
+use crate::dim::Dim;
+use crate::grid::NodeBox;
+use std::ops::Range;
+
+/// Node mass.
+pub const MASS: u8 = 1;
+/// Node momentum.
+pub const MOMENTUM: u8 = 2;
+/// Node force (internal and external, as mapped).
+pub const FORCE: u8 = 4;
+/// Node external force.
+pub const EXTERNAL: u8 = 8;
+
+/// Sums the columns of `what` not yet summed this step over the ranks sharing them.
+pub fn exchange<D: Dim>(ctx: &mut Context<D>, what: u8) {
+    let todo = what & !ctx.exchanged;
+    if todo != 0 {
+        exchange_again(ctx, todo);
+        ctx.exchanged |= todo;
+    }
+}
+
+/// Sums the columns of `what` over the ranks sharing them, whether or not they were this
+/// step (the MUSL remap maps momentum a second time).
+pub fn exchange_again<D: Dim>(ctx: &mut Context<D>, what: u8) {
+    if ctx.comm.size() == 1 {
+        return;
+    }
+    let layer = ctx.grid.layer();
+    let [below, above] = ctx.decomposition.bands();
+    let ids = |b: &Option<(usize, Range<usize>)>| b.as_ref().map(|(_, l)| l.start * layer..l.end * layer);
+    let (ids_below, ids_above) = (ids(&below), ids(&above));
+    let mine_below = ids_below
+        .clone()
+        .map(|r| pack::<D>(ctx, what, r))
+        .unwrap_or_default();
+    let mine_above = ids_above
+        .clone()
+        .map(|r| pack::<D>(ctx, what, r))
+        .unwrap_or_default();
+    let (rank_below, rank_above) = (below.as_ref().map(|b| b.0), above.as_ref().map(|a| a.0));
+    let from_below = ctx.comm.exchange(rank_above, &mine_above, rank_below);
+    let from_above = ctx.comm.exchange(rank_below, &mine_below, rank_above);
+    if let Some(r) = ids_below {
+        // The lower rank's part first.
+        let sum: Vec<f64> = from_below.iter().zip(&mine_below).map(|(l, u)| l + u).collect();
+        unpack::<D>(ctx, what, r, &sum);
+    }
+    if let Some(r) = ids_above {
+        let sum: Vec<f64> = mine_above.iter().zip(&from_above).map(|(l, u)| l + u).collect();
+        unpack::<D>(ctx, what, r, &sum);
+    }
+    // The shared bands are part of this rank's grid from now on in the step: reset, updated
+    // and read like the nodes its own points reach.
+    let cross = |a: usize| {
+        if a == ctx.grid.slab_axis {
+            None
+        } else {
+            Some(ctx.grid.nodes[a])
+        }
+    };
+    for r in [below, above].into_iter().flatten().map(|(_, l)| l) {
+        let mut b = NodeBox::default();
+        for a in 0..3 {
+            (b.lo[a], b.hi[a]) = match cross(a) {
+                Some(n) => (0, n),
+                None => (r.start, r.end),
+            };
+        }
+        ctx.state.active_nodes = ctx.state.active_nodes.union(b);
+    }
+}
+
+/// The values of the columns of `what` at node ids `ids`, in node order, column after
+/// column (mass, momentum, force, external force).
+fn pack<D: Dim>(ctx: &Context<D>, what: u8, ids: Range<usize>) -> Vec<f64> {
+    let n = nodes(&ctx.world);
+    let mut out = Vec::new();
+    if what & MASS != 0 {
+        out.extend(col_mut::<NodeMass>(n)[ids.clone()].iter().map(|m| m.0));
+    }
+    let vectors = |out: &mut Vec<f64>, v: &mut dyn Iterator<Item = D::Vec>| {
+        for v in v {
+            out.extend_from_slice(&D::vec_to3(v)[..D::N]);
+        }
+    };
+    if what & MOMENTUM != 0 {
+        vectors(
+            &mut out,
+            &mut col_mut::<NodeMomentum<D::Vec>>(n)[ids.clone()]
+                .iter()
+                .map(|p| p.0),
+        );
+    }
+    if what & FORCE != 0 {
+        vectors(
+            &mut out,
+            &mut col_mut::<NodeForce<D::Vec>>(n)[ids.clone()].iter().map(|f| f.0),
+        );
+    }
+    if what & EXTERNAL != 0 {
+        vectors(
+            &mut out,
+            &mut col_mut::<NodeExternalForce<D::Vec>>(n)[ids].iter().map(|f| f.0),
+        );
+    }
+    out
+}
+
+/// Puts `values` (as [`pack`] lays them out) into the columns of `what` at `ids`.
+fn unpack<D: Dim>(ctx: &Context<D>, what: u8, ids: Range<usize>, values: &[f64]) {
+    let n = nodes(&ctx.world);
+    let mut at = 0;
+    let mut next = |k: usize| {
+        let v = &values[at..at + k];
+        at += k;
+        v
+    };
+    let vec = |v: &[f64]| {
+        let mut c = [0.0; 3];
+        c[..D::N].copy_from_slice(v);
+        D::vec_from(c)
+    };
+    if what & MASS != 0 {
+        for m in &mut col_mut::<NodeMass>(n)[ids.clone()] {
+            m.0 = next(1)[0];
+        }
+    }
+    if what & MOMENTUM != 0 {
+        for p in &mut col_mut::<NodeMomentum<D::Vec>>(n)[ids.clone()] {
+            p.0 = vec(next(D::N));
+        }
+    }
+    if what & FORCE != 0 {
+        for f in &mut col_mut::<NodeForce<D::Vec>>(n)[ids.clone()] {
+            f.0 = vec(next(D::N));
+        }
+    }
+    if what & EXTERNAL != 0 {
+        for f in &mut col_mut::<NodeExternalForce<D::Vec>>(n)[ids] {
+            f.0 = vec(next(D::N));
+        }
+    }
+}

@@ -1,0 +1,230 @@
+//! Points that left this rank's cell layers move to the neighbouring rank (runs over MPI).
+//!
+//! [`Migrate`] ends every step of a run over several ranks (`distributed::decompose` adds
+//! it): a point moves less than a cell a step, so at the next mapping every point lies in
+//! its rank's layers and maps only into that rank's nodes and the bands it shares. A point goes
+//! with every column it has (the list of [`point_components!`](crate::point_components!),
+//! its material's state and its [`PointId`] included) and is spawned again on the other
+//! side, so a run's points are the same set whatever the rank count.
+
+use crate::components::*;
+use crate::context::Context;
+use crate::decomposition::Decomposition;
+use crate::dim::Dim;
+use crate::error::StepError;
+use crate::point_components;
+use crate::schedule::System;
+use hecs::{Entity, EntityBuilder, World};
+
+/// The last system of a step over several ranks: [`migrate`], then [`rebalance`].
+#[derive(Debug, Default)]
+pub struct Migrate;
+
+impl<D: Dim> System<D> for Migrate {
+    fn name(&self) -> &str {
+        "migrate"
+    }
+    fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
+        migrate(ctx);
+        rebalance(ctx);
+        Ok(())
+    }
+}
+
+/// Steps between two looks at the ranks' balance.
+pub const REBALANCE_EVERY: u64 = 100;
+
+/// Largest point count of a rank over the mean above which the layers are split again.
+pub const IMBALANCE_LIMIT: f64 = 1.2;
+
+/// Every [`REBALANCE_EVERY`] steps, splits the cell layers again by point count when the
+/// ranks' loads differ by more than [`IMBALANCE_LIMIT`] (a failing slope moves its points
+/// down and out), and moves the points to their new ranks; true when it did. A collective.
+pub fn rebalance<D: Dim>(ctx: &mut Context<D>) -> bool {
+    if ctx.comm.size() == 1 || !ctx.state.step.is_multiple_of(REBALANCE_EVERY) {
+        return false;
+    }
+    let axis = ctx.grid.slab_axis;
+    let mut counts = vec![0.0; ctx.grid.axes[axis].cells];
+    for (_, x) in ctx.world.query::<(Entity, &Position<D::Vec>)>().iter() {
+        counts[ctx.grid.clamped_cell_along(x.0, axis)] += 1.0;
+    }
+    ctx.comm.sum(&mut counts);
+    let counts: Vec<u64> = counts.iter().map(|&c| c as u64).collect();
+    let d = &ctx.decomposition;
+    let per_rank: Vec<u64> = (0..d.ranks())
+        .map(|r| counts[d.bounds[r]..d.bounds[r + 1]].iter().sum())
+        .collect();
+    if Decomposition::imbalance(&per_rank) <= IMBALANCE_LIMIT {
+        return false;
+    }
+    let Ok(next) = Decomposition::balanced(&counts, d.ranks(), d.rank, d.support) else {
+        return false;
+    };
+    if next.bounds == d.bounds {
+        return false;
+    }
+    ctx.decomposition = next;
+    ctx.state.rebalances += 1;
+    migrate(ctx);
+    true
+}
+
+/// Sends this rank's points outside its cell layers towards the ranks that own them and
+/// spawns the points the others send, until every point is on its owner; true when points
+/// came or went (rows moved: slabs and traced points must be found again). A collective.
+pub fn migrate<D: Dim>(ctx: &mut Context<D>) -> bool {
+    if ctx.comm.size() == 1 {
+        return false;
+    }
+    let mut moved = false;
+    // A point hops one rank at a time, so one that must cross an empty rank (or several,
+    // after a new decomposition) takes more than one round.
+    loop {
+        let (left, came, astray) = migrate_once(ctx);
+        moved |= left + came > 0;
+        if !ctx.comm.any(astray) {
+            break;
+        }
+    }
+    if moved {
+        ctx.slabs.invalidate();
+        ctx.state.points_reordered = true;
+    }
+    moved
+}
+
+/// One round: points below this rank's layers go to rank − 1, points above to rank + 1,
+/// and the points they send come in. Returns the points sent, the points received and
+/// whether a received point is still outside this rank's layers.
+fn migrate_once<D: Dim>(ctx: &mut Context<D>) -> (usize, usize, bool) {
+    let (rank, ranks) = (ctx.comm.rank(), ctx.comm.size());
+    let below = rank.checked_sub(1);
+    let above = (rank + 1 < ranks).then_some(rank + 1);
+    let cells = ctx.decomposition.cells();
+    let axis = ctx.grid.slab_axis;
+    let (mut down, mut up): (Vec<Entity>, Vec<Entity>) = (Vec::new(), Vec::new());
+    for (e, x) in ctx.world.query::<(Entity, &Position<D::Vec>)>().iter() {
+        let c = ctx.grid.clamped_cell_along(x.0, axis);
+        if c < cells.start {
+            down.push(e);
+        } else if c >= cells.end {
+            up.push(e);
+        }
+    }
+    let pack = |world: &World, list: &[Entity]| -> Vec<f64> {
+        let mut bytes = Vec::new();
+        for &e in list {
+            write_point::<D>(world, e, &mut bytes);
+        }
+        words(bytes)
+    };
+    let (to_below, to_above) = (pack(&ctx.world, &down), pack(&ctx.world, &up));
+    for e in down.iter().chain(&up) {
+        ctx.world.despawn(*e).expect("a point found above");
+    }
+    ctx.state.migrations += (down.len() + up.len()) as u64;
+    let from_below = ctx.comm.exchange(above, &to_above, below);
+    let from_above = ctx.comm.exchange(below, &to_below, above);
+    let (mut came, mut astray) = (0, false);
+    for message in [from_below, from_above] {
+        let bytes: Vec<u8> = bytemuck::cast_slice(&message).to_vec();
+        let mut at = 0;
+        loop {
+            let mut builder = EntityBuilder::new();
+            let Some(x) = read_point::<D>(&bytes, &mut at, &mut builder) else {
+                break;
+            };
+            astray |= !cells.contains(&ctx.grid.clamped_cell_along(x, axis));
+            ctx.world.spawn(builder.build());
+            came += 1;
+        }
+    }
+    (down.len() + up.len(), came, astray)
+}
+
+/// Bytes as whole f64 words (zero-padded), the unit [`crate::comm::Comm::exchange`] sends.
+fn words(mut bytes: Vec<u8>) -> Vec<f64> {
+    bytes.resize(bytes.len().div_ceil(8) * 8, 0);
+    bytes
+        .chunks_exact(8)
+        .map(|w| f64::from_ne_bytes(w.try_into().expect("8 bytes")))
+        .collect()
+}
+
+/// Appends point `e`: a mask of the components it has (bit k: the k-th of
+/// [`point_components!`](crate::point_components!)), then each one's bytes.
+fn write_point<D: Dim>(world: &World, e: Entity, out: &mut Vec<u8>) {
+    let point = world.entity(e).expect("a point found above");
+    let at = out.len();
+    out.extend_from_slice(&0u64.to_le_bytes());
+    let mut mask = 0u64;
+    let mut bit = 0;
+    macro_rules! write {
+        ($($t:ty),*) => {$(
+            if let Some(c) = point.get::<&$t>() {
+                mask |= 1 << bit;
+                // SAFETY: every point component is a plain struct of f64, u32 or u16 fields
+                // without padding (checkpoint's `point_components_have_no_padding`, and the
+                // `Pod` bound of a material's state), so each of its bytes is initialised.
+                out.extend_from_slice(unsafe { value_bytes::<$t>(&c) });
+            }
+            bit += 1;
+        )*};
+    }
+    point_components!(D, write);
+    let _ = bit;
+    out[at..at + 8].copy_from_slice(&mask.to_le_bytes());
+    // Keep the next point on an 8-byte boundary, as the padding of the message does.
+    out.resize(out.len().div_ceil(8) * 8, 0);
+}
+
+/// Reads the point at `*at` (as [`write_point`] wrote it) into `builder` and returns its
+/// position; `None` at the message's end.
+fn read_point<D: Dim>(bytes: &[u8], at: &mut usize, builder: &mut EntityBuilder) -> Option<D::Vec> {
+    if *at + 8 > bytes.len() {
+        return None;
+    }
+    let mask = u64::from_le_bytes(bytes[*at..*at + 8].try_into().expect("8 bytes"));
+    if mask == 0 {
+        return None;
+    }
+    // Every point has a position, the first of the list.
+    let mut position = None;
+    *at += 8;
+    let mut bit = 0;
+    macro_rules! read {
+        ($($t:ty),*) => {$(
+            if mask & (1 << bit) != 0 {
+                let n = std::mem::size_of::<$t>();
+                // SAFETY: the bytes were written by `write_point` from a value of this type,
+                // a plain struct for which every bit pattern it was written with is valid;
+                // the read is unaligned-safe.
+                let v: $t = unsafe { std::ptr::read_unaligned(bytes[*at..*at + n].as_ptr().cast::<$t>()) };
+                if bit == 0 {
+                    debug_assert_eq!(n, std::mem::size_of::<Position<D::Vec>>());
+                    // SAFETY: as above; the first component of the list is the position.
+                    position = Some(unsafe {
+                        std::ptr::read_unaligned(bytes[*at..*at + n].as_ptr().cast::<Position<D::Vec>>())
+                    });
+                }
+                builder.add(v);
+                *at += n;
+            }
+            bit += 1;
+        )*};
+    }
+    point_components!(D, read);
+    let _ = bit;
+    *at = (*at).div_ceil(8) * 8;
+    Some(position.expect("every point has a position").0)
+}
+
+/// The bytes of one value.
+///
+/// # Safety
+/// `T` must have no padding bytes.
+unsafe fn value_bytes<T>(v: &T) -> &[u8] {
+    // SAFETY: the caller guarantees every byte is initialised; the length is the value's.
+    unsafe { std::slice::from_raw_parts((v as *const T).cast::<u8>(), std::mem::size_of::<T>()) }
+}
