@@ -181,6 +181,23 @@ impl Comm {
         }
     }
 
+    /// The correctly rounded sum of every rank's `values`: the same bits whatever the rank
+    /// count and the order of the values (an exact sum, rounded once).
+    pub fn exact_sum(&self, values: impl IntoIterator<Item = f64>) -> f64 {
+        let mut mine = ExactSum::default();
+        values.into_iter().for_each(|v| mine.add(v));
+        if self.size == 1 {
+            return mine.total();
+        }
+        let mut len = [mine.partials.len() as f64];
+        self.max(&mut len);
+        let mut padded = mine.partials.clone();
+        padded.resize(len[0] as usize, 0.0);
+        let mut all = ExactSum::default();
+        self.gather_all(&padded).into_iter().for_each(|v| all.add(v));
+        all.total()
+    }
+
     /// Sends `send` to rank `to` and receives what rank `from` sends this rank, of any
     /// length. Every rank calls it in the same pattern, so that sends meet receives.
     pub fn exchange(&self, to: Option<usize>, send: &[f64], from: Option<usize>) -> Vec<f64> {
@@ -222,9 +239,83 @@ impl Comm {
     }
 }
 
+/// An exact sum of doubles as non-overlapping partial sums (Shewchuk 1997, "Adaptive
+/// precision floating-point arithmetic", as Python's `math.fsum`), rounded once at the end.
+#[derive(Clone, Debug, Default)]
+pub struct ExactSum {
+    partials: Vec<f64>,
+}
+
+impl ExactSum {
+    /// Adds `x` exactly.
+    pub fn add(&mut self, mut x: f64) {
+        let mut kept = 0;
+        for j in 0..self.partials.len() {
+            let mut y = self.partials[j];
+            if x.abs() < y.abs() {
+                std::mem::swap(&mut x, &mut y);
+            }
+            let hi = x + y;
+            let lo = y - (hi - x);
+            if lo != 0.0 {
+                self.partials[kept] = lo;
+                kept += 1;
+            }
+            x = hi;
+        }
+        self.partials.truncate(kept);
+        self.partials.push(x);
+    }
+
+    /// The sum, correctly rounded.
+    pub fn total(&self) -> f64 {
+        let mut p = self.partials.clone();
+        let Some(mut hi) = p.pop() else {
+            return 0.0;
+        };
+        let mut lo = 0.0;
+        while let Some(y) = p.pop() {
+            let x = hi;
+            hi = x + y;
+            lo = y - (hi - x);
+            if lo != 0.0 {
+                break;
+            }
+        }
+        // Round half to even across the partials left: the next one breaks a tie.
+        if let Some(&next) = p.last() {
+            if (lo < 0.0 && next < 0.0) || (lo > 0.0 && next > 0.0) {
+                let y = lo * 2.0;
+                let x = hi + y;
+                if y == x - hi {
+                    hi = x;
+                }
+            }
+        }
+        hi
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn an_exact_sum_does_not_depend_on_the_order_of_its_values() {
+        let values: Vec<f64> = (0..1000)
+            .map(|i| 1.0 / (i as f64 + 0.37) * if i % 3 == 0 { -1e8 } else { 1.0 })
+            .collect();
+        let sum = |v: &[f64]| {
+            let mut s = ExactSum::default();
+            v.iter().for_each(|&x| s.add(x));
+            s.total()
+        };
+        let mut reversed = values.clone();
+        reversed.reverse();
+        assert_eq!(sum(&values).to_bits(), sum(&reversed).to_bits());
+        assert_eq!(sum(&[1e100, 1.0, -1e100]), 1.0);
+        assert_eq!(sum(&[0.1; 10]), 1.0);
+    }
 
     #[test]
     fn one_rank_leaves_its_values_as_they_are() {

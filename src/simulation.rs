@@ -192,9 +192,11 @@ impl<D: Dim> Simulation<D> {
 
     /// Total mass of the points (kg).
     pub fn total_mass(&self) -> f64 {
-        points_with::<Mass>(&self.ctx.world)
-            .map(|a| col::<Mass>(a).iter().map(|m| m.0).sum::<f64>())
-            .sum()
+        // Exact, then rounded once: the same bits whatever the order of the points and the
+        // number of ranks (over MPI a collective).
+        let masses = points_with::<Mass>(&self.ctx.world)
+            .flat_map(|a| col::<Mass>(a).iter().map(|m| m.0).collect::<Vec<_>>());
+        self.ctx.comm.exact_sum(masses)
     }
 
     /// Current displacement and stress of every traced point. Over MPI a collective: each

@@ -184,10 +184,10 @@ impl Summary {
         // Over MPI every figure here is the ranks' (each call below is a collective, made
         // by every rank in this order).
         let comm = &sim.ctx.comm;
-        let mut totals = [sim.point_count() as f64, sim.total_mass()];
+        let mut totals = [sim.point_count() as f64];
         comm.sum(&mut totals);
-        let [particles, total_mass] = totals;
-        let particles = particles as usize;
+        let particles = totals[0] as usize;
+        let total_mass = sim.total_mass();
         let max_u = max_displacements(sim);
         let mut largest = max_u.map_or([f64::NEG_INFINITY; 2], |u| [u.0, u.1]);
         comm.max(&mut largest);
