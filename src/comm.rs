@@ -87,7 +87,21 @@ impl Comm {
             })
         }
         #[cfg(not(feature = "mpi"))]
-        Ok(Comm::single())
+        {
+            // Started by mpirun or srun (Open MPI and PMI set these in each process) but
+            // built without MPI: every process would run the whole scene on its own.
+            let launched = ["OMPI_COMM_WORLD_SIZE", "PMI_SIZE"]
+                .iter()
+                .filter_map(|v| std::env::var(v).ok())
+                .find_map(|n| n.parse::<usize>().ok().filter(|&n| n > 1));
+            if let Some(n) = launched {
+                return Err(format!(
+                    "started as one of {n} MPI processes, but this kdmpm was built without \
+                     MPI: build it with `cargo build --release --features mpi`"
+                ));
+            }
+            Ok(Comm::single())
+        }
     }
 
     /// This process's rank, from 0.

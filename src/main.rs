@@ -137,7 +137,7 @@ fn main() -> ExitCode {
         Ok(c) => c,
         Err(e) => {
             eprintln!("error: {e}");
-            return ExitCode::from(RUN_FAILED);
+            return ExitCode::from(BAD_INPUT);
         }
     };
     let comm = Arc::new(comm);
