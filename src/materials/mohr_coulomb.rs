@@ -662,31 +662,10 @@ mod tests {
         }
     }
 
-    /// A stress-controlled triaxial test: axial strain increments `de_axial` along z while
-    /// the lateral stresses σxx = σyy are held at `confinement` (Pa, tension positive) by
-    /// solving for the lateral strain increment (bisection). Returns the principal stresses.
+    /// The principal stresses at the end of a triaxial test ([`crate::testing::triaxial`]).
     fn triaxial(mc: &MohrCoulomb, confinement: f64, de_axial: f64, steps: usize) -> [f64; 3] {
-        let mut s = Sym3::diagonal(confinement, confinement, confinement);
-        let mut eps = PlasticStrain(0.0);
-        for _ in 0..steps {
-            let attempt = |e: f64| {
-                let mut t = s;
-                let mut p = eps;
-                mc.update(&mut t, &Sym3::diagonal(e, e, de_axial), &mut p);
-                (t, p)
-            };
-            let (mut lo, mut hi) = (-1e-3, 1e-3);
-            for _ in 0..200 {
-                let mid = 0.5 * (lo + hi);
-                if attempt(mid).0.xx > confinement {
-                    hi = mid;
-                } else {
-                    lo = mid;
-                }
-            }
-            (s, eps) = attempt(0.5 * (lo + hi));
-        }
-        s.principal_values()
+        let path = crate::testing::triaxial(mc, confinement, de_axial, steps);
+        path.last().expect("steps > 0").0.principal_values()
     }
 
     #[test]

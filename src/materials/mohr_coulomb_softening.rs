@@ -245,37 +245,17 @@ mod tests {
         }
     }
 
-    /// A stress-controlled triaxial compression test: `steps` increments of axial strain
-    /// `de_axial` (z) with the lateral stresses held at `confinement` (Pa, tension positive)
-    /// by bisection on the lateral strain. Returns the largest axial stress reached, the
-    /// last principal stresses and κ.
+    /// A triaxial compression test ([`crate::testing::triaxial`]): the largest axial
+    /// stress reached (Pa, compression positive), the last principal stresses and κ.
     fn triaxial(
         m: &MohrCoulombSoftening,
         confinement: f64,
         de_axial: f64,
         steps: usize,
     ) -> (f64, [f64; 3], f64) {
-        let mut s = Sym3::diagonal(confinement, confinement, confinement);
-        let mut kappa = SofteningStrain(0.0);
-        let mut largest: f64 = 0.0;
-        for _ in 0..steps {
-            let attempt = |e: f64| {
-                let (mut t, mut k) = (s, kappa);
-                m.update(&mut t, &Sym3::diagonal(e, e, de_axial), &mut k);
-                (t, k)
-            };
-            let (mut lo, mut hi) = (-1e-3, 1e-3);
-            for _ in 0..200 {
-                let mid = 0.5 * (lo + hi);
-                if attempt(mid).0.xx > confinement {
-                    hi = mid;
-                } else {
-                    lo = mid;
-                }
-            }
-            (s, kappa) = attempt(0.5 * (lo + hi));
-            largest = largest.max(-s.zz);
-        }
+        let path = crate::testing::triaxial(m, confinement, de_axial, steps);
+        let largest = path.iter().map(|(s, _)| -s.zz).fold(0.0, f64::max);
+        let (s, kappa) = path.last().expect("steps > 0");
         (largest, s.principal_values(), kappa.0)
     }
 
