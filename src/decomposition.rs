@@ -34,15 +34,10 @@ impl Decomposition {
     }
 
     /// Splits cell layers holding `counts[c]` points each into `ranks` contiguous ranges of
-    /// nearly equal point count, each holding cells at least `support + 1` layers wide. The
-    /// split depends only on the counts, so every rank finds the same one. An error when
-    /// the grid is too thin for the ranks.
-    pub fn balanced(
-        counts: &[u64],
-        ranks: usize,
-        rank: usize,
-        support: usize,
-    ) -> Result<Decomposition, String> {
+    /// nearly equal point count, each holding cells at least `support + 1` layers wide; a
+    /// grid too thin for the ranks leaves the last ones empty. The split depends only on the
+    /// counts, so every rank finds the same one.
+    pub fn balanced(counts: &[u64], ranks: usize, rank: usize, support: usize) -> Decomposition {
         let layers = counts.len();
         let min_width = support + 1;
         let total: u64 = counts.iter().sum();
@@ -52,11 +47,11 @@ impl Decomposition {
             // Everything on rank 0; the others hold nothing.
             let mut bounds = vec![0, layers];
             bounds.extend(std::iter::repeat_n(layers, ranks - 1));
-            return Ok(Decomposition {
+            return Decomposition {
                 bounds,
                 rank,
                 support,
-            });
+            };
         }
         let mut bounds = vec![0];
         let mut prefix = 0u64;
@@ -76,11 +71,11 @@ impl Decomposition {
         bounds.push(layers);
         // Ranks beyond the busy ones hold nothing (at the top).
         bounds.extend(std::iter::repeat_n(layers, ranks - busy));
-        Ok(Decomposition {
+        Decomposition {
             bounds,
             rank,
             support,
-        })
+        }
     }
 
     /// The number of ranks.
@@ -168,7 +163,7 @@ mod tests {
 
     fn ranks_of(counts: &[u64], ranks: usize, support: usize) -> Vec<Decomposition> {
         (0..ranks)
-            .map(|r| Decomposition::balanced(counts, ranks, r, support).unwrap())
+            .map(|r| Decomposition::balanced(counts, ranks, r, support))
             .collect()
     }
 

@@ -6,13 +6,12 @@
 //! ([`crate::systems::exchange`]), reduces the global figures in rank order, and moves points
 //! that leave a rank to its neighbour ([`crate::systems::migrate`]).
 
-use crate::columns::{col, points_with};
 use crate::comm::Comm;
 use crate::components::Position;
 use crate::decomposition::Decomposition;
 use crate::dim::Dim;
 use crate::simulation::Simulation;
-use crate::systems::migrate::Migrate;
+use crate::systems::migrate::{layer_counts, Migrate};
 use hecs::Entity;
 use std::sync::Arc;
 
@@ -38,9 +37,6 @@ pub fn unsupported<D: Dim>(sim: &Simulation<D>) -> Option<&'static str> {
 /// Gives `sim` its part of the run: the decomposition of its points over `comm`'s ranks,
 /// and only the points of this rank's cell layers. With one rank nothing changes.
 pub fn decompose<D: Dim>(sim: &mut Simulation<D>, comm: Arc<Comm>) -> Result<(), String> {
-    let ctx = &mut sim.ctx;
-    let (axis, layers) = (ctx.grid.slab_axis, ctx.grid.axes[ctx.grid.slab_axis].cells);
-    let support = ctx.decomposition.support;
     if comm.size() > 1 {
         if let Some(what) = unsupported(sim) {
             return Err(format!(
@@ -51,13 +47,10 @@ pub fn decompose<D: Dim>(sim: &mut Simulation<D>, comm: Arc<Comm>) -> Result<(),
         }
     }
     let ctx = &mut sim.ctx;
-    let mut counts = vec![0u64; layers];
-    for arch in points_with::<Position<D::Vec>>(&ctx.world) {
-        for x in col::<Position<D::Vec>>(arch).iter() {
-            counts[ctx.grid.clamped_cell_along(x.0, axis)] += 1;
-        }
-    }
-    let d = Decomposition::balanced(&counts, comm.size(), comm.rank(), support)?;
+    let axis = ctx.grid.slab_axis;
+    // Every rank holds the whole scene here: its counts are everyone's.
+    let counts = layer_counts(ctx);
+    let d = Decomposition::balanced(&counts, comm.size(), comm.rank(), ctx.decomposition.support);
     let cells = d.cells();
     let away: Vec<Entity> = ctx
         .world

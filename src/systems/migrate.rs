@@ -7,6 +7,7 @@
 //! its material's state and its [`PointId`] included) and is spawned again on the other
 //! side, so a run's points are the same set whatever the rank count.
 
+use crate::columns::{col, points_with};
 use crate::components::*;
 use crate::context::Context;
 use crate::decomposition::Decomposition;
@@ -44,11 +45,7 @@ pub fn rebalance<D: Dim>(ctx: &mut Context<D>) -> bool {
     if ctx.comm.size() == 1 || !ctx.state.step.is_multiple_of(REBALANCE_EVERY) {
         return false;
     }
-    let axis = ctx.grid.slab_axis;
-    let mut counts = vec![0.0; ctx.grid.axes[axis].cells];
-    for (_, x) in ctx.world.query::<(Entity, &Position<D::Vec>)>().iter() {
-        counts[ctx.grid.clamped_cell_along(x.0, axis)] += 1.0;
-    }
+    let mut counts: Vec<f64> = layer_counts(ctx).iter().map(|&c| c as f64).collect();
     ctx.comm.sum(&mut counts);
     let counts: Vec<u64> = counts.iter().map(|&c| c as u64).collect();
     let d = &ctx.decomposition;
@@ -58,9 +55,7 @@ pub fn rebalance<D: Dim>(ctx: &mut Context<D>) -> bool {
     if Decomposition::imbalance(&per_rank) <= IMBALANCE_LIMIT {
         return false;
     }
-    let Ok(next) = Decomposition::balanced(&counts, d.ranks(), d.rank, d.support) else {
-        return false;
-    };
+    let next = Decomposition::balanced(&counts, d.ranks(), d.rank, d.support);
     if next.bounds == d.bounds {
         return false;
     }
@@ -68,6 +63,18 @@ pub fn rebalance<D: Dim>(ctx: &mut Context<D>) -> bool {
     ctx.state.rebalances += 1;
     migrate(ctx);
     true
+}
+
+/// This rank's points in each cell layer along the slab axis.
+pub fn layer_counts<D: Dim>(ctx: &Context<D>) -> Vec<u64> {
+    let axis = ctx.grid.slab_axis;
+    let mut counts = vec![0u64; ctx.grid.axes[axis].cells];
+    for arch in points_with::<Position<D::Vec>>(&ctx.world) {
+        for x in col::<Position<D::Vec>>(arch).iter() {
+            counts[ctx.grid.clamped_cell_along(x.0, axis)] += 1;
+        }
+    }
+    counts
 }
 
 /// Sends this rank's points outside its cell layers towards the ranks that own them and
