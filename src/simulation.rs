@@ -202,42 +202,57 @@ impl<D: Dim> Simulation<D> {
     /// Current displacement and stress of every traced point. Over MPI a collective: each
     /// point's values come from the rank that holds it, and every rank gets them.
     pub fn traced_results(&self) -> Vec<TracedResult> {
-        // Per point: displacement (3) and stress (6), zero on the ranks that lack it.
-        let mut values = Vec::with_capacity(self.traced.len() * 9);
-        for t in &self.traced {
-            match t.find(&self.ctx.world) {
-                Some(entity) => {
-                    let e = self.ctx.world.entity(entity).expect("found above");
-                    let s = e
-                        .get::<&Stress<D::Stress>>()
-                        .map(|s| s.0.to_sym3())
-                        .unwrap_or_default();
-                    values.extend(t.displacement::<D>(&self.ctx.world));
-                    values.extend([s.xx, s.yy, s.zz, s.xy, s.yz, s.zx]);
-                }
-                None => values.extend([0.0; 9]),
-            }
-        }
-        // One rank holds each point: the others add zeros, which leaves its value.
-        self.ctx.comm.sum(&mut values);
-        self.traced
-            .iter()
-            .zip(values.chunks(9))
-            .map(|(t, v)| TracedResult {
+        let mut traced = self.traced.clone();
+        traced_values(&self.ctx, &mut traced)
+            .into_iter()
+            .zip(&self.traced)
+            .map(|((displacement, stress), t)| TracedResult {
                 name: t.name.clone(),
                 initial_position: t.initial_position,
-                displacement: [v[0], v[1], v[2]],
-                stress: Sym3 {
-                    xx: v[3],
-                    yy: v[4],
-                    zz: v[5],
-                    xy: v[6],
-                    yz: v[7],
-                    zx: v[8],
-                },
+                displacement,
+                stress,
             })
             .collect()
     }
+}
+
+/// Displacement (m) and stress (Pa; zero for a load carrier) of each of `traced`, whose
+/// entities it finds again. Over MPI a collective: each point's values come from the rank
+/// that holds it, and every rank gets them.
+pub fn traced_values<D: Dim>(ctx: &Context<D>, traced: &mut [TracedPoint]) -> Vec<([f64; 3], Sym3)> {
+    // Per point: displacement (3) and stress (6), zero on the ranks that lack it.
+    let mut values = Vec::with_capacity(traced.len() * 9);
+    for t in traced.iter_mut() {
+        match t.find(&ctx.world) {
+            Some(entity) => {
+                t.entity = entity;
+                let e = ctx.world.entity(entity).expect("found above");
+                let s = e
+                    .get::<&Stress<D::Stress>>()
+                    .map(|s| s.0.to_sym3())
+                    .unwrap_or_default();
+                values.extend(t.displacement::<D>(&ctx.world));
+                values.extend([s.xx, s.yy, s.zz, s.xy, s.yz, s.zx]);
+            }
+            None => values.extend([0.0; 9]),
+        }
+    }
+    // One rank holds each point: the others add zeros, which leaves its value.
+    ctx.comm.sum(&mut values);
+    values
+        .chunks(9)
+        .map(|v| {
+            let stress = Sym3 {
+                xx: v[3],
+                yy: v[4],
+                zz: v[5],
+                xy: v[6],
+                yz: v[7],
+                zx: v[8],
+            };
+            ([v[0], v[1], v[2]], stress)
+        })
+        .collect()
 }
 
 /// A simulation of either dimension, as built from a scene.

@@ -5,7 +5,7 @@ use crate::dim::Dim;
 use crate::error::StepError;
 use crate::output::dir::RowFile;
 use crate::schedule::System;
-use crate::simulation::TracedPoint;
+use crate::simulation::{traced_values, TracedPoint};
 use crate::state::Drive;
 use crate::systems::convergence::ratio_text;
 use std::marker::PhantomData;
@@ -173,19 +173,8 @@ impl<D: Dim> System<D> for TracedGather {
         "traced_gather"
     }
     fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
-        let mut values = Vec::with_capacity(3 * self.traced.len());
-        for t in &mut self.traced {
-            match t.find(&ctx.world) {
-                Some(e) => {
-                    t.entity = e;
-                    values.extend(t.displacement::<D>(&ctx.world));
-                }
-                None => values.extend([0.0; 3]),
-            }
-        }
-        // One rank holds each point; the others add zeros.
-        ctx.comm.sum(&mut values);
-        ctx.state.traced_displacements = values.chunks(3).map(|u| [u[0], u[1], u[2]]).collect();
+        let values = traced_values(ctx, &mut self.traced);
+        ctx.state.traced_displacements = values.into_iter().map(|(u, _)| u).collect();
         Ok(())
     }
 }
