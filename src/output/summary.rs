@@ -184,16 +184,15 @@ impl Summary {
         // Over MPI every figure here is the ranks' (each call below is a collective, made
         // by every rank in this order).
         let comm = &sim.ctx.comm;
-        let mut totals = [sim.point_count() as f64];
-        comm.sum(&mut totals);
-        let particles = totals[0] as usize;
+        // Each rank's points (exact in f64), in rank order.
+        let points = comm.gather_all(&[sim.point_count() as f64]);
+        let particles = points.iter().sum::<f64>() as usize;
         let total_mass = sim.total_mass();
         let max_u = max_displacements(sim);
         let mut largest = max_u.map_or([f64::NEG_INFINITY; 2], |u| [u.0, u.1]);
         comm.max(&mut largest);
         let max_u = (largest[0] >= 0.0).then_some((largest[0], largest[1]));
         let ranks = (comm.size() > 1).then(|| {
-            let points = comm.gather_all(&[sim.point_count() as f64]);
             let mut migrations = [s.migrations as f64, comm.sent_bytes() as f64];
             comm.sum(&mut migrations);
             Ranks {

@@ -8,7 +8,7 @@
 //!
 //! With one rank every function here returns at once.
 
-use crate::columns::{col_mut, nodes};
+use crate::columns::{col, col_mut, nodes};
 use crate::components::*;
 use crate::context::Context;
 use crate::dim::Dim;
@@ -90,7 +90,7 @@ fn pack<D: Dim>(ctx: &Context<D>, what: u8, ids: Range<usize>) -> Vec<f64> {
     let n = nodes(&ctx.world);
     let mut out = Vec::new();
     if what & MASS != 0 {
-        out.extend(col_mut::<NodeMass>(n)[ids.clone()].iter().map(|m| m.0));
+        out.extend(col::<NodeMass>(n)[ids.clone()].iter().map(|m| m.0));
     }
     let vectors = |out: &mut Vec<f64>, v: &mut dyn Iterator<Item = D::Vec>| {
         for v in v {
@@ -100,21 +100,19 @@ fn pack<D: Dim>(ctx: &Context<D>, what: u8, ids: Range<usize>) -> Vec<f64> {
     if what & MOMENTUM != 0 {
         vectors(
             &mut out,
-            &mut col_mut::<NodeMomentum<D::Vec>>(n)[ids.clone()]
-                .iter()
-                .map(|p| p.0),
+            &mut col::<NodeMomentum<D::Vec>>(n)[ids.clone()].iter().map(|p| p.0),
         );
     }
     if what & FORCE != 0 {
         vectors(
             &mut out,
-            &mut col_mut::<NodeForce<D::Vec>>(n)[ids.clone()].iter().map(|f| f.0),
+            &mut col::<NodeForce<D::Vec>>(n)[ids.clone()].iter().map(|f| f.0),
         );
     }
     if what & EXTERNAL != 0 {
         vectors(
             &mut out,
-            &mut col_mut::<NodeExternalForce<D::Vec>>(n)[ids].iter().map(|f| f.0),
+            &mut col::<NodeExternalForce<D::Vec>>(n)[ids].iter().map(|f| f.0),
         );
     }
     out

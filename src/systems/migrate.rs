@@ -135,11 +135,11 @@ fn migrate_once<D: Dim>(ctx: &mut Context<D>) -> (usize, usize, bool) {
     let from_above = ctx.comm.exchange(below, &to_below, above);
     let (mut came, mut astray) = (0, false);
     for message in [from_below, from_above] {
-        let bytes: Vec<u8> = bytemuck::cast_slice(&message).to_vec();
+        let bytes: &[u8] = bytemuck::cast_slice(&message);
         let mut at = 0;
         loop {
             let mut builder = EntityBuilder::new();
-            let Some(x) = read_point::<D>(&bytes, &mut at, &mut builder) else {
+            let Some(x) = read_point::<D>(bytes, &mut at, &mut builder) else {
                 break;
             };
             astray |= !cells.contains(&ctx.grid.clamped_cell_along(x, axis));
