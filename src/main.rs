@@ -406,11 +406,8 @@ fn run_ranks<D: Dim>(
     }
     let start = Instant::now();
     let result = sim.run(|_| {});
-    let part = out.join(format!("points_{}.vtu", comm.rank()));
-    let written = match sim.first_non_finite() {
-        None => kdmpm::output::vtk::write_points(sim, &part),
-        Some(_) => Ok(()),
-    };
+    // A state with a non-finite value comes with the run's error, reported below.
+    let written = kdmpm::output::recorder::write_final_points(sim, out);
     // The summary's figures are collectives: this rank takes part, rank 0 writes them.
     let error = result.as_ref().err().map(|e| e.to_string());
     let _ = Summary::collect(
@@ -420,16 +417,16 @@ fn run_ranks<D: Dim>(
         error,
     );
     match (result, written) {
-        (Ok(()), Ok(())) => ExitCode::SUCCESS,
+        (Ok(()), Ok(_)) => ExitCode::SUCCESS,
         (Err(e), _) => {
             eprintln!("error: rank {}: {e}", comm.rank());
             ExitCode::from(RUN_FAILED)
         }
         (_, Err(e)) => {
             eprintln!(
-                "error: rank {}: cannot write {}: {e}",
+                "error: rank {}: cannot write its points into {}: {e}",
                 comm.rank(),
-                part.display()
+                out.display()
             );
             ExitCode::from(RUN_FAILED)
         }

@@ -13,6 +13,7 @@ use crate::simulation::Simulation;
 use crate::state::{CurvePoint, StageResult};
 use crate::systems::convergence::ratio_text;
 use std::io::Write;
+use std::path::Path;
 use std::sync::{Arc, Mutex};
 
 /// The load–displacement curve's file.
@@ -63,6 +64,27 @@ fn stages_csv(stages: &[StageResult]) -> String {
         );
     }
     t
+}
+
+/// Writes this rank's final points into `dir`: `points.vtu`, or over MPI
+/// `points_<rank>.vtu`, which rank 0's `points.pvtu` ties together. When the state holds a non-finite value
+/// nothing is written, and the note says why.
+pub fn write_final_points<D: Dim>(sim: &Simulation<D>, dir: &Path) -> std::io::Result<Option<String>> {
+    let comm = &sim.ctx.comm;
+    let points = match comm.size() {
+        1 => "points.vtu".to_string(),
+        _ => format!("points_{}.vtu", comm.rank()),
+    };
+    if comm.size() > 1 && comm.is_root() {
+        let parts: Vec<String> = (0..comm.size()).map(|r| format!("points_{r}.vtu")).collect();
+        write_parallel_points(sim, &dir.join("points.pvtu"), &parts)?;
+    }
+    match sim.first_non_finite() {
+        None => write_points(sim, &dir.join(&points)).map(|()| None),
+        Some(what) => Ok(Some(format!(
+            "{points} not written: the state holds a non-finite {what}"
+        ))),
+    }
 }
 
 /// The outputs a run writes into its directory: `history.csv` every `history_every` steps,
@@ -128,26 +150,16 @@ impl Recorder {
         history::lock(&self.rows).flush()?;
         let series = self.snapshots.map(SnapshotWriter::finish).transpose()?;
         let mut notes = Notes::default();
-        // Over MPI each rank writes its own points, and points.pvtu ties them together.
-        let comm = &sim.ctx.comm;
-        let points = match comm.size() {
-            1 => "points.vtu".to_string(),
-            _ => format!("points_{}.vtu", comm.rank()),
-        };
-        if comm.size() > 1 {
-            let parts: Vec<String> = (0..comm.size()).map(|r| format!("points_{r}.vtu")).collect();
-            write_parallel_points(sim, &dir.file("points.pvtu"), &parts)?;
-        }
-        match sim.first_non_finite() {
-            None => write_points(sim, &dir.file(&points))?,
-            Some(what) => notes.0.push(format!(
-                "points.vtu not written: the state holds a non-finite {what}{}",
-                if dir.file(crate::checkpoint::FILE_NAME).exists() {
+        if let Some(note) = write_final_points(sim, dir.path())? {
+            let resume = dir.file(crate::checkpoint::FILE_NAME).exists();
+            notes.0.push(format!(
+                "{note}{}",
+                if resume {
                     "; the last checkpoint holds a finite state (kdmpm resume)"
                 } else {
                     ""
                 }
-            )),
+            ));
         }
         if !sim.ctx.state.stages.is_empty() {
             dir.write_atomic(STAGES, |out| {
