@@ -295,6 +295,14 @@ impl MotionSpec {
                 return Err((field, format!("needs {dimension} entries, one per axis")));
             }
         }
+        for (field, v) in [("min", &self.min), ("max", &self.max)] {
+            if let Some(k) = v.iter().position(|x| !x.is_finite()) {
+                return Err((
+                    field,
+                    format!("entry {k} must be a finite coordinate (m), found {}", v[k]),
+                ));
+            }
+        }
         if self.min.iter().zip(&self.max).any(|(lo, hi)| lo > hi) {
             return Err(("max", "every entry must be at least min's".into()));
         }
@@ -423,6 +431,11 @@ pub struct SolverState {
     /// True when a control system consumed a static state in this step (an increment or a
     /// stage ended): snapshot writers take one.
     pub milestone: bool,
+    /// The external force K_F is measured against while none is applied (N: max and sum of
+    /// |F_ext| over free degrees of freedom): the last applied load's. A stage that removes
+    /// every load (gravity set to 0) relaxes towards an unloaded state, and its out-of-balance
+    /// force is judged against the load it took away; `None` before any load acted.
+    pub force_reference: Option<[f64; 2]>,
 }
 
 impl Settings {
@@ -447,6 +460,21 @@ impl SolverState {
     /// True while a prescribed motion moves: not a static state, however balanced.
     pub fn driving(&self) -> bool {
         self.drives.iter().any(|d| d.velocity != [0.0; 3])
+    }
+
+    /// Goes on after a static state that a control system consumed (an increment, a
+    /// stage): the stop is lifted unless the step or time limit is reached, which ends the
+    /// run even while increments are left (a load in 10⁹ increments that each balance at
+    /// once would otherwise never reach `max_steps`).
+    pub fn go_on(&mut self, settings: &Settings) {
+        self.static_window_start = None;
+        self.stop = if settings.max_steps.is_some_and(|m| self.step >= m) {
+            Some(StopReason::MaxSteps)
+        } else if settings.max_time.is_some_and(|t| self.time >= t * (1.0 - 1e-12)) {
+            Some(StopReason::MaxTime)
+        } else {
+            None
+        };
     }
 
     /// K_F in the norm the stopping rule reads.

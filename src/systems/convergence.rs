@@ -34,22 +34,41 @@ pub fn ratio_text(ratio: f64, digits: usize) -> String {
     }
 }
 
-/// Force-ratio sums over the free degrees of freedom of nodes that carry mass.
+/// Force-ratio norms over the free degrees of freedom of nodes that carry mass.
 ///
 /// Fixed components are left out (their reaction keeps K_F near 1 for ever), and so are
 /// massless nodes (they carry no degree of freedom). A component driven by a prescribed
-/// motion counts its load (the reaction) as external force and has no unbalanced force. With no external force on any free
-/// degree of freedom both ratios are [`UNDEFINED`].
+/// motion counts its load (the reaction) as external force and has no unbalanced force.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct ForceRatios {
-    /// K_F = max|F_ext + F_int| / max|F_ext|.
-    pub max_norm: f64,
-    /// Σ|F_ext + F_int| / Σ|F_ext|.
-    pub mean_norm: f64,
+pub struct ForceNorms {
+    /// max|F_ext + F_int| and Σ|F_ext + F_int| (N).
+    pub unbalanced: [f64; 2],
+    /// max|F_ext| and Σ|F_ext| (N).
+    pub external: [f64; 2],
 }
 
-/// Computes both force ratios from the node columns.
-pub fn force_ratios<D: Dim>(ctx: &Context<D>) -> ForceRatios {
+impl ForceNorms {
+    /// K_F = max|F_ext + F_int| / max|F_ext| and Σ|F_ext + F_int| / Σ|F_ext|, measured
+    /// against `reference` (the last applied load's norms) when no external force acts:
+    /// [`UNDEFINED`] when there is neither.
+    pub fn ratios(&self, reference: Option<[f64; 2]>) -> [f64; 2] {
+        let e = if self.external[0] > 0.0 {
+            self.external
+        } else {
+            reference.unwrap_or([0.0; 2])
+        };
+        std::array::from_fn(|k| {
+            if e[k] > 0.0 {
+                self.unbalanced[k] / e[k]
+            } else {
+                UNDEFINED
+            }
+        })
+    }
+}
+
+/// Computes the force norms from the node columns.
+pub fn force_norms<D: Dim>(ctx: &Context<D>) -> ForceNorms {
     let min_mass = ctx.settings.min_node_mass;
     let n = nodes(&ctx.world);
     let nm = col::<NodeMass>(n);
@@ -98,10 +117,9 @@ pub fn force_ratios<D: Dim>(ctx: &Context<D>) -> ForceRatios {
         ctx.comm.sum(&mut sums);
         [max_u, max_e, sum_u, sum_e] = [largest[0], largest[1], sums[0], sums[1]];
     }
-    let ratio = |u: f64, e: f64| if e > 0.0 { u / e } else { UNDEFINED };
-    ForceRatios {
-        max_norm: ratio(max_u, max_e),
-        mean_norm: ratio(sum_u, sum_e),
+    ForceNorms {
+        unbalanced: [max_u, sum_u],
+        external: [max_e, sum_e],
     }
 }
 
@@ -161,7 +179,8 @@ impl<D: Dim> System<D> for Convergence {
         "convergence"
     }
     fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
-        let ratios = force_ratios(ctx);
+        let norms = force_norms(ctx);
+        let ratios = norms.ratios(ctx.state.force_reference);
         let dw = if let Some(dt) = ctx.state.motion_dt() {
             let n = nodes(&ctx.world);
             let ne = col::<NodeExternalForce<D::Vec>>(n);
@@ -189,8 +208,10 @@ impl<D: Dim> System<D> for Convergence {
         };
         let s = &mut ctx.state;
         s.external_work += dw;
-        s.force_ratio_max = ratios.max_norm;
-        s.force_ratio_mean = ratios.mean_norm;
+        [s.force_ratio_max, s.force_ratio_mean] = ratios;
+        if norms.external[0] > 0.0 {
+            s.force_reference = Some(norms.external);
+        }
         s.energy_ratio = if s.external_work > 0.0 {
             s.kinetic_energy / s.external_work
         } else {

@@ -92,9 +92,7 @@ impl<D: Dim> System<D> for LoadControl {
             }
         }
         if more {
-            let s = &mut ctx.state;
-            s.stop = None;
-            s.static_window_start = None;
+            ctx.state.go_on(&ctx.settings);
         }
         Ok(())
     }

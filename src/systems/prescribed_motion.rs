@@ -43,12 +43,10 @@ impl<D: Dim> System<D> for PrescribedMotion {
     fn prepare(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
         let grid = &ctx.grid;
         let mut fix = col_mut::<NodeFixity>(nodes(&ctx.world));
-        // A node on the box's face, to round-off of the grid's coordinates.
-        let slack = 1e-9 * grid.cell_size;
         for (k, m) in self.motions.iter().enumerate() {
             for (id, f) in fix.iter_mut().enumerate() {
                 let x = D::vec_to3(grid.node_position(grid.node_ijk(id)));
-                if (0..D::N).all(|a| x[a] >= m.min[a] - slack && x[a] <= m.max[a] + slack) {
+                if in_box(m, x, D::N, grid.cell_size) {
                     // Face conditions on other axes stay (a footing on a symmetry
                     // plane keeps its roller).
                     *f = NodeFixity::driven(f.0 | ctx.state.drives[k].axes, k);
@@ -102,11 +100,17 @@ impl<D: Dim> System<D> for PrescribedMotion {
             }
         }
         if more {
-            s.stop = None;
-            s.static_window_start = None;
+            s.go_on(&ctx.settings);
         }
         Ok(())
     }
+}
+
+/// True when the node at `x` (m) is driven by motion `m` in `n` dimensions: on or inside
+/// its box, to round-off of the grid's coordinates (cells of `h` m).
+pub(crate) fn in_box(m: &MotionSpec, x: [f64; 3], n: usize, h: f64) -> bool {
+    let slack = 1e-9 * h;
+    (0..n).all(|a| x[a] >= m.min[a] - slack && x[a] <= m.max[a] + slack)
 }
 
 /// Travel at the end of increment `k` (0-based), m.

@@ -3,7 +3,7 @@
 //! Mohr-Coulomb strength), gravity, point loads and tractions when it begins, and may zero
 //! the displacements.
 
-use crate::columns::{col_mut, nodes, points_with};
+use crate::columns::{col, col_mut, nodes, points_with};
 use crate::components::*;
 use crate::context::Context;
 use crate::dim::{Dim, Vector};
@@ -43,6 +43,31 @@ fn apply<D: Dim>(ctx: &mut Context<D>, stage: &LoadStage, start: f64) {
     set_point_loads(ctx, &stage.loads, 1.0);
 }
 
+/// Scales the mass of every point whose material `stage` gives another density by
+/// ρ_new/ρ_old (its volume is what it is; its mass, and with it its weight, change). Called
+/// once as the stage begins, before [`apply`] replaces the models: unlike `apply` it is
+/// not idempotent, and a resumed run's masses are already those of its stage.
+fn reweigh<D: Dim>(ctx: &mut Context<D>, stage: &LoadStage) {
+    let ratios: Vec<(u16, f64)> = stage
+        .materials
+        .iter()
+        .map(|(id, model)| (*id, model.density() / ctx.materials[*id as usize].density()))
+        .filter(|&(_, r)| r != 1.0)
+        .collect();
+    if ratios.is_empty() {
+        return;
+    }
+    for arch in points_with::<MaterialId>(&ctx.world) {
+        let ids = col::<MaterialId>(arch);
+        let mut mass = col_mut::<Mass>(arch);
+        for (m, id) in mass.iter_mut().zip(ids.iter()) {
+            if let Some(&(_, r)) = ratios.iter().find(|(k, _)| *k == id.0) {
+                m.0 *= r;
+            }
+        }
+    }
+}
+
 impl<D: Dim> System<D> for Stages {
     fn name(&self) -> &str {
         "stages"
@@ -57,6 +82,11 @@ impl<D: Dim> System<D> for Stages {
         {
             // A stage starts when the one before it ended.
             let start = k.checked_sub(1).map_or(0.0, |j| ctx.state.stages[j].time);
+            // A fresh run begins in the first stage with the scene's masses; a resumed one
+            // has the masses of its stage in its checkpoint.
+            if k == 0 && ctx.state.step == 0 {
+                reweigh(ctx, stage);
+            }
             apply(ctx, stage, start);
         }
         Ok(())
@@ -81,13 +111,13 @@ impl<D: Dim> System<D> for Stages {
             return Ok(());
         }
         s.stage += 1;
-        s.stop = None;
-        s.static_window_start = None;
+        s.go_on(&ctx.settings);
         s.kinetic_energy = 0.0;
         s.previous_kinetic_energy = 0.0;
         s.earlier_kinetic_energy = 0.0;
         let stage = stages[s.stage].clone();
         let start = ctx.state.time;
+        reweigh(ctx, &stage);
         apply(ctx, &stage, start);
         if stage.reset_displacements {
             for arch in points_with::<Displacement<D::Vec>>(&ctx.world) {
