@@ -93,7 +93,17 @@ pub trait SceneMaterial: Clone + PartialEq + Debug + Serialize + DeserializeOwne
     fn reduce_strength(&mut self, _factor: f64) -> bool {
         false
     }
+    /// The largest dilatancy angle ψ the model's plastic flow takes (degrees): 0 for an
+    /// elastic model or isochoric flow. Volumetric smoothing is refused where it is above 0.
+    fn dilatancy_angle(&self) -> f64 {
+        0.0
+    }
 }
+
+/// The largest Young's modulus a scene may give (Pa): a thousand times diamond's
+/// (1.2e12 Pa), so stiffer than any ground or structure. Far above it, the products of
+/// moduli in a plastic return overflow and the stress becomes NaN.
+pub const MAX_MODULUS: f64 = 1e15;
 
 /// Something done with one state type, chosen at run time (see [`visit_states`] and
 /// [`MaterialModel::visit_state`]).
@@ -205,6 +215,13 @@ macro_rules! define_materials {
             pub fn reduce_strength(&mut self, factor: f64) -> bool {
                 match self {
                     $(MaterialSpec::$variant(s) => s.reduce_strength(factor),)*
+                }
+            }
+
+            /// The largest dilatancy angle (degrees; see [`SceneMaterial::dilatancy_angle`]).
+            pub fn dilatancy_angle(&self) -> f64 {
+                match self {
+                    $(MaterialSpec::$variant(s) => s.dilatancy_angle(),)*
                 }
             }
         }
@@ -323,7 +340,7 @@ impl Elasticity {
         }
     }
 
-    /// Checked E (Pa, > 0) and ν (in [0, 0.5)) with the density ρ (kg/m³, > 0) of the same
+    /// Checked E (Pa, in (0, [`MAX_MODULUS`]]) and ν (in [0, 0.5)) with the density ρ (kg/m³, > 0) of the same
     /// scene entry; an error names the field (through `at`) and the rule.
     pub fn checked(
         at: &dyn Fn(&str) -> String,
@@ -335,10 +352,10 @@ impl Elasticity {
         if !positive(density) {
             return Err((at("density"), format!("must be > 0 kg/m³, found {density}")));
         }
-        if !positive(youngs_modulus) {
+        if !(positive(youngs_modulus) && youngs_modulus <= MAX_MODULUS) {
             return Err((
                 at("youngs_modulus"),
-                format!("must be > 0 Pa, found {youngs_modulus}"),
+                format!("must be > 0 Pa and at most {MAX_MODULUS:e} Pa, found {youngs_modulus:e}"),
             ));
         }
         if !(0.0..0.5).contains(&poisson_ratio) {

@@ -105,6 +105,9 @@ impl SceneMaterial for MohrCoulombSpec {
             self.tension_cutoff,
         ))
     }
+    fn dilatancy_angle(&self) -> f64 {
+        self.dilatancy_angle
+    }
     /// c, tan φ, tan ψ and an explicit cut-off, each divided by `factor`.
     fn reduce_strength(&mut self, factor: f64) -> bool {
         self.cohesion /= factor;
@@ -378,9 +381,10 @@ impl MohrCoulomb {
                 return (s, kind);
             }
         }
-        let apex = self
-            .apex
-            .expect("a Tresca return always lands on a plane or an edge");
+        // A Tresca surface has no apex: only a trial stress that is not a finite number
+        // (moduli or strains that overflow) misses all its planes and edges. The NaN it
+        // gets back stops the run, as a non-finite state, at the next energy check.
+        let apex = self.apex.unwrap_or(f64::NAN);
         (DVec3::splat(apex), Return::Apex)
     }
 

@@ -95,6 +95,9 @@ impl SceneMaterial for MohrCoulombSofteningSpec {
             at_residual: Box::new(self.at(residual)),
         })
     }
+    fn dilatancy_angle(&self) -> f64 {
+        self.dilatancy_angle.max(self.residual_dilatancy_angle)
+    }
     /// Peak and residual c, tan φ, tan ψ and an explicit cut-off, each divided by `factor`.
     fn reduce_strength(&mut self, factor: f64) -> bool {
         self.cohesion /= factor;

@@ -201,6 +201,65 @@ fn face_fixity<D: Dim>(grid: &Grid<D>, boundaries: &[BoundarySpec]) -> Vec<NodeF
     fixity
 }
 
+/// Every motion's box holds grid nodes that the body touches at the start, and no node is
+/// in two boxes: a box of nodes the body never reaches pushes nothing (a curve of zero
+/// forces), and a node two motions claim is driven by the later one only.
+fn check_motion_boxes<D: Dim>(
+    loaded: &LoadedScene,
+    grid: &Grid<D>,
+    touched: &[bool],
+) -> Result<(), SceneError> {
+    let motions = &loaded.scene.motions;
+    if motions.is_empty() {
+        return Ok(());
+    }
+    let mut owner: Vec<Option<usize>> = vec![None; grid.node_count()];
+    for (k, m) in motions.iter().enumerate() {
+        let (mut inside, mut loaded_nodes) = (0usize, 0usize);
+        for (id, o) in owner.iter_mut().enumerate() {
+            let x = D::vec_to3(grid.node_position(grid.node_ijk(id)));
+            if !crate::systems::prescribed_motion::in_box(m, x, D::N, grid.cell_size) {
+                continue;
+            }
+            if let Some(j) = *o {
+                return Err(loaded.invalid(
+                    &format!("motions[{k}].min"),
+                    format!(
+                        "the box shares the node at {:?} with motions[{j}] (\"{}\"): a node has one \
+                         motion; give the motions boxes apart",
+                        &x[..D::N],
+                        motions[j].name
+                    ),
+                ));
+            }
+            *o = Some(k);
+            inside += 1;
+            loaded_nodes += usize::from(touched[id]);
+        }
+        if inside == 0 {
+            return Err(loaded.invalid(
+                &format!("motions[{k}].min"),
+                format!(
+                    "the box {:?}..{:?} holds no grid node (nodes lie every {} m from the grid's \
+                     origin): the motion would drive nothing",
+                    m.min, m.max, grid.cell_size
+                ),
+            ));
+        }
+        if loaded_nodes == 0 {
+            return Err(loaded.invalid(
+                &format!("motions[{k}].min"),
+                format!(
+                    "none of the box's {inside} nodes touches the body at the start: grid nodes \
+                     do not move, so the motion would push nothing and report zero force; put the \
+                     box on the body's surface"
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// The scene's stages with their materials built (indexed as `table`) and their loads by
 /// carrier id (`load_ids`).
 fn stages<D: Dim>(
@@ -404,6 +463,8 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
             visit_support(&grid, s.shape, x.0, |i, w| touched[i] |= w > 0.0);
         }
     }
+
+    check_motion_boxes(loaded, &grid, &touched)?;
 
     // Point loads: massless carriers that move with the body.
     let mut load_ids = Vec::new();

@@ -130,6 +130,79 @@ pub fn machine_memory_bytes() -> Option<u64> {
     kib.checked_mul(1024)
 }
 
+/// A `/proc/self/status` figure in bytes (`VmSize`, `VmData`).
+fn status_bytes(key: &str) -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with(key))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    kib.checked_mul(1024)
+}
+
+/// What this process may still allocate under a resource limit (bytes): `getrlimit`'s
+/// soft limit less what the process uses already by that measure.
+fn rlimit_room(resource: libc::__rlimit_resource_t, used: &str) -> Option<u64> {
+    let mut r = libc::rlimit {
+        rlim_cur: 0,
+        rlim_max: 0,
+    };
+    // SAFETY: getrlimit writes one `rlimit` through a valid pointer and reads nothing else.
+    if unsafe { libc::getrlimit(resource, &mut r) } != 0 || r.rlim_cur == libc::RLIM_INFINITY {
+        return None;
+    }
+    // rlim_t is 64 bits on 64-bit Linux, 32 on some other targets.
+    #[allow(clippy::unnecessary_cast)]
+    let limit = r.rlim_cur as u64;
+    Some(limit.saturating_sub(status_bytes(used).unwrap_or(0)))
+}
+
+/// The memory limit of this process's control group (v2 `memory.max`, v1
+/// `memory.limit_in_bytes`), as a cluster's batch system or a container sets it.
+fn cgroup_limit() -> Option<u64> {
+    let membership = std::fs::read_to_string("/proc/self/cgroup").unwrap_or_default();
+    let mut candidates = Vec::new();
+    for line in membership.lines() {
+        let mut parts = line.splitn(3, ':');
+        let (_, controllers, path) = (
+            parts.next(),
+            parts.next().unwrap_or(""),
+            parts.next().unwrap_or(""),
+        );
+        let path = path.trim_start_matches('/');
+        if controllers.is_empty() {
+            candidates.push(format!("/sys/fs/cgroup/{path}/memory.max"));
+        } else if controllers.split(',').any(|c| c == "memory") {
+            candidates.push(format!("/sys/fs/cgroup/memory/{path}/memory.limit_in_bytes"));
+        }
+    }
+    candidates.push("/sys/fs/cgroup/memory.max".into());
+    candidates.push("/sys/fs/cgroup/memory/memory.limit_in_bytes".into());
+    candidates
+        .iter()
+        .filter_map(|f| std::fs::read_to_string(f).ok()?.trim().parse::<u64>().ok())
+        .min()
+}
+
+/// The most memory a run of this process can have (bytes) and what sets it: the machine's
+/// memory, a control group's limit, or the address-space or data limit (`ulimit -v`,
+/// `ulimit -d`), whichever is smallest; `None` where none can be read.
+pub fn memory_limit() -> Option<(u64, &'static str)> {
+    [
+        (machine_memory_bytes(), "this machine's memory"),
+        (cgroup_limit(), "the control group's memory limit"),
+        (
+            rlimit_room(libc::RLIMIT_AS, "VmSize:"),
+            "the address-space limit (ulimit -v) left",
+        ),
+        (
+            rlimit_room(libc::RLIMIT_DATA, "VmData:"),
+            "the data-segment limit (ulimit -d) left",
+        ),
+    ]
+    .into_iter()
+    .filter_map(|(bytes, what)| Some((bytes?, what)))
+    .min_by_key(|&(bytes, _)| bytes)
+}
+
 /// Counts points and nodes in checked arithmetic: a count that overflows is an error, not
 /// a different problem.
 fn estimate(loaded: &LoadedScene, table: &[(String, MaterialModel)]) -> Result<Estimate, SceneError> {
@@ -227,6 +300,105 @@ fn polygon_fault(vertices: &[Vec<f64>]) -> Option<String> {
         }
     }
     None
+}
+
+/// The finest bisection of `kdmpm fos`, relative to the bracket's high end: about 24
+/// halvings of a bracket [0.5, 2].
+pub const MIN_FOS_TOLERANCE: f64 = 1e-7;
+
+/// Names that label output (columns of `history.csv`, rows of `curve.csv` and
+/// `stages.csv`) are unique within their list: two traced points called "top" would give
+/// two columns of one name.
+fn unique_names(s: &super::Scene) -> Result<(), (String, String)> {
+    let lists: [(&str, Vec<&str>); 5] = [
+        ("traced", s.traced.iter().map(|t| t.name.as_str()).collect()),
+        (
+            "point_loads",
+            s.point_loads.iter().map(|t| t.name.as_str()).collect(),
+        ),
+        ("tractions", s.tractions.iter().map(|t| t.name.as_str()).collect()),
+        ("motions", s.motions.iter().map(|t| t.name.as_str()).collect()),
+        ("stages", s.stages.iter().map(|t| t.name.as_str()).collect()),
+    ];
+    for (field, names) in lists {
+        for (i, name) in names.iter().enumerate() {
+            if let Some(j) = names[..i].iter().position(|m| m == name) {
+                return Err((
+                    format!("{field}[{i}].name"),
+                    format!("\"{name}\" is also the name of {field}[{j}]: each needs its own name"),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Each body's mass (ρ times its bounding box's volume, an upper bound) and the scene's
+/// weight are finite numbers: a density of 1e308 kg/m³ gives points whose mass sums to
+/// infinity, and a gravity of 1e308 m/s² forces that do, and the first step turns them
+/// into NaN.
+fn check_mass_finite(
+    loaded: &LoadedScene,
+    table: &[(String, MaterialModel)],
+    n: usize,
+) -> Result<(), SceneError> {
+    let s = &loaded.scene;
+    let mut total = 0.0f64;
+    for body in &s.bodies {
+        let Some((_, model)) = table.iter().find(|(name, _)| *name == body.material) else {
+            continue;
+        };
+        let (lo, hi) = super::region_bounds(&body.region, n);
+        let volume: f64 = (0..n).map(|a| (hi[a] - lo[a]).abs()).product();
+        let mass = model.density() * volume;
+        total += mass;
+        if !mass.is_finite() || !total.is_finite() {
+            return Err(loaded.invalid(
+                &format!("materials.{}.density", body.material),
+                format!(
+                    "{:e} kg/m³ over the bodies' {volume:e} m{} gives a mass that is not a finite number",
+                    model.density(),
+                    if n == 2 { "² (per metre)" } else { "³" }
+                ),
+            ));
+        }
+    }
+    if let Some(g) = &s.gravity {
+        let size = g.acceleration.iter().fold(0.0f64, |s, a| s.hypot(*a));
+        if !(total * size).is_finite() {
+            return Err(loaded.invalid(
+                "gravity.acceleration",
+                format!("|g| = {size:e} m/s² on {total:e} kg gives a weight that is not a finite number"),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Volumetric smoothing is for isochoric plastic flow (ψ = 0): it is refused on a material
+/// that dilates, in the scene or in a stage. The smoothed strain rate is not work-conjugate
+/// to the nodal forces, and on dilatant flow the mismatch feeds the kinetic energy: a
+/// smooth strip footing on c = 10 kPa, φ = ψ = 30° soil stops at K_E > 10 (docs/verification.md).
+/// Making the forces conjugate (the mean stress projected the same way) is stable there but
+/// spreads a shear band's dilation into the soil around it, which loses confinement: the
+/// limit pressure falls 12 % below Prandtl–Reissner and the footing then sinks without end.
+fn check_smoothing(loaded: &LoadedScene) -> Result<(), SceneError> {
+    let s = &loaded.scene;
+    let staged = s.stages.iter().flat_map(|st| st.materials.iter());
+    for (name, m) in s.materials.iter().chain(staged) {
+        let psi = m.dilatancy_angle();
+        if psi > 0.0 {
+            return Err(loaded.invalid(
+                "solver.volumetric_smoothing",
+                format!(
+                    "material \"{name}\" dilates (ψ = {psi}°): volumetric smoothing is for plastic \
+                     flow without volume change (ψ = 0) and makes a run with dilatant flow \
+                     unstable (docs/verification.md); set it false, or ψ = 0"
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// True for a finite number > 0 (NaN fails).
@@ -513,6 +685,12 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
                     finite(&format!("bodies[{b}].region.vertices[{k}]"), v, "m")?;
                 }
                 if let Some(z) = z {
+                    if n == 2 {
+                        return bad(
+                            &format!("bodies[{b}].region.z"),
+                            "a 2D polygon has no extent along z: remove z (it is for 3D scenes)".into(),
+                        );
+                    }
                     finite(&format!("bodies[{b}].region.z"), z, "m")?;
                 }
                 if let Some(rule) = polygon_fault(vertices) {
@@ -538,6 +716,10 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
             );
         }
     }
+    check_mass_finite(loaded, &table, n)?;
+    if s.solver.volumetric_smoothing {
+        check_smoothing(loaded)?;
+    }
     for (i, l) in s.point_loads.iter().enumerate() {
         len(&format!("point_loads[{i}].position"), l.position.len())?;
         len(&format!("point_loads[{i}].force"), l.force.len())?;
@@ -558,6 +740,7 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
         m.check(s.dimension as usize)
             .map_err(|(field, rule)| loaded.invalid(&format!("motions[{i}].{field}"), rule))?;
     }
+    unique_names(s).map_err(|(field, rule)| loaded.invalid(&field, rule))?;
     if let Some(r) = &s.strength_reduction {
         let ok = matches!(r.bracket[..], [lo, hi] if lo.is_finite() && hi.is_finite() && 0.0 < lo && lo < hi);
         if !ok {
@@ -566,8 +749,18 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
                 format!("needs two factors 0 < low < high, found {:?}", r.bracket),
             );
         }
-        if !(r.tolerance.is_finite() && r.tolerance > 0.0) {
-            return bad("strength_reduction.tolerance", "must be above 0".into());
+        let hi = r.bracket[1];
+        if !(r.tolerance.is_finite() && r.tolerance >= MIN_FOS_TOLERANCE * hi) {
+            return bad(
+                "strength_reduction.tolerance",
+                format!(
+                    "must be at least {MIN_FOS_TOLERANCE:e} of the bracket's high end ({:e}), found {:e}: \
+                     each halving of the bracket is a whole run, and a factor finer than that is \
+                     below what a trial resolves",
+                    MIN_FOS_TOLERANCE * hi,
+                    r.tolerance
+                ),
+            );
         }
         if !(r.failure_displacement.is_finite() && r.failure_displacement > 0.0) {
             return bad(
@@ -715,10 +908,27 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
         return bad(
             "solver.time_step",
             format!(
-                "Δt = {dt:.6e} s is Courant {:.3}; USL is unstable above Courant {USL_COURANT_LIMIT}                  (it diverges or never settles there, see docs/verification.md): use Courant({USL_COURANT_LIMIT})                  or less, or scheme Musl or Usf, which are stable up to 1",
+                "Δt = {dt:.6e} s is Courant {:.3}; USL is unstable above Courant {USL_COURANT_LIMIT} \
+                 (it diverges or never settles there, see docs/verification.md): use \
+                 Courant({USL_COURANT_LIMIT}) or less, or scheme Musl or Usf, which are stable up to 1",
                 dt / dt_crit
             ),
         );
+    }
+    // Explicit viscous damping scales a node's velocity by (1 − 2βΔt) each step: above
+    // βΔt = 1 that factor is below −1 and the velocities grow without bound.
+    if let crate::state::Damping::Viscous { beta } = s.solver.damping {
+        if beta * dt > 1.0 {
+            return bad(
+                "solver.damping",
+                format!(
+                    "viscous β = {beta:e} 1/s with Δt = {dt:.6e} s gives βΔt = {:.3e}: explicit viscous \
+                     damping is unstable above βΔt = 1; use β ≤ {:.6e} 1/s",
+                    beta * dt,
+                    1.0 / dt
+                ),
+            );
+        }
     }
     // A time step that rounds to zero or to a subnormal never advances the clock: the run
     // would write history rows for ever without getting anywhere.
@@ -835,12 +1045,12 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
         }
     }
     let estimate = estimate(loaded, &table)?;
-    if let Some(total) = machine_memory_bytes() {
+    if let Some((total, what)) = memory_limit() {
         if estimate.bytes > total {
             return bad(
                 "grid",
                 format!(
-                    "the scene needs up to {:.3} GB ({} points, {} nodes at most), more than this machine's {:.3} GB: \
+                    "the scene needs up to {:.3} GB ({} points, {} nodes at most), more than {what}, {:.3} GB: \
                      use larger cells, fewer points per cell or a smaller grid",
                     estimate.bytes as f64 / 1e9,
                     estimate.points,

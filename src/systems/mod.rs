@@ -531,6 +531,15 @@ pub fn check_names(names: &[String], settings: &Settings, needs: Needs) -> Resul
     if has("p2g") && has("p2g_force") {
         return Err("`p2g` already maps the internal force: drop `p2g_force`".into());
     }
+    // Without the remap a MUSL step is a USL step, which is unstable at the Courant
+    // numbers MUSL is allowed (the USL limit is checked against the scheme's name).
+    if settings.scheme == Scheme::Musl && !has("remap") {
+        return Err(
+            "scheme Musl needs `remap` (without it the step is USL, which is unstable above \
+             Courant 0.7): add `remap`, or set solver.scheme: Usl and keep its Courant limit"
+                .into(),
+        );
+    }
     if has("p2g_momentum") && !has("nodal_velocity") {
         return Err("`p2g_momentum` needs `nodal_velocity` to turn momentum into velocity".into());
     }
