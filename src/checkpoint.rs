@@ -8,8 +8,12 @@
 //! every point column of every archetype in row order; resuming builds the scene again
 //! (which spawns the same archetypes with the same row counts) and overwrites them.
 //!
-//! The file is binary, little-endian, written for the machine that reads it back (same
-//! build of kdmpm): numbers are stored as their bits, so nothing is rounded on the way.
+//! The file is binary, little-endian, written for the machine that reads it back: numbers
+//! are stored as their bits, so nothing is rounded on the way. It is refused, with the
+//! reason, unless it is whole and unchanged (a CRC-32 of every byte ends it), was written
+//! by this build of kdmpm (a fingerprint of its sources), carries the scene its hash says,
+//! continues the `history.csv` beside it (a CRC-32 of the rows it had written), and holds
+//! only ids within range: a damaged or foreign checkpoint is never resumed.
 
 use crate::columns::points_with;
 use crate::components::*;
@@ -26,7 +30,10 @@ use thiserror::Error;
 /// The first bytes of a checkpoint file.
 const MAGIC: &[u8; 8] = b"KDMPMCK\0";
 /// Format version; a file of another version is refused.
-const VERSION: u32 = 6;
+const VERSION: u32 = 7;
+/// The build that writes and reads checkpoints: the crate's version and a fingerprint of
+/// its sources (build.rs).
+pub const BUILD_ID: &str = concat!(env!("CARGO_PKG_VERSION"), "+", env!("KDMPM_SOURCE_HASH"));
 /// The file's name in an output directory.
 pub const FILE_NAME: &str = "checkpoint.kdc";
 
@@ -41,7 +48,8 @@ pub enum CheckpointError {
         /// The I/O error.
         source: std::io::Error,
     },
-    /// The file is not a checkpoint of this version, or is cut short.
+    /// The file is not a whole, unchanged checkpoint of this build, or does not fit its
+    /// scene.
     #[error("checkpoint {path}: {reason}")]
     Format {
         /// The file.
@@ -52,7 +60,7 @@ pub enum CheckpointError {
 }
 
 /// What a checkpoint holds besides the simulation's state.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct Header {
     /// The scene file the run was started from (for messages).
     pub scene_path: PathBuf,
@@ -60,6 +68,8 @@ pub struct Header {
     pub scene_text: String,
     /// Bytes of `history.csv` written up to this step.
     pub history_bytes: u64,
+    /// CRC-32 of those bytes: the history a resumed run continues must be this one.
+    pub history_crc: u32,
     /// Wall time of the stepping loop so far (s).
     pub wall_seconds: f64,
 }
@@ -69,10 +79,13 @@ pub fn encode<D: Dim>(sim: &Simulation<D>, header: &Header) -> Vec<u8> {
     let mut w = Writer(Vec::new());
     w.0.extend_from_slice(MAGIC);
     w.u32(VERSION);
+    w.str(BUILD_ID);
     w.u64(D::N as u64);
     w.str(&header.scene_path.to_string_lossy());
     w.str(&header.scene_text);
+    w.u32(crc32fast::hash(header.scene_text.as_bytes()));
     w.u64(header.history_bytes);
+    w.u32(header.history_crc);
     w.f64(header.wall_seconds);
     encode_state(&mut w, &sim.ctx.state);
     let archs: Vec<&Archetype> = points_with::<Position<D::Vec>>(&sim.ctx.world).collect();
@@ -100,6 +113,8 @@ pub fn encode<D: Dim>(sim: &Simulation<D>, header: &Header) -> Vec<u8> {
         }
         point_components!(D, save);
     }
+    let crc = crc32fast::hash(&w.0);
+    w.u32(crc);
     w.0
 }
 
@@ -162,9 +177,10 @@ pub fn restore<D: Dim>(
             return Err(r.fault(format!("column {name} is saved but the scene's points lack it")));
         }
     }
-    if r.at != bytes.len() {
+    if r.at != r.bytes.len() {
         return Err(r.fault("bytes left after the last column".into()));
     }
+    check_ids(sim, &state).map_err(|reason| r.fault(reason))?;
     sim.ctx.state = state;
     // Nodes are zero and no box is active right after building, as after a grid reset.
     sim.ctx.state.active_nodes = NodeBox::default();
@@ -173,6 +189,74 @@ pub fn restore<D: Dim>(
         t.entity = t.current_entity(&sim.ctx.world);
     }
     Ok(header)
+}
+
+/// The ids and counts the restored columns and state hold are within the scene's ranges:
+/// material ids name one of its materials, point ids are distinct and below the point
+/// count, the motions, stages and loads under control are the scene's. Whole files of
+/// this build never fail this; it guards what the checksum cannot (a file of another
+/// scene made to fit).
+fn check_ids<D: Dim>(sim: &Simulation<D>, state: &SolverState) -> Result<(), String> {
+    let world = &sim.ctx.world;
+    let materials = sim.ctx.materials.len();
+    for arch in points_with::<MaterialId>(world) {
+        if let Some(m) = crate::columns::col::<MaterialId>(arch)
+            .iter()
+            .find(|m| m.0 as usize >= materials)
+        {
+            return Err(format!(
+                "a point has material id {}, but the scene has {materials} materials",
+                m.0
+            ));
+        }
+    }
+    let count = sim.point_count();
+    let mut seen = vec![false; count];
+    for arch in points_with::<PointId>(world) {
+        for id in crate::columns::col::<PointId>(arch).iter() {
+            match seen.get_mut(id.0 as usize) {
+                None => {
+                    return Err(format!(
+                        "a point has id {}, but the scene has {count} points",
+                        id.0
+                    ))
+                }
+                Some(true) => return Err(format!("two points have id {}", id.0)),
+                Some(s) => *s = true,
+            }
+        }
+    }
+    let settings = &sim.ctx.settings;
+    if state.drives.len() != settings.motions.len() {
+        return Err(format!(
+            "{} motions saved, the scene has {}",
+            state.drives.len(),
+            settings.motions.len()
+        ));
+    }
+    if state.stage >= settings.stages.len().max(1) || state.stages.len() > settings.stages.len() {
+        return Err(format!(
+            "stage {} saved, the scene has {} stages",
+            state.stage,
+            settings.stages.len()
+        ));
+    }
+    if state.load_increments.len() > settings.load_steps.len()
+        || state
+            .load_increments
+            .iter()
+            .zip(&settings.load_steps)
+            .any(|(&k, l)| k > l.increments)
+    {
+        return Err("the loads' increments saved do not fit the scene's loads".into());
+    }
+    if !state.static_window_snapshot.is_empty() && state.static_window_snapshot.len() != count {
+        return Err("the static check's saved positions do not fit the scene's points".into());
+    }
+    if !(state.dt.is_finite() && state.dt > 0.0 && state.time.is_finite()) {
+        return Err("the saved time or time step is not a finite number".into());
+    }
+    Ok(())
 }
 
 /// The bytes of a column.
@@ -240,6 +324,11 @@ fn encode_state(w: &mut Writer, s: &SolverState) {
     }
     w.u64(s.load_increments.len() as u64);
     s.load_increments.iter().for_each(|&k| w.u64(k as u64));
+    w.u8(s.force_reference.is_some() as u8);
+    s.force_reference
+        .unwrap_or_default()
+        .iter()
+        .for_each(|&f| w.f64(f));
 }
 
 fn decode_state(r: &mut Reader) -> Result<SolverState, CheckpointError> {
@@ -308,6 +397,9 @@ fn decode_state(r: &mut Reader) -> Result<SolverState, CheckpointError> {
     for _ in 0..r.u64()? {
         s.load_increments.push(r.u64()? as u32);
     }
+    let some = r.u8()? == 1;
+    let reference = [r.f64()?, r.f64()?];
+    s.force_reference = some.then_some(reference);
     Ok(s)
 }
 
@@ -384,21 +476,51 @@ impl<'a> Reader<'a> {
         let b = self.take(n)?;
         String::from_utf8(b.to_vec()).map_err(|_| self.fault("a text field is not UTF-8".into()))
     }
+    fn u32(&mut self) -> Result<u32, CheckpointError> {
+        Ok(u32::from_le_bytes(self.take(4)?.try_into().expect("4 bytes")))
+    }
     fn header(&mut self) -> Result<Header, CheckpointError> {
         if self.take(MAGIC.len()).ok() != Some(MAGIC.as_slice()) {
             return Err(self.fault("not a kdmpm checkpoint".into()));
         }
-        let version = u32::from_le_bytes(self.take(4)?.try_into().expect("4 bytes"));
+        let version = self.u32()?;
         if version != VERSION {
             return Err(self.fault(format!(
-                "format version {version}; this kdmpm reads version {VERSION}"
+                "format version {version}; this kdmpm reads version {VERSION}: finish the run \
+                 with the kdmpm that wrote it, or start it again"
+            )));
+        }
+        // The checksum ends the file and covers every byte before it: the rest is read
+        // only from a file that is whole and unchanged.
+        let body = self.bytes.len().checked_sub(4).filter(|&b| b >= self.at);
+        let body = body.ok_or_else(|| self.fault("the file is cut short".into()))?;
+        let saved = u32::from_le_bytes(self.bytes[body..].try_into().expect("4 bytes"));
+        if crc32fast::hash(&self.bytes[..body]) != saved {
+            return Err(self.fault(
+                "its checksum does not match: the file was damaged or changed after it was \
+                 written, so it is not resumed"
+                    .into(),
+            ));
+        }
+        self.bytes = &self.bytes[..body];
+        let build = self.str()?;
+        if build != BUILD_ID {
+            return Err(self.fault(format!(
+                "written by kdmpm build {build}, this is {BUILD_ID}: a run resumes bit for bit only \
+                 with the build that started it"
             )));
         }
         self.dimension = self.u64()?;
+        let scene_path = PathBuf::from(self.str()?);
+        let scene_text = self.str()?;
+        if self.u32()? != crc32fast::hash(scene_text.as_bytes()) {
+            return Err(self.fault("the scene it holds does not match the scene's hash".into()));
+        }
         Ok(Header {
-            scene_path: PathBuf::from(self.str()?),
-            scene_text: self.str()?,
+            scene_path,
+            scene_text,
             history_bytes: self.u64()?,
+            history_crc: self.u32()?,
             wall_seconds: self.f64()?,
         })
     }

@@ -80,19 +80,41 @@ pub enum FosError {
     /// The bracket does not hold the factor of safety: the trials are in their folders.
     #[error("{0}")]
     NotBracketed(String),
+    /// Stopped by a signal ([`STOP`]) during the trial at this factor.
+    #[error("interrupted during the trial at F = {0}: the trials so far are in their folders")]
+    Interrupted(f64),
+    /// The output directory cannot be used (exit 2).
+    #[error("{0}")]
+    OutputDir(String),
     /// The output could not be written.
     #[error("cannot write into {0}: {1}")]
     Output(PathBuf, std::io::Error),
 }
 
+/// Set (by a Ctrl-C or SIGTERM handler) to stop the analysis after the step under way of
+/// the trial under way.
+pub static STOP: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
 /// The scene with the strength of every material that has one divided by `factor`
-/// ([`crate::materials::SceneMaterial::reduce_strength`]).
+/// ([`crate::materials::SceneMaterial::reduce_strength`]), in the scene and in every stage
+/// that sets a material (a geostatic stage, then the soil's strength).
 pub fn reduced(loaded: &LoadedScene, factor: f64) -> LoadedScene {
     let mut l = loaded.clone();
-    for m in l.scene.materials.values_mut() {
+    let staged = l.scene.stages.iter_mut().flat_map(|st| st.materials.values_mut());
+    for m in l.scene.materials.values_mut().chain(staged) {
         m.reduce_strength(factor);
     }
     l
+}
+
+/// True when some material of the scene or of a stage has a strength to reduce.
+fn has_strength(loaded: &LoadedScene) -> bool {
+    let s = &loaded.scene;
+    let staged = s.stages.iter().flat_map(|st| st.materials.values());
+    s.materials
+        .values()
+        .chain(staged)
+        .any(|m| m.clone().reduce_strength(1.0))
 }
 
 /// Runs the analysis of `loaded` into `out`; `report` sees each trial as it ends.
@@ -108,24 +130,26 @@ pub fn strength_reduction(
             loaded.path.display()
         ))
     })?;
-    if !loaded
-        .scene
-        .materials
-        .values()
-        .any(|m| m.clone().reduce_strength(1.0))
-    {
+    // The scene as given, bracket and tolerance included, before any trial reduces it.
+    crate::scene::check(loaded)?;
+    if !has_strength(loaded) {
         return Err(FosError::NotAnAnalysis(format!(
-            "{}: no material with a strength (such as MohrCoulomb): there is no strength \
-             to reduce",
+            "{}: no material with a strength (such as MohrCoulomb), in the scene or its \
+             stages: there is no strength to reduce",
             loaded.path.display()
         )));
     }
     let start = Instant::now();
     let io = |e: std::io::Error| FosError::Output(out.to_path_buf(), e);
-    std::fs::create_dir_all(out).map_err(io)?;
+    // The analysis's own directory, held for its whole run: one that cannot be made (a
+    // file of that name, no permission) or that another run holds is bad input.
+    let _dir = OutputDir::claim(out).map_err(|e| FosError::OutputDir(e.to_string()))?;
     let mut trials: Vec<Trial> = Vec::new();
     let mut trial = |f: f64| -> Result<Trial, FosError> {
         let t = run_trial(loaded, &spec, f, out)?;
+        if t.outcome == Outcome::Interrupted {
+            return Err(FosError::Interrupted(f));
+        }
         report(&t);
         trials.push(t.clone());
         Ok(t)
@@ -145,6 +169,10 @@ pub fn strength_reduction(
     }
     while hi - lo > spec.tolerance {
         let mid = 0.5 * (lo + hi);
+        if mid <= lo || mid >= hi {
+            // No float between the ends: the bracket is as narrow as f64 allows.
+            break;
+        }
         if trial(mid)?.failed {
             hi = mid;
         } else {
@@ -166,9 +194,10 @@ pub fn strength_reduction(
     Ok(fos)
 }
 
-/// The folder of the trial at `factor`, relative to the analysis's.
+/// The folder of the trial at `factor`, relative to the analysis's: the factor's shortest
+/// exact decimal, so that two trials never share a folder however fine the bisection.
 fn trial_dir(factor: f64) -> String {
-    format!("trials/F{factor:.4}")
+    format!("trials/F{factor}")
 }
 
 /// Runs the scene at `factor` into its trial folder, stopping early once a point moved
@@ -213,6 +242,9 @@ fn trial_run<D: Dim>(
     let recorder = Recorder::attach(sim, dir, output.history_every, output.snapshots, None)?;
     let (every, limit) = (spec.check_every, spec.failure_displacement);
     let result = sim.run_with(|s| {
+        if s.ctx.state.stop.is_none() && STOP.load(std::sync::atomic::Ordering::SeqCst) {
+            s.ctx.state.stop = Some(StopReason::Interrupted);
+        }
         let st = &s.ctx.state;
         if st.stop.is_none() && st.step.is_multiple_of(every) {
             let (u, _) = max_displacements(s).unwrap_or_default();
@@ -281,7 +313,7 @@ fn plot(fos: &FosReport, rows: &[&Trial]) -> String {
                 .map(|t| t.max_displacement)
                 .filter(|u| *u > 0.0)
                 .fold(u_hi, f64::min);
-            let (y0, y1) = (u_lo / 2.0, u_hi * 2.0);
+            let (y0, y1) = crate::output::plots::log_range([u_lo, u_hi].into_iter());
             let pad = 0.05 * (f1 - f0).max(1e-3);
             let mut c = ChartBuilder::on(&root)
                 .caption(
@@ -338,4 +370,35 @@ fn plot(fos: &FosReport, rows: &[&Trial]) -> String {
         let _ = draw();
     }
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Bisecting [1, 2] to the finest tolerance allowed (1e-7 × 2) gives 24 factors, each
+    /// its own folder; with four decimals once 22 trials shared 15 folders, and `mechanism`
+    /// named a trial that stood.
+    #[test]
+    fn every_trial_of_the_finest_bisection_has_its_own_folder() {
+        let (mut lo, mut hi) = (1.0f64, 2.0f64);
+        let mut dirs = vec![trial_dir(lo), trial_dir(hi)];
+        let mut k = 0;
+        while hi - lo > 2e-7 {
+            let mid = 0.5 * (lo + hi);
+            dirs.push(trial_dir(mid));
+            // Alternate the sides, as a bisection that finds the factor in the middle does.
+            if k % 2 == 0 {
+                hi = mid
+            } else {
+                lo = mid
+            }
+            k += 1;
+        }
+        let mut unique = dirs.clone();
+        unique.sort();
+        unique.dedup();
+        assert_eq!(unique.len(), dirs.len(), "{dirs:?}");
+        assert_eq!(dirs.len(), 25);
+    }
 }

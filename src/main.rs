@@ -339,8 +339,7 @@ fn run(
     let header = checkpoint::Header {
         scene_path: path.to_path_buf(),
         scene_text: loaded.text.clone(),
-        history_bytes: 0,
-        wall_seconds: 0.0,
+        ..checkpoint::Header::default()
     };
     let options = Options {
         profile,
@@ -399,8 +398,7 @@ fn run_ranks<D: Dim>(
         let header = checkpoint::Header {
             scene_path: path.to_path_buf(),
             scene_text: loaded.text.clone(),
-            history_bytes: 0,
-            wall_seconds: 0.0,
+            ..checkpoint::Header::default()
         };
         return drive(sim, loaded, &dir, None, header, options);
     }
@@ -470,8 +468,8 @@ fn resume(dir_path: &Path, profile: bool, quiet: bool) -> ExitCode {
         if let Err(e) = checkpoint::restore(s, &bytes, &file) {
             return fail(&e);
         }
-        let bytes = Some(header.history_bytes);
-        drive(s, &loaded, &dir, bytes, header, options)
+        let mark = Some((header.history_bytes, header.history_crc));
+        drive(s, &loaded, &dir, mark, header, options)
     })
 }
 
@@ -497,13 +495,13 @@ fn drive<D: Dim>(
     sim: &mut Simulation<D>,
     loaded: &LoadedScene,
     dir: &OutputDir,
-    history_bytes: Option<u64>,
+    history: Option<(u64, u32)>,
     mut header: checkpoint::Header,
     options: Options,
 ) -> ExitCode {
     let scene = &header.scene_path.clone();
     let output = &loaded.scene.output;
-    let recorder = match Recorder::attach(sim, dir, output.history_every, output.snapshots, history_bytes) {
+    let recorder = match Recorder::attach(sim, dir, output.history_every, output.snapshots, history) {
         Ok(r) => r,
         Err(e) => {
             eprintln!("error: cannot write into {}: {e}", dir.path().display());
@@ -543,6 +541,7 @@ fn drive<D: Dim>(
         let mut rows = kdmpm::output::history::lock(&rows);
         rows.flush()?;
         header.history_bytes = rows.committed();
+        header.history_crc = rows.committed_crc();
         header.wall_seconds = before + start.elapsed().as_secs_f64();
         let bytes = checkpoint::encode(sim, header);
         dir.write_atomic(checkpoint::FILE_NAME, |out| out.write_all(&bytes))
@@ -624,6 +623,8 @@ fn run_fos(path: &Path, out: Option<PathBuf>, overrides: &[String], quiet: bool)
         }
     };
     let out = out.unwrap_or_else(|| default_out(path, "fos-", "scene"));
+    // Ctrl-C or SIGTERM ends the trial under way at its next step, then the analysis.
+    let _ = ctrlc::set_handler(|| kdmpm::fos::STOP.store(true, Ordering::SeqCst));
     let result = kdmpm::fos::strength_reduction(&loaded, &out, |t| {
         if !quiet {
             eprintln!(
@@ -653,7 +654,10 @@ fn run_fos(path: &Path, out: Option<PathBuf>, overrides: &[String], quiet: bool)
         Err(e) => {
             eprintln!("error: {e}");
             ExitCode::from(match e {
-                kdmpm::fos::FosError::Scene(_) | kdmpm::fos::FosError::NotAnAnalysis(_) => BAD_INPUT,
+                kdmpm::fos::FosError::Scene(_)
+                | kdmpm::fos::FosError::NotAnAnalysis(_)
+                | kdmpm::fos::FosError::OutputDir(_) => BAD_INPUT,
+                kdmpm::fos::FosError::Interrupted(_) => INTERRUPTED_EXIT,
                 _ => RUN_FAILED,
             })
         }
@@ -729,21 +733,30 @@ fn run_study(
         }
         r
     };
+    // Ctrl-C or SIGTERM: the run under way gets the signal and is waited for.
+    let _ = ctrlc::set_handler(|| study::STOP.store(true, Ordering::SeqCst));
+    let failed = |e: study::StudyError| {
+        progress.done();
+        eprintln!("error: {e}");
+        ExitCode::from(match e {
+            study::StudyError::Interrupted(_) => INTERRUPTED_EXIT,
+            _ => RUN_FAILED,
+        })
+    };
     let reference = match study.reference.as_ref().map(&mut run).transpose() {
         Ok(r) => r,
-        Err(e) => {
-            eprintln!("error: {e}");
-            return ExitCode::from(RUN_FAILED);
-        }
+        Err(e) => return failed(e),
     };
+    if let Some(r) = &reference {
+        if let Err(e) = study::check_reference(r) {
+            return failed(e);
+        }
+    }
     let mut finished = Vec::with_capacity(study.runs.len());
     for planned in &study.runs {
         match run(planned) {
             Ok(f) => finished.push(f),
-            Err(e) => {
-                eprintln!("error: {e}");
-                return ExitCode::from(RUN_FAILED);
-            }
+            Err(e) => return failed(e),
         }
     }
     progress.done();

@@ -145,7 +145,7 @@ impl<D: Dim> Simulation<D> {
     }
 
     /// The first non-finite value of the point state that output would write (position,
-    /// displacement, stress, volume, plastic strain), as "stress of point 17".
+    /// velocity, displacement, stress, volume, plastic strain), as "stress of point 17".
     pub fn first_non_finite(&self) -> Option<String> {
         let w = &self.ctx.world;
         let finite = |v: &[f64]| v.iter().all(|c| c.is_finite());
@@ -157,6 +157,12 @@ impl<D: Dim> Simulation<D> {
                 .position(|x| !finite(&D::vec_to3(x.0)))
             {
                 return bad("position", r);
+            }
+            if let Some(r) = col::<Velocity<D::Vec>>(arch)
+                .iter()
+                .position(|v| !finite(&D::vec_to3(v.0)))
+            {
+                return bad("velocity", r);
             }
             if let Some(u) = arch.get::<&Displacement<D::Vec>>() {
                 if let Some(r) = u.iter().position(|u| !finite(&D::vec_to3(u.0))) {

@@ -51,6 +51,36 @@ const SEEDS: &[&str] = &[
              schedule: ["grid_reset", "p2g_momentum", "nodal_velocity", "velocity_gradient", "volumetric_smoothing", "stress_update", "volume_update", "p2g_force", "gravity", "boundary", "integrate", "g2p", "peak_watch", "move_points", "convergence"]),
     output: (surface_angle: true, displacements: false),
 )"#,
+    r#"Scene(
+    dimension: 2,
+    grid: (origin: [0.0, 0.0], cell_size: 0.5, cells: [8, 6]),
+    shape: QuadraticBSpline,
+    materials: { "clay": MohrCoulomb(density: 2000.0, youngs_modulus: 1.0e7, poisson_ratio: 0.3, cohesion: 1.0e4, friction_angle: 0.0) },
+    bodies: [(material: "clay", region: Box(min: [0.0, 0.0], max: [4.0, 2.0]), points_per_cell: [2, 2])],
+    boundaries: [(face: XMin, condition: Roller), (face: XMax, condition: Roller), (face: YMin, condition: Fixed)],
+    gravity: (acceleration: [0.0, -9.81]),
+    motions: [(name: "footing", min: [0.0, 2.0], max: [1.0, 2.5], velocity: [None, Some(-0.01)], travel: 0.02, increment: 0.01, area: 1.0)],
+    stages: [(name: "geostatic"), (name: "strong", materials: {"clay": MohrCoulomb(density: 2000.0, youngs_modulus: 1.0e7, poisson_ratio: 0.3, cohesion: 2.0e4, friction_angle: 0.0)}, reset_displacements: true)],
+    strength_reduction: (bracket: [0.5, 2.0], tolerance: 0.1, failure_displacement: 0.1),
+    traced: [(name: "corner", position: [0.1, 1.9])],
+    solver: (time_step: Courant(0.5), max_steps: 30),
+)"#,
+    r#"Scene(
+    dimension: 2,
+    grid: (origin: [0.0, 0.0], cell_size: 0.5, cells: [8, 6]),
+    materials: { "block": LinearElastic(density: 2000.0, youngs_modulus: 1.0e7, poisson_ratio: 0.3), "soft": LinearElastic(density: 1000.0, youngs_modulus: 1.0e6, poisson_ratio: 0.3) },
+    bodies: [(material: "block", region: Box(min: [0.0, 0.0], max: [4.0, 2.0]), points_per_cell: [2, 2])],
+    boundaries: [(face: YMin, condition: Fixed)],
+    gravity: (acceleration: [0.0, -9.81], ramp_time: 0.01),
+    tractions: [(name: "strip", surface: YMax, min: [0.0, 1.5], max: [1.0, 2.0], traction: [0.0, -1.0e4], increments: 3),
+                (name: "side", surface: XMax, min: [3.5, 0.0], max: [4.0, 2.0], traction: [-1.0e3, 0.0])],
+    point_loads: [(name: "P", position: [2.1, 1.9], force: [0.0, -100.0])],
+    stages: [(name: "one"), (name: "two", tractions: {"side": [-2.0e3, 0.0]}, point_loads: {"P": [0.0, -200.0]},
+              gravity: (acceleration: [0.0, 0.0]), boundaries: [(face: YMin, condition: Fixed), (face: XMin, condition: Roller)],
+              materials: {"block": LinearElastic(density: 2000.0, youngs_modulus: 5.0e6, poisson_ratio: 0.3)})],
+    traced: [(name: "top", position: [0.1, 1.9]), (name: "side", position: [3.9, 1.0])],
+    solver: (time_step: Courant(0.5), max_steps: 40, checkpoint_every: Steps(5)),
+)"#,
 ];
 
 /// Values that broke or nearly broke earlier versions.
@@ -85,6 +115,15 @@ const EXTREMES: &[&str] = &[
     "\"soil\"",
     "None",
     "Some(1.0)",
+    "\"top\"",
+    "[0.5]",
+    "[0.0, 2.0]",
+    "[2.0, 1.0]",
+    "[1.0, 4294967295]",
+    "4294967295",
+    "(acceleration: [0.0, 0.0])",
+    "Viscous(beta: 1e308)",
+    "Usl",
 ];
 
 /// Paths a user may `--set`, valid or not.
@@ -114,6 +153,25 @@ const PATHS: &[&str] = &[
     "traced[0].position",
     "point_loads[0].force",
     "output.history_every",
+    "stages[1].materials.clay.density",
+    "stages[1].materials.block.density",
+    "stages[1].gravity",
+    "stages[1].name",
+    "stages[0].reset_displacements",
+    "motions[0].min",
+    "motions[0].max",
+    "motions[0].increment",
+    "motions[0].travel",
+    "motions[1]",
+    "tractions[0].increments",
+    "tractions[0].min",
+    "tractions[1].name",
+    "strength_reduction.bracket",
+    "strength_reduction.tolerance",
+    "strength_reduction.failure_displacement",
+    "traced[1].name",
+    "solver.damping",
+    "solver.scheme",
     "nothing[0]x",
     "solver..tolerance",
     "[3]",
@@ -222,6 +280,15 @@ fn exercise(text: &str, sets: &[String]) -> Result<(), TestCaseError> {
         Err(e) => return placed(&e),
     };
     BUILT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    // Strength reduction divides the strengths of the scene and of its stages: every
+    // trial's scene is checked again (a factor that breaks a material is a placed error).
+    if loaded.scene.strength_reduction.is_some() {
+        for factor in [0.5, 1.7] {
+            if let Err(e) = check(&kdmpm::fos::reduced(&loaded, factor)) {
+                placed(&e)?;
+            }
+        }
+    }
     with_simulation!(&mut sim, s => {
         for _ in 0..20 {
             if s.ctx.state.stop.is_some() || s.step().is_err() {
@@ -284,4 +351,37 @@ fn every_seed_scene_is_valid() {
         let loaded = LoadedScene::from_text(Path::new("seed.ron"), s, &[]).unwrap();
         build(&loaded).unwrap_or_else(|e| panic!("{e}\n{s}"));
     }
+}
+
+/// Study files, mutated like scenes: parsing, checking and planning every run ends in a
+/// study or a placed error, never a panic.
+#[test]
+fn mutated_study_files_end_in_ok_or_a_placed_error_never_a_panic() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("studies");
+    let seeds: Vec<String> = ["column.ron", "bar.ron"]
+        .iter()
+        .map(|f| std::fs::read_to_string(dir.join(f)).unwrap())
+        .collect();
+    let config = Config {
+        cases: 400,
+        failure_persistence: None,
+        ..Config::default()
+    };
+    let rng = TestRng::from_seed(RngAlgorithm::ChaCha, &[11; 32]);
+    let mut runner = TestRunner::new_with_rng(config, rng);
+    let text_only = prop_oneof![
+        4 => (0..200usize, 0..EXTREMES.len()).prop_map(|(k, v)| Mutation::Number(k, v)),
+        1 => (0.0..1.0f64, 1..8usize).prop_map(|(f, n)| Mutation::Cut(f, n)),
+        1 => (0.0..1.0f64, prop::sample::select(vec!['(', ')', '[', ']', '"', ',', ':'])).prop_map(|(f, c)| Mutation::Insert(f, c)),
+    ];
+    let strategy = (0..seeds.len(), prop::collection::vec(text_only, 1..3));
+    runner
+        .run(&strategy, |(seed, ms)| {
+            let (text, _) = mutate(&seeds[seed], &ms);
+            match kdmpm::study::Study::from_text(&dir.join("fuzz.ron"), &text) {
+                Ok(_) => Ok(()),
+                Err(e) => placed(&e),
+            }
+        })
+        .unwrap();
 }

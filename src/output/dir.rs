@@ -76,6 +76,9 @@ impl OutputDir {
         let _ = lock.set_len(0);
         let _ = lock.seek(SeekFrom::Start(0));
         let _ = writeln!(lock, "process {}", std::process::id());
+        // Files a killed process was writing (`write_atomic`'s temporaries): no one else
+        // writes here while the lock is held, so every one of them is dead.
+        remove_partials(path).map_err(create)?;
         Ok(OutputDir {
             path: path.to_path_buf(),
             _lock: lock,
@@ -102,6 +105,22 @@ impl OutputDir {
     ) -> std::io::Result<()> {
         write_atomic(&self.file(name), write)
     }
+}
+
+/// Removes the `*.partial-<pid>` temporaries of [`write_atomic`] in `dir` and its
+/// `snapshots/` folder.
+fn remove_partials(dir: &Path) -> std::io::Result<()> {
+    for folder in [dir.to_path_buf(), dir.join("snapshots")] {
+        let Ok(entries) = std::fs::read_dir(&folder) else {
+            continue;
+        };
+        for e in entries.flatten() {
+            if e.file_name().to_string_lossy().contains(".partial-") && e.path().is_file() {
+                std::fs::remove_file(e.path())?;
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Writes `path` whole through a temporary file (see [`OutputDir::write_atomic`]).
@@ -134,6 +153,8 @@ pub struct RowFile {
     file: File,
     buffer: Vec<u8>,
     committed: u64,
+    /// CRC-32 of the committed bytes, which a checkpoint records ([`RowFile::resume`]).
+    crc: crc32fast::Hasher,
     flushed: std::time::Instant,
 }
 
@@ -143,23 +164,26 @@ const ROW_BUFFER: usize = 64 * 1024;
 impl RowFile {
     /// Creates (or empties) `path`.
     pub fn create(path: &Path) -> std::io::Result<Self> {
-        Ok(Self::at(File::create(path)?, 0))
+        Ok(Self::at(File::create(path)?, 0, crc32fast::Hasher::new()))
     }
 
-    /// Rows appended to `file`, which holds `committed` bytes of whole rows.
-    fn at(file: File, committed: u64) -> Self {
+    /// Rows appended to `file`, which holds `committed` bytes of whole rows whose CRC so
+    /// far is `crc`.
+    fn at(file: File, committed: u64, crc: crc32fast::Hasher) -> Self {
         RowFile {
             file,
             buffer: Vec::with_capacity(ROW_BUFFER),
             flushed: std::time::Instant::now(),
             committed,
+            crc,
         }
     }
 
-    /// Opens `path` to continue after its first `bytes` bytes; what follows them (rows of
-    /// steps after a checkpoint) is cut off.
-    pub fn resume(path: &Path, bytes: u64) -> std::io::Result<Self> {
-        let mut file = OpenOptions::new().write(true).open(path)?;
+    /// Opens `path` to continue after its first `bytes` bytes, whose CRC-32 must be `crc`
+    /// (the rows the checkpoint's run wrote, not another run's); what follows them (rows
+    /// of steps after a checkpoint) is cut off. Nothing is cut from a file that fails.
+    pub fn resume(path: &Path, bytes: u64, crc: u32) -> std::io::Result<Self> {
+        let mut file = OpenOptions::new().read(true).write(true).open(path)?;
         if file.metadata()?.len() < bytes {
             return Err(std::io::Error::new(
                 std::io::ErrorKind::UnexpectedEof,
@@ -169,9 +193,29 @@ impl RowFile {
                 ),
             ));
         }
+        let mut hasher = crc32fast::Hasher::new();
+        let mut left = bytes;
+        let mut chunk = vec![0u8; 1 << 16];
+        while left > 0 {
+            let n = left.min(chunk.len() as u64) as usize;
+            file.read_exact(&mut chunk[..n])?;
+            hasher.update(&chunk[..n]);
+            left -= n as u64;
+        }
+        if hasher.clone().finalize() != crc {
+            return Err(std::io::Error::new(
+                std::io::ErrorKind::InvalidData,
+                format!(
+                    "{} is not the history this checkpoint continues (its first {bytes} bytes \
+                     differ from the ones the checkpoint's run wrote): the directory holds \
+                     another run's files",
+                    path.display()
+                ),
+            ));
+        }
         file.set_len(bytes)?;
         file.seek(SeekFrom::Start(bytes))?;
-        Ok(Self::at(file, bytes))
+        Ok(Self::at(file, bytes, hasher))
     }
 
     /// Adds one row (its text must end with a newline).
@@ -196,6 +240,7 @@ impl RowFile {
             return Err(e);
         }
         self.committed += self.buffer.len() as u64;
+        self.crc.update(&self.buffer);
         self.buffer.clear();
         self.flushed = std::time::Instant::now();
         Ok(())
@@ -204,5 +249,10 @@ impl RowFile {
     /// Bytes on disk (whole rows).
     pub fn committed(&self) -> u64 {
         self.committed
+    }
+
+    /// CRC-32 of the bytes on disk.
+    pub fn committed_crc(&self) -> u32 {
+        self.crc.clone().finalize()
     }
 }

@@ -86,8 +86,13 @@ impl<D: Dim> History<D> {
     }
 
     /// Continues `path` after its first `bytes` bytes (a checkpoint's length of it).
-    pub fn resume(path: &Path, bytes: u64, every: u64, traced: &[TracedPoint]) -> std::io::Result<Self> {
-        Ok(Self::with(RowFile::resume(path, bytes)?, every, traced))
+    pub fn resume(
+        path: &Path,
+        mark: (u64, u32),
+        every: u64,
+        traced: &[TracedPoint],
+    ) -> std::io::Result<Self> {
+        Ok(Self::with(RowFile::resume(path, mark.0, mark.1)?, every, traced))
     }
 
     fn with(rows: RowFile, every: u64, traced: &[TracedPoint]) -> Self {

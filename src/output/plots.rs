@@ -229,17 +229,25 @@ fn curve_plot(names: &[String], u: &[f64], y: &[f64], label: &str) -> String {
     })
 }
 
-/// The lower and upper ends of a log axis through the positive finite values of `v`.
-fn log_range(v: impl Iterator<Item = f64>) -> (f64, f64) {
+/// The lower and upper ends of a log axis through the positive finite values of `v`, with
+/// a factor of 2 of room each side. The ends stay normal, finite numbers (a value near
+/// f64::MAX doubled would be infinite, and a log axis to infinity is never drawn), and the
+/// axis spans at most [`MAX_DECADES`] decades below its top: smaller values sit on its
+/// floor.
+pub(crate) fn log_range(v: impl Iterator<Item = f64>) -> (f64, f64) {
     let (lo, hi) = v
         .filter(|x| x.is_finite() && *x > 0.0)
         .fold((f64::INFINITY, 0.0f64), |(a, b), x| (a.min(x), b.max(x)));
-    if lo.is_finite() {
-        (lo / 2.0, hi * 2.0)
-    } else {
-        (1e-12, 1.0)
+    if !lo.is_finite() {
+        return (1e-12, 1.0);
     }
+    let top = if hi < f64::MAX / 2.0 { hi * 2.0 } else { f64::MAX };
+    let floor = (top * 10f64.powi(-MAX_DECADES)).max(f64::MIN_POSITIVE);
+    ((lo / 2.0).max(floor), top)
 }
+
+/// The most decades a log axis spans.
+const MAX_DECADES: i32 = 40;
 
 fn time_range(t: &[f64]) -> (f64, f64) {
     let hi = t.iter().copied().filter(|x| x.is_finite()).fold(0.0f64, f64::max);

@@ -87,6 +87,40 @@ pub fn write_final_points<D: Dim>(sim: &Simulation<D>, dir: &Path) -> std::io::R
     }
 }
 
+/// Removes what an earlier run left in `dir` as its results (summary, points, curve,
+/// stages, plots, snapshot series), so that after a crash of the new run nothing of the old
+/// one sits beside the new history.csv looking current.
+fn clear_earlier_results(dir: &OutputDir) -> std::io::Result<()> {
+    let fixed = [
+        "summary.json",
+        "points.vtu",
+        "points.pvtu",
+        CURVE,
+        STAGES,
+        crate::output::plots::CURVE_PLOT,
+    ];
+    let names = fixed.iter().chain(&crate::output::plots::FILES);
+    for name in names {
+        remove_if_there(&dir.file(name))?;
+    }
+    for e in std::fs::read_dir(dir.path())?.flatten() {
+        let name = e.file_name().to_string_lossy().into_owned();
+        // Over MPI, each rank's points.
+        if name.starts_with("points_") && name.ends_with(".vtu") {
+            remove_if_there(&e.path())?;
+        }
+    }
+    crate::output::snapshots::clear(dir.path())
+}
+
+/// Removes `path`; one that is not there is fine.
+pub(crate) fn remove_if_there(path: &Path) -> std::io::Result<()> {
+    match std::fs::remove_file(path) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(e),
+        _ => Ok(()),
+    }
+}
+
 /// The outputs a run writes into its directory: `history.csv` every `history_every` steps,
 /// the snapshot series when `snapshots` is set, and at the end `points.vtu`,
 /// `summary.json` and the plots ([`crate::output::plots`]).
@@ -103,18 +137,22 @@ pub struct Notes(pub Vec<String>);
 impl Recorder {
     /// Adds the history and (with `snapshots`) the snapshot systems to the end of `sim`'s
     /// schedule, writing into `dir`. A run resumed from a checkpoint passes the history
-    /// file's committed length in `history_bytes`; a new run passes `None`.
+    /// file's committed length and its CRC-32 in `history`; a new run passes `None`.
     pub fn attach<D: Dim>(
         sim: &mut Simulation<D>,
         dir: &OutputDir,
         history_every: u64,
         snapshots: Option<SnapshotSpec>,
-        history_bytes: Option<u64>,
+        history: Option<(u64, u32)>,
     ) -> std::io::Result<Recorder> {
+        let history_bytes = history.map(|h| h.0);
+        if history.is_none() {
+            clear_earlier_results(dir)?;
+        }
         let file = dir.file("history.csv");
-        let history = match history_bytes {
+        let history = match history {
             None => History::<D>::create(&file, history_every, &sim.traced, &sim.ctx.state.drives)?,
-            Some(bytes) => History::<D>::resume(&file, bytes, history_every, &sim.traced)?,
+            Some(mark) => History::<D>::resume(&file, mark, history_every, &sim.traced)?,
         };
         let rows = history.rows();
         sim.schedule.push(history);

@@ -80,17 +80,10 @@ impl<D: Dim> Snapshots<D> {
         resume_time: Option<f64>,
     ) -> std::io::Result<(Self, SnapshotWriter)> {
         let folder = dir.join(FOLDER);
-        std::fs::create_dir_all(&folder)?;
         if resume_time.is_none() {
-            // A new run: an earlier run's snapshots are not part of this series.
-            for e in std::fs::read_dir(&folder)?.flatten() {
-                let name = e.file_name().to_string_lossy().into_owned();
-                if name.starts_with("points_") && name.ends_with(".vtu") {
-                    std::fs::remove_file(e.path())?;
-                }
-            }
-            let _ = std::fs::remove_file(dir.join(PVD));
+            clear(dir)?;
         }
+        std::fs::create_dir_all(&folder)?;
         let mut entries: Vec<Entry> = match resume_time {
             Some(t) => read_pvd(&dir.join(PVD))
                 .into_iter()
@@ -245,4 +238,19 @@ pub fn collection(dir: &Path) -> Vec<(f64, PathBuf)> {
         .into_iter()
         .map(|(t, f)| (t, dir.join(f)))
         .collect()
+}
+
+/// Removes an earlier run's series from output directory `dir`: its `points.pvd` and the
+/// snapshots in its folder (a new run's series is its own).
+pub(crate) fn clear(dir: &Path) -> std::io::Result<()> {
+    let folder = dir.join(FOLDER);
+    if let Ok(entries) = std::fs::read_dir(&folder) {
+        for e in entries.flatten() {
+            let name = e.file_name().to_string_lossy().into_owned();
+            if name.starts_with("points_") && name.ends_with(".vtu") {
+                std::fs::remove_file(e.path())?;
+            }
+        }
+    }
+    crate::output::recorder::remove_if_there(&dir.join(PVD))
 }

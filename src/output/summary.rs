@@ -5,7 +5,6 @@ use crate::measure::{max_displacements, surface_angle, SurfaceAngle};
 use crate::schedule::Timing;
 use crate::simulation::{Simulation, TracedResult};
 use crate::state::{CurvePoint, ForceNorm, Peak, StageResult, StopReason};
-use crate::systems::convergence::is_defined;
 use serde::Serialize;
 
 /// The outcome of a run, as written to `summary.json`. Nothing is written as `null`: an
@@ -50,7 +49,7 @@ pub struct Summary {
     /// Tolerance for both.
     pub tolerance: f64,
     /// Largest point movement over the last completed static-check window (m).
-    #[serde(skip_serializing_if = "Option::is_none")]
+    #[serde(skip_serializing_if = "none_or_not_finite")]
     pub static_window_movement: Option<f64>,
     /// Kinetic-damping resets.
     pub kinetic_resets: u64,
@@ -58,12 +57,15 @@ pub struct Summary {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub first_peak: Option<Peak>,
     /// Kinetic energy (J) at the end.
+    #[serde(skip_serializing_if = "not_finite")]
     pub kinetic_energy: f64,
     /// External work (J) at the end.
+    #[serde(skip_serializing_if = "not_finite")]
     pub external_work: f64,
     /// Material points (load carriers included).
     pub particles: usize,
     /// Total point mass (kg).
+    #[serde(skip_serializing_if = "not_finite")]
     pub total_mass: f64,
     /// Wall time of the stepping loop (s).
     pub wall_seconds: f64,
@@ -74,10 +76,10 @@ pub struct Summary {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub peak_memory_bytes: Option<u64>,
     /// Largest displacement magnitude of any point (m), unless the scene keeps none.
-    #[serde(skip_serializing_if = "Option::is_none")]
+    #[serde(skip_serializing_if = "none_or_not_finite")]
     pub max_displacement: Option<f64>,
     /// Largest |horizontal displacement| of any point (m), unless the scene keeps none.
-    #[serde(skip_serializing_if = "Option::is_none")]
+    #[serde(skip_serializing_if = "none_or_not_finite")]
     pub max_horizontal_displacement: Option<f64>,
     /// Free-surface angle, when the scene asks for it (`output.surface_angle`).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -94,11 +96,11 @@ pub struct Summary {
     pub output_wait_seconds: Option<f64>,
     /// The largest mean pressure of the static states of the prescribed motions given a
     /// loaded area (Pa): the limit pressure where the curve has levelled off.
-    #[serde(skip_serializing_if = "Option::is_none")]
+    #[serde(skip_serializing_if = "none_or_not_finite")]
     pub limit_pressure: Option<f64>,
     /// How much the pressure rose over the curve's last increment, relative to the limit
     /// pressure: near 0 on a plateau, well above it while the curve still climbs.
-    #[serde(skip_serializing_if = "Option::is_none")]
+    #[serde(skip_serializing_if = "none_or_not_finite")]
     pub last_increment_rise: Option<f64>,
     /// Static states of the load–displacement curve (`curve.csv`).
     #[serde(skip_serializing_if = "Vec::is_empty")]
@@ -162,9 +164,21 @@ impl Outcome {
     }
 }
 
-/// A ratio K_F or K_E: its value, or `"undefined"` where its denominator was zero.
+/// True for NaN or ±∞: a figure a run that failed on a non-finite state leaves behind. It
+/// is left out of summary.json (which JSON would write as null); `error` says why.
+fn not_finite(x: &f64) -> bool {
+    !x.is_finite()
+}
+
+/// True for an absent or non-finite figure (left out, see [`not_finite`]).
+fn none_or_not_finite(x: &Option<f64>) -> bool {
+    x.is_none_or(|x| !x.is_finite())
+}
+
+/// A ratio K_F or K_E: its value, or `"undefined"` where its denominator was zero (or where
+/// a failed run left it non-finite).
 fn ratio<S: serde::Serializer>(r: &f64, s: S) -> Result<S::Ok, S::Error> {
-    if is_defined(*r) {
+    if r.is_finite() {
         s.serialize_f64(*r)
     } else {
         s.serialize_str("undefined")

@@ -41,6 +41,45 @@ pub enum StudyError {
     /// The study's output directory or a file in it could not be used.
     #[error("{0}")]
     Output(String),
+    /// The reference run found no static state: errors measured against it would mean
+    /// nothing.
+    #[error("{0}")]
+    Reference(String),
+    /// The study was stopped by a signal; the run under way was stopped and waited for,
+    /// and is run again when the study is started again.
+    #[error("interrupted: run {0} was stopped and will be run again when the study is started again")]
+    Interrupted(String),
+}
+
+/// Set (by a Ctrl-C or SIGTERM handler) to stop a study: the run under way is passed the
+/// signal and waited for, and no record is written for it.
+pub static STOP: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// Refuses a reference run that did not converge: it ended at its step or time limit, or
+/// failed, so its figures are not the static answer the other runs are compared with.
+pub fn check_reference(reference: &Finished) -> Result<(), StudyError> {
+    if reference.outcome == "converged" {
+        return Ok(());
+    }
+    Err(StudyError::Reference(format!(
+        "the reference run ({}) did not converge: it {}; its figures are no static answer to \
+         measure errors against: give the reference a larger max_steps or max_time (or a \
+         looser tolerance), then start the study again",
+        reference.run.id,
+        match reference.outcome.as_str() {
+            "max_steps" | "max_time" | "stopped" => format!("ended at its limit ({})", reference.outcome),
+            other => format!("ended as `{other}`"),
+        }
+    )))
+}
+
+/// Asks the child run to stop as Ctrl-C would (it writes its checkpoint and exits).
+fn pass_signal(child: &std::process::Child) {
+    // SAFETY: `kill` with a valid signal number has no memory effects; the pid is our
+    // own child's, not yet waited for, so it cannot have been reused.
+    unsafe {
+        libc::kill(child.id() as libc::pid_t, libc::SIGTERM);
+    }
 }
 
 /// What one finished (or reused) run left.
@@ -111,8 +150,9 @@ pub fn run_one(
     for o in &run.overrides {
         cmd.arg("--set").arg(o);
     }
-    std::fs::create_dir_all(&out)
-        .map_err(|e| StudyError::Output(format!("cannot create {}: {e}", out.display())))?;
+    // A run directory another process holds (a run of an earlier study still going) is
+    // an error of the study's, not a row of "bad input" with that run's numbers.
+    drop(OutputDir::claim(&out).map_err(|e| StudyError::Output(e.to_string()))?);
     let stderr = std::fs::File::create(out.join("stderr.txt"))
         .map_err(|e| StudyError::Output(format!("cannot write {}: {e}", out.join("stderr.txt").display())))?;
     cmd.stdout(Stdio::null()).stderr(stderr);
@@ -126,6 +166,11 @@ pub fn run_one(
             Ok(Some(status)) => break Some(status),
             Ok(None) => {}
             Err(e) => return Err(StudyError::Output(format!("cannot wait for run {}: {e}", run.id))),
+        }
+        if STOP.load(std::sync::atomic::Ordering::SeqCst) {
+            pass_signal(&child);
+            let _ = child.wait();
+            return Err(StudyError::Interrupted(run.id.clone()));
         }
         if limit.is_some_and(|l| start.elapsed() > l) {
             // A run past its limit is stopped; it is a row with outcome `timeout`.

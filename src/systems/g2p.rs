@@ -84,7 +84,7 @@ impl<D: Dim, S: Shape> System<D> for G2p<D, S> {
         }
         // A NaN or infinite velocity shows in the energy's sum. Stop here, before any point
         // moves with it: positions, stresses and the solver state stay those of the last
-        // finite step.
+        // finite step (the velocities do not, so the final points are not written).
         // Over MPI the energy is the ranks' sum (a NaN on one rank reaches all, so that every
         // rank stops alike).
         let mut twice_ek = [twice_ek];

@@ -1,0 +1,575 @@
+//! Nothing silently wrong in the features added last (stages, motions, load steps, factors
+//! of safety, checkpoints, studies, plots, signals): one regression test per class of bad
+//! or extreme input that gave a wrong answer, a hang, a panic or a stale file. Each gives
+//! the right answer or exits 2 (bad input) or 1 (a run that went wrong) naming the field and
+//! the rule.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+fn scratch(name: &str) -> PathBuf {
+    common::scratch("features", name)
+}
+
+/// `kdmpm ARGS` with `--set`s, waited for at most `limit`: a hang fails the test.
+fn kdmpm_within(args: &[&str], sets: &[&str], limit: Duration) -> Output {
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_kdmpm"));
+    cmd.args(args);
+    for s in sets {
+        cmd.args(["--set", s]);
+    }
+    let mut child = cmd.stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().unwrap();
+    let start = Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if start.elapsed() > limit {
+            let _ = child.kill();
+            panic!("kdmpm {args:?} {sets:?} did not end within {limit:?}");
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    child.wait_with_output().unwrap()
+}
+
+/// `kdmpm check SCENE --set ...` exits 2 with one line holding every `expect`.
+fn refused(scene: &str, sets: &[&str], expect: &[&str]) {
+    let path = common::scene(scene);
+    let o = kdmpm_within(&["check", path.to_str().unwrap()], sets, Duration::from_secs(60));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{sets:?}: {err}");
+    for e in expect {
+        assert!(err.contains(e), "{sets:?}: expected `{e}` in: {err}");
+    }
+    assert_eq!(err.trim_end().lines().count(), 1, "{sets:?}: one line: {err}");
+}
+
+fn summary(dir: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap()
+}
+
+const COLUMN_SOIL: &str = "MohrCoulomb(density: DENSITY, youngs_modulus: 10.0e6, poisson_ratio: 0.3, \
+                           cohesion: 0.0, friction_angle: 30.0, dilatancy_angle: 0.0)";
+
+// ---- Stages -------------------------------------------------------------------------
+
+/// soil_column.ron with `stages` (the text of the list).
+fn staged_column(stages: &str) -> String {
+    let text = std::fs::read_to_string(common::scene("soil_column.ron")).unwrap();
+    text.replace("    solver: (", &format!("    stages: {stages},\n    solver: ("))
+}
+
+/// The top settles by ρgH²/(2M) (scenes/soil_column.ron): 0.06559 m at 1800 kg/m³, twice
+/// that once a stage doubles the density; the mass doubles with it. Once the stage's
+/// density was ignored and the run converged at the first stage's settlement.
+#[test]
+fn a_stage_that_doubles_the_density_doubles_the_mass_and_the_settlement() {
+    let heavy = COLUMN_SOIL.replace("DENSITY", "3600.0");
+    let s = common::run_text(
+        "heavy.ron",
+        &staged_column(&format!(
+            r#"[(name: "a"), (name: "heavy", materials: {{"soil": {heavy}}})]"#
+        )),
+    );
+    assert!(s.converged, "{:?}", s.error);
+    assert_eq!(s.total_mass, 3600.0 * 2.0 * 10.0);
+    let m = 10.0e6 * 0.7 / (1.3 * 0.4);
+    let analytic = 3600.0 * 9.81 * 100.0 / (2.0 * m);
+    let top = -s.traced[1].displacement[1];
+    // The column's own discretisation error at 1800 kg/m³ (tests/robustness.rs): under 1 %.
+    assert!(
+        (top / analytic - 1.0).abs() < 0.01,
+        "top {top} m, analytic {analytic} m"
+    );
+}
+
+/// A stage that takes every load away (gravity 0) relaxes the column back towards its
+/// unloaded shape and stops: K_F is measured against the load it took away. Once K_F was
+/// 0/0 in such a stage and the run went on to max_steps with the body at rest.
+#[test]
+fn a_stage_that_removes_every_load_stops_at_its_static_state() {
+    let elastic = "LinearElastic(density: 1800.0, youngs_modulus: 10.0e6, poisson_ratio: 0.3)";
+    let text =
+        staged_column(r#"[(name: "loaded"), (name: "unloaded", gravity: (acceleration: [0.0, 0.0]))]"#);
+    let text = text.replace(
+        "MohrCoulomb(\n            density: 1800.0,\n            youngs_modulus: 10.0e6,\n            poisson_ratio: 0.3,\n            cohesion: 0.0,\n            friction_angle: 30.0,\n            dilatancy_angle: 0.0,\n        )",
+        elastic,
+    );
+    assert!(text.contains("LinearElastic"), "the column's soil was replaced");
+    let s = common::run_text("unload.ron", &text);
+    assert!(s.converged, "{:?}", s.error);
+    assert_eq!(s.stages.len(), 2);
+    assert!(s.steps < 2 * s.stages[0].step + 2000, "{} steps", s.steps);
+    // Elastic: the top comes back to where it started, to the tolerance's share of the
+    // 0.0656 m it settled.
+    let top = s.traced[1].displacement[1];
+    assert!(top.abs() < 0.01 * 0.0656, "top still displaced {top} m");
+}
+
+// ---- Motions ------------------------------------------------------------------------
+
+#[test]
+fn a_motion_box_that_drives_no_node_of_the_body_is_refused() {
+    // Outside the grid (18 cells of 0.25 m: the top is 4.5 m).
+    refused(
+        "footing.ron",
+        &["motions[0].min=[0.0, 5.0]", "motions[0].max=[1.0, 5.5]"],
+        &["motions[0].min", "holds no grid node"],
+    );
+    // Between grid nodes.
+    refused(
+        "footing.ron",
+        &["motions[0].min=[0.1, 4.01]", "motions[0].max=[0.2, 4.2]"],
+        &["motions[0].min", "holds no grid node"],
+    );
+    // Nodes the body does not reach: grid nodes do not move, so it would push nothing.
+    refused(
+        "footing.ron",
+        &[
+            "grid.cells=[24, 24]",
+            "motions[0].min=[0.0, 5.5]",
+            "motions[0].max=[1.0, 6.0]",
+        ],
+        &["motions[0].min", "touches the body"],
+    );
+}
+
+#[test]
+fn a_motion_box_corner_that_is_not_a_finite_number_is_refused() {
+    refused(
+        "footing.ron",
+        &["motions[0].max=[1.0, inf]"],
+        &["motions[0].max", "finite"],
+    );
+    refused(
+        "footing.ron",
+        &["motions[0].min=[NaN, 4.0]"],
+        &["motions[0].min", "finite"],
+    );
+}
+
+#[test]
+fn two_motions_over_one_node_are_refused() {
+    let two = concat!(
+        r#"motions=[(name: "a", min: [0.0, 4.0], max: [1.0, 4.5], velocity: [None, Some(-0.01)], travel: 0.1), "#,
+        r#"(name: "b", min: [0.5, 4.0], max: [1.5, 4.5], velocity: [None, Some(-0.01)], travel: 0.1)]"#
+    );
+    refused(
+        "footing.ron",
+        &[two],
+        &["motions[1].min", "motions[0]", "one motion"],
+    );
+}
+
+// ---- Load steps ---------------------------------------------------------------------
+
+/// Increments that balance at once used to clear the stop each step and run past
+/// max_steps for ever.
+#[test]
+fn a_load_in_billions_of_increments_stops_at_max_steps() {
+    let dir = scratch("increments");
+    let scene = common::scene("footing_load.ron");
+    let o = kdmpm_within(
+        &[
+            "run",
+            scene.to_str().unwrap(),
+            "--quiet",
+            "--out",
+            dir.to_str().unwrap(),
+        ],
+        &["tractions[0].increments=4294967295", "solver.max_steps=3000"],
+        Duration::from_secs(120),
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let s = summary(&dir);
+    assert_eq!(s["outcome"], "max_steps");
+    assert_eq!(s["steps"], 3000);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+// ---- Factor of safety ---------------------------------------------------------------
+
+/// slope_fos.ron with an elastic soil whose strength comes from a stage (a geostatic
+/// elastic stage, then Mohr-Coulomb with the displacements zeroed).
+fn slope_with_strength_in_a_stage() -> PathBuf {
+    let text = std::fs::read_to_string(common::scene("slope_fos.ron")).unwrap();
+    let soil = "MohrCoulomb(density: 2038.74, youngs_modulus: 100.0e6, poisson_ratio: 0.3, \
+                cohesion: 10.0e3, friction_angle: 20.0, dilatancy_angle: 0.0)";
+    let start = text.find("\"soil\": MohrCoulomb(").unwrap() + "\"soil\": ".len();
+    let end = start + text[start..].find(')').unwrap() + 1;
+    let mut text = text.replace(
+        &text[start..end],
+        "LinearElastic(density: 2038.74, youngs_modulus: 100.0e6, poisson_ratio: 0.3)",
+    );
+    text = text.replace(
+        "    solver: (",
+        &format!(
+            "    stages: [(name: \"geostatic\"), (name: \"strength\", materials: {{\"soil\": {soil}}}, \
+             reset_displacements: true)],\n    solver: ("
+        ),
+    );
+    let path = scratch("fos-staged").join("slope_staged_strength.ron");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+/// Strength reduction divides the strength a stage gives, as it does the scene's: the
+/// factor is Griffiths & Lane's slope's, the bracket of the one-stage scene (1.406–1.422,
+/// README). Once the stage's strength was left whole ("above 2"), and an elastic scene
+/// with a Mohr-Coulomb stage was refused.
+#[test]
+fn fos_reduces_the_strength_that_a_stage_gives() {
+    let scene = slope_with_strength_in_a_stage();
+    let out = scene.parent().unwrap().join("out");
+    let o = kdmpm_within(
+        &[
+            "fos",
+            scene.to_str().unwrap(),
+            "--quiet",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        &[],
+        Duration::from_secs(300),
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let s = summary(&out);
+    assert_eq!(s["bracket"], serde_json::json!([1.40625, 1.421875]));
+    // The mechanism is the smallest failing trial's folder.
+    let trials = s["trials"].as_array().unwrap();
+    let mechanism = trials.iter().find(|t| t["dir"] == s["mechanism"]).unwrap();
+    assert_eq!(mechanism["failed"], true);
+    assert_eq!(mechanism["factor"], 1.421875);
+    let _ = std::fs::remove_dir_all(scene.parent().unwrap());
+}
+
+#[test]
+fn a_bracket_without_two_ordered_factors_is_refused_by_its_own_field() {
+    let scene = common::scene("slope_fos.ron");
+    for bracket in ["[1.0]", "[NaN, 2.0]", "[-1.0, 2.0]", "[0.0, 2.0]", "[2.0, 1.0]"] {
+        let set = format!("strength_reduction.bracket={bracket}");
+        let o = kdmpm_within(
+            &["fos", scene.to_str().unwrap(), "--quiet"],
+            &[&set],
+            Duration::from_secs(60),
+        );
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{bracket}: {err}");
+        assert!(
+            err.contains("field `strength_reduction.bracket`"),
+            "{bracket}: {err}"
+        );
+    }
+}
+
+#[test]
+fn a_bisection_finer_than_a_trial_resolves_is_refused() {
+    refused(
+        "slope_fos.ron",
+        &["strength_reduction.tolerance=1e-300"],
+        &["strength_reduction.tolerance", "at least 1e-7"],
+    );
+}
+
+#[test]
+fn fos_into_a_path_that_cannot_be_a_directory_is_bad_input() {
+    let dir = scratch("fos-out");
+    let file = dir.join("a-file");
+    std::fs::write(&file, "").unwrap();
+    let scene = common::scene("slope_fos.ron");
+    let o = kdmpm_within(
+        &[
+            "fos",
+            scene.to_str().unwrap(),
+            "--quiet",
+            "--out",
+            file.to_str().unwrap(),
+        ],
+        &[],
+        Duration::from_secs(60),
+    );
+    assert_eq!(o.status.code(), Some(2), "{}", String::from_utf8_lossy(&o.stderr));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+// ---- Other scene rules --------------------------------------------------------------
+
+#[test]
+fn a_musl_schedule_without_the_remap_is_refused() {
+    let names = "solver.schedule=[\"grid_reset\", \"spatial_sort\", \"p2g\", \"gravity\", \"boundary\", \
+                 \"integrate\", \"g2p\", \"peak_watch\", \"kinematics\", \"stress_update\", \
+                 \"volume_update\", \"convergence\"]";
+    refused("soil_column.ron", &[names], &["solver.schedule", "remap"]);
+}
+
+#[test]
+fn a_z_extent_on_a_2d_polygon_is_refused() {
+    refused(
+        "slope_fos.ron",
+        &["bodies[0].region=Polygon(vertices: [[15.0, 0.0], [55.0, 0.0], [55.0, 10.0], [35.0, 10.0]], z: [0.0, 1.0])"],
+        &["bodies[0].region.z", "2D"],
+    );
+}
+
+#[test]
+fn two_traced_points_of_one_name_are_refused() {
+    refused(
+        "soil_column.ron",
+        &["traced=[(name: \"top\", position: [0.875, 9.875]), (name: \"top\", position: [0.875, 4.875])]"],
+        &["traced[1].name", "traced[0]"],
+    );
+}
+
+#[test]
+fn masses_weights_and_damping_that_overflow_are_refused() {
+    refused(
+        "soil_column.ron",
+        &["materials.soil.density=1e308"],
+        &["materials.soil.density", "not a finite"],
+    );
+    refused(
+        "soil_column.ron",
+        &["gravity.acceleration=[0.0, -1e308]"],
+        &["gravity.acceleration", "not a finite"],
+    );
+    refused(
+        "soil_column.ron",
+        &["solver.damping=Viscous(beta: 1e308)"],
+        &["solver.damping", "βΔt = 1"],
+    );
+}
+
+/// The memory bound holds against an address-space limit, as on a shared cluster node,
+/// not only against the machine's memory: refused at once instead of an abort.
+#[test]
+fn a_scene_over_the_address_space_limit_is_refused_quickly() {
+    let scene = common::scene("block_1m.ron");
+    let start = Instant::now();
+    let o = Command::new("sh")
+        .arg("-c")
+        .arg(format!(
+            "ulimit -v 4000000 && exec {} check {} --set 'bodies[0].points_per_cell=[8, 8, 8]'",
+            env!("CARGO_BIN_EXE_kdmpm"),
+            scene.display()
+        ))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("address-space limit"), "{err}");
+    assert!(start.elapsed() < Duration::from_secs(10));
+}
+
+// ---- Output -------------------------------------------------------------------------
+
+/// A tolerance near the largest float once made convergence.svg's axis infinite, and
+/// drawing it never returned.
+#[test]
+fn a_huge_tolerance_draws_its_plots_and_plot_returns() {
+    let dir = scratch("huge-tolerance");
+    let scene = common::scene("bar.ron");
+    let o = kdmpm_within(
+        &[
+            "run",
+            scene.to_str().unwrap(),
+            "--quiet",
+            "--out",
+            dir.to_str().unwrap(),
+        ],
+        &["solver.tolerance=5e307"],
+        Duration::from_secs(60),
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let o = kdmpm_within(&["plot", dir.to_str().unwrap()], &[], Duration::from_secs(60));
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(dir.join("convergence.svg").exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A new run into a directory removes what the run before left as results and what a
+/// killed process left half-written, before it writes anything: a crash of the new run
+/// leaves nothing old looking current.
+#[test]
+fn a_new_run_leaves_no_earlier_result_or_partial_file_beside_its_history() {
+    let dir = scratch("stale-results");
+    for f in [
+        "summary.json",
+        "points.vtu",
+        "curve.csv",
+        "stages.csv",
+        "curve.svg",
+        "points.pvd",
+    ] {
+        std::fs::write(dir.join(f), "from an earlier run").unwrap();
+    }
+    std::fs::write(dir.join("summary.json.partial-999999"), "half").unwrap();
+    let scene = common::scene("slope.ron");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_kdmpm"))
+        .args([
+            "run",
+            scene.to_str().unwrap(),
+            "--quiet",
+            "--set",
+            "output.snapshots=None",
+            "--out",
+        ])
+        .arg(&dir)
+        .spawn()
+        .unwrap();
+    let history = dir.join("history.csv");
+    while std::fs::read_to_string(&history).map_or(0, |t| t.lines().count()) < 3 {
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    let left: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n != "history.csv" && n != ".kdmpm.lock")
+        .collect();
+    assert!(left.is_empty(), "left beside the new history: {left:?}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// SIGTERM, what a batch scheduler sends before its limit, is handled as Ctrl-C: the run
+/// checkpoints and exits 130, and resumes.
+#[test]
+fn sigterm_checkpoints_like_ctrl_c() {
+    let dir = scratch("sigterm");
+    let scene = common::scene("slope.ron");
+    let child = Command::new(env!("CARGO_BIN_EXE_kdmpm"))
+        .args([
+            "run",
+            scene.to_str().unwrap(),
+            "--quiet",
+            "--set",
+            "output.snapshots=None",
+            "--out",
+        ])
+        .arg(&dir)
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let history = dir.join("history.csv");
+    while std::fs::read_to_string(&history).map_or(0, |t| t.lines().count()) < 3 {
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    assert!(Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .unwrap()
+        .success());
+    let o = child.wait_with_output().unwrap();
+    assert_eq!(
+        o.status.code(),
+        Some(130),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert_eq!(summary(&dir)["outcome"], "interrupted");
+    assert!(dir.join("checkpoint.kdc").exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+// ---- Studies ------------------------------------------------------------------------
+
+fn study_file(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let path = dir.join(name);
+    std::fs::write(&path, text.replace("SCENES", common::scene("").to_str().unwrap())).unwrap();
+    path
+}
+
+/// A reference that ended at max_steps once gave every run an error against a state that
+/// is not static (52 %, all on the Pareto front); the study now stops and says so.
+#[test]
+fn a_study_refuses_a_reference_run_that_did_not_converge() {
+    let dir = scratch("study-reference");
+    let study = study_file(
+        &dir,
+        "s.ron",
+        r#"Study(
+    scene: "SCENES/soil_column.ron",
+    reference: ["solver.max_steps=20"],
+    axes: [Set(path: "solver.tolerance", values: ["1e-3"])],
+    quantities: [(name: "u top", of: Displacement(point: "top", component: 1), compare: Reference)],
+)"#,
+    );
+    let out = dir.join("out");
+    let o = kdmpm_within(
+        &[
+            "study",
+            study.to_str().unwrap(),
+            "--quiet",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        &[],
+        Duration::from_secs(120),
+    );
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("did not converge") && err.contains("max_steps"),
+        "{err}"
+    );
+    assert!(!out.join("study.csv").exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// SIGTERM to a study reaches the run under way, which is waited for: no run is left
+/// holding its directory, and the study exits 130.
+#[test]
+fn sigterm_to_a_study_stops_its_run_and_waits_for_it() {
+    let dir = scratch("study-sigterm");
+    let study = study_file(
+        &dir,
+        "s.ron",
+        r#"Study(
+    scene: "SCENES/slope.ron",
+    set: ["output.snapshots=None"],
+    axes: [Set(path: "solver.tolerance", values: ["1e-2", "1e-3"])],
+    quantities: [(name: "angle", of: SurfaceAngle, compare: Analytic(20.0))],
+)"#,
+    );
+    let out = dir.join("out");
+    let child = Command::new(env!("CARGO_BIN_EXE_kdmpm"))
+        .args(["study", study.to_str().unwrap(), "--quiet", "--out"])
+        .arg(&out)
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let history = out.join("run-001").join("history.csv");
+    while std::fs::read_to_string(&history).map_or(0, |t| t.lines().count()) < 3 {
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    assert!(Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .unwrap()
+        .success());
+    let o = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(130), "{err}");
+    assert!(err.contains("interrupted"), "{err}");
+    // The run was stopped as by Ctrl-C (its summary says so) and released its directory.
+    assert_eq!(summary(&out.join("run-001"))["outcome"], "interrupted");
+    assert!(kdmpm::output::OutputDir::claim(&out.join("run-001")).is_ok());
+    assert!(!out.join("run-001").join(kdmpm::study::RECORD).exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Volumetric smoothing on a dilatant soil (the c–φ footing of docs/verification.md) once
+/// ran until "kinetic energy exceeds 10× the external work"; it is refused with the reason.
+#[test]
+fn volumetric_smoothing_on_a_dilatant_soil_is_refused() {
+    refused(
+        "footing.ron",
+        &[
+            "solver.volumetric_smoothing=true",
+            "materials.clay=MohrCoulomb(density: 2000.0, youngs_modulus: 10.0e6, poisson_ratio: 0.3, \
+             cohesion: 10.0e3, friction_angle: 30.0, dilatancy_angle: 30.0)",
+        ],
+        &["solver.volumetric_smoothing", "\"clay\" dilates", "ψ = 0"],
+    );
+}
