@@ -7,7 +7,7 @@ use crate::output::dir::RowFile;
 use crate::schedule::System;
 use crate::simulation::{traced_values, TracedPoint};
 use crate::state::Drive;
-use crate::systems::convergence::ratio_text;
+use crate::systems::convergence::ratio_cell;
 use std::marker::PhantomData;
 use std::path::Path;
 use std::sync::{Arc, Mutex, MutexGuard};
@@ -15,7 +15,7 @@ use std::sync::{Arc, Mutex, MutexGuard};
 /// Writes step, time, E_k (J), W_ext (J), K_F (max and mean norm), K_E, resets, each
 /// traced point's displacement (m) and each prescribed motion's travel (m) and reaction
 /// (N; N/m in 2D) every `every` steps and at the last step. A ratio whose
-/// denominator is zero is written `undefined`.
+/// denominator is zero is an empty cell.
 ///
 /// The file only ever holds whole rows ([`RowFile`]): a run stopped by an error, a crash or
 /// a full disk leaves a valid file with every row that reached it. The row file is shared
@@ -130,9 +130,9 @@ impl<D: Dim> System<D> for History<D> {
             format!("{:.9e}", s.time),
             format!("{:.9e}", s.kinetic_energy),
             format!("{:.9e}", s.external_work),
-            ratio_text(s.force_ratio_max, 9),
-            ratio_text(s.force_ratio_mean, 9),
-            ratio_text(s.energy_ratio, 9),
+            ratio_cell(s.force_ratio_max, 9),
+            ratio_cell(s.force_ratio_mean, 9),
+            ratio_cell(s.energy_ratio, 9),
             s.resets.to_string(),
         ];
         for (k, t) in self.traced.iter().enumerate() {

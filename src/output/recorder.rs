@@ -11,7 +11,7 @@ use crate::output::vtk::{write_parallel_points, write_points};
 use crate::output::RowFile;
 use crate::simulation::Simulation;
 use crate::state::{CurvePoint, StageResult};
-use crate::systems::convergence::ratio_text;
+use crate::systems::convergence::ratio_cell;
 use std::io::Write;
 use std::path::Path;
 use std::sync::{Arc, Mutex};
@@ -58,8 +58,8 @@ fn stages_csv(stages: &[StageResult]) -> String {
             s.name,
             s.step,
             s.time,
-            ratio_text(s.force_ratio, 9),
-            ratio_text(s.energy_ratio, 9),
+            ratio_cell(s.force_ratio, 9),
+            ratio_cell(s.energy_ratio, 9),
             s.resets
         );
     }

@@ -17,7 +17,8 @@ pub const UNSTABLE_ENERGY_RATIO: f64 = 10.0;
 
 /// The value of a ratio whose denominator is zero (no external force on a free degree of
 /// freedom, no external work yet). It is not 0: it compares false with every tolerance,
-/// so it never counts as met, and writers show it as `undefined` (see [`is_defined`]).
+/// so it never counts as met; the terminal and summary.json show it as `undefined`, the CSV
+/// files as an empty cell (see [`is_defined`]).
 pub const UNDEFINED: f64 = f64::NAN;
 
 /// True when a ratio K_F or K_E has a value (its denominator was not zero).
@@ -25,7 +26,19 @@ pub fn is_defined(ratio: f64) -> bool {
     !ratio.is_nan()
 }
 
-/// A ratio as text: in scientific notation with `digits` decimals, or `undefined`.
+/// A ratio as a CSV cell: in scientific notation with `digits` decimals, or empty where it
+/// is undefined (pandas, R and spreadsheets read an empty cell as missing, where a word
+/// would turn the whole column into text).
+pub fn ratio_cell(ratio: f64, digits: usize) -> String {
+    if is_defined(ratio) {
+        format!("{ratio:.digits$e}")
+    } else {
+        String::new()
+    }
+}
+
+/// A ratio as text for people: in scientific notation with `digits` decimals, or
+/// `undefined`.
 pub fn ratio_text(ratio: f64, digits: usize) -> String {
     if is_defined(ratio) {
         format!("{ratio:.digits$e}")
