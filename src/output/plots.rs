@@ -20,7 +20,8 @@ pub const FILES: [&str; 4] = [
 /// The load–displacement plot, drawn when the run wrote `curve.csv`.
 pub const CURVE_PLOT: &str = "curve.svg";
 
-/// `history.csv` as columns of numbers (a value written `undefined` is NaN here, and
+/// `history.csv` as columns of numbers (an empty cell, or `undefined` in the files of
+/// earlier versions, is NaN here, and
 /// left out of every plot).
 struct History {
     names: Vec<String>,
@@ -449,20 +450,28 @@ fn field(x: &[[f64; 3]], u: &[[f64; 3]]) -> String {
             yl = yl.min(p[1]);
             yh = yh.max(p[1]);
         }
+        let caption = if every > 1 {
+            format!("Displacement magnitude |u| on the deformed points (one in {every} drawn)")
+        } else {
+            "Displacement magnitude |u| on the deformed points".to_string()
+        };
+        let main = main.titled(&caption, ("sans-serif", 22))?;
+        // One metre is as many pixels along x as along y, so that a slope's final angle
+        // looks like its angle: the shorter extent is widened to the plot's aspect.
+        let (margin, y_labels, x_labels) = (20u32, 70u32, 50u32);
+        let (w, h) = main.dim_in_pixel();
+        let plot_w = w.saturating_sub(2 * margin + y_labels).max(1) as f64;
+        let plot_h = h.saturating_sub(2 * margin + x_labels).max(1) as f64;
         let pad = 0.03 * (xh - xl).max(yh - yl).max(1e-9);
+        let (span_x, span_y) = (xh - xl + 2.0 * pad, yh - yl + 2.0 * pad);
+        let per_pixel = (span_x / plot_w).max(span_y / plot_h);
+        let (cx, cy) = (0.5 * (xl + xh), 0.5 * (yl + yh));
+        let (hx, hy) = (0.5 * per_pixel * plot_w, 0.5 * per_pixel * plot_h);
         let mut c = ChartBuilder::on(&main)
-            .caption(
-                if every > 1 {
-                    format!("Displacement magnitude |u| on the deformed points (one in {every} drawn)")
-                } else {
-                    "Displacement magnitude |u| on the deformed points".to_string()
-                },
-                ("sans-serif", 22),
-            )
-            .margin(20)
-            .x_label_area_size(50)
-            .y_label_area_size(70)
-            .build_cartesian_2d((xl - pad)..(xh + pad), (yl - pad)..(yh + pad))?;
+            .margin(margin)
+            .x_label_area_size(x_labels)
+            .y_label_area_size(y_labels)
+            .build_cartesian_2d((cx - hx)..(cx + hx), (cy - hy)..(cy + hy))?;
         c.configure_mesh()
             .x_desc("x (m)")
             .y_desc("y (m)")
