@@ -27,8 +27,34 @@ fn mass_bits<D: Dim>(sim: &Simulation<D>) -> u64 {
         .to_bits()
 }
 
-/// Runs to the stop, then 10 s more; returns (stop time, angle, max |u_x|, movement after).
-fn run_and_continue<D: Dim>(sim: &mut Simulation<D>) -> (f64, f64, f64, f64) {
+/// Where a slope came to rest.
+struct Rest {
+    /// Simulated time at the stop (s).
+    time: f64,
+    /// Steps to the stop.
+    steps: u64,
+    /// Surface angle (degrees).
+    angle: f64,
+    /// Largest |u_x| of any point (m).
+    max_ux: f64,
+    /// The traced crest point's u_x (m).
+    crest_ux: f64,
+    /// Largest movement in 10 s more (m).
+    moved: f64,
+}
+
+/// Checks a deterministic figure against the value the run gives (2 threads or 1): within
+/// `rel` of it, a band that a change of summation order survives and a regression does not.
+fn pinned(what: &str, value: f64, reference: f64, rel: f64) {
+    assert!(
+        (value / reference - 1.0).abs() <= rel,
+        "{what} {value}, pinned at {reference} (within {:.2} %)",
+        100.0 * rel
+    );
+}
+
+/// Runs to the stop, then 10 s more.
+fn run_and_continue<D: Dim>(sim: &mut Simulation<D>) -> Rest {
     let mass0 = mass_bits(sim);
     sim.run(|_| {})
         .expect("no point leaves the grid, nothing becomes NaN");
@@ -41,10 +67,15 @@ fn run_and_continue<D: Dim>(sim: &mut Simulation<D>) -> (f64, f64, f64, f64) {
         s.force_ratio_max,
         s.energy_ratio
     );
-    let (t_stop, norm) = (s.time, sim.ctx.settings.force_norm);
+    let (t_stop, steps, norm) = (s.time, s.step, sim.ctx.settings.force_norm);
     assert!(s.force_ratio(norm) <= 0.01 && s.energy_ratio <= 0.01);
     let angle = surface_angle(sim).expect("a surface").degrees;
     let (_, max_ux) = max_displacements(sim).expect("the slope scenes keep displacements");
+    let crest = sim
+        .traced_results()
+        .into_iter()
+        .find(|t| t.name == "crest")
+        .unwrap();
     assert_eq!(mass_bits(sim), mass0, "total mass changed");
     assert!(all_positions_finite(sim));
     // Static: ten more seconds move nothing by more than 1 cm.
@@ -59,18 +90,30 @@ fn run_and_continue<D: Dim>(sim: &mut Simulation<D>) -> (f64, f64, f64, f64) {
     println!(
         "stop t = {t_stop:.2} s, angle {angle:.2}°, max u_x {max_ux:.3} m, moved {moved:.4} m in 10 s more"
     );
-    (t_stop, angle, max_ux, moved)
+    Rest {
+        time: t_stop,
+        steps,
+        angle,
+        max_ux,
+        crest_ux: crest.displacement[0],
+        moved,
+    }
 }
 
+/// The run is deterministic: pinned to what it gives, `kdmpm run scenes/slope.ron`: 28 131
+/// steps to t = 38.434 s, surface angle 18.99398° (about φ = 20° in the paper, φ* = 18.9°
+/// by Davis for ψ = 0), crest u_x 22.5158 m, max u_x 35.312 m.
 #[test]
 fn failing_slope_comes_to_rest_at_its_repose_angle() {
     let mut sim = scene("slope.ron", &[]);
-    let (t, angle, max_ux, moved) = with_simulation!(&mut sim, s => run_and_continue(s));
-    assert!(t <= 120.0, "stopped at {t} s");
-    // About φ = 20° (paper); φ* = 18.9° for ψ = 0 (Davis).
-    assert!((angle - 20.0).abs() <= 3.0, "angle {angle}");
-    assert!(max_ux > 20.0, "the φ = 20° slope fails: max u_x = {max_ux}");
-    assert!(moved <= 0.01, "not static: {moved} m in 10 s");
+    let r = with_simulation!(&mut sim, s => run_and_continue(s));
+    pinned("steps", r.steps as f64, 28131.0, 0.01);
+    pinned("stop time (s)", r.time, 38.434, 0.01);
+    // 0.005° of 19°: a change of 0.5° fails by a hundred times.
+    pinned("angle (°)", r.angle, REFERENCE_ANGLE, 0.005 / 19.0);
+    pinned("crest u_x (m)", r.crest_ux, REFERENCE_CREST_UX, 5e-4);
+    pinned("max u_x (m)", r.max_ux, 35.312, 5e-4);
+    assert!(r.moved <= 0.01, "not static: {} m in 10 s", r.moved);
 }
 
 #[test]
@@ -96,19 +139,23 @@ fn a_creeping_slope_is_not_declared_static() {
     });
 }
 
+/// φ = 35° under a 30° face: it stands, settling 0.17 m at most (`kdmpm run
+/// scenes/slope_stable.ron`: 8 937 steps, angle 29.7668°, crest u_x 0.05444 m).
 #[test]
 fn slope_steeper_friction_than_its_face_stands() {
     let mut sim = scene("slope_stable.ron", &[]);
-    let (_, angle, max_ux, moved) = with_simulation!(&mut sim, s => run_and_continue(s));
-    assert!(max_ux < 1.0, "max u_x {max_ux}");
-    assert!((angle - 30.0).abs() <= 1.0, "angle {angle}");
-    assert!(moved <= 0.01, "not static: {moved} m in 10 s");
+    let r = with_simulation!(&mut sim, s => run_and_continue(s));
+    pinned("steps", r.steps as f64, 8937.0, 0.01);
+    pinned("angle (°)", r.angle, 29.7668, 0.005 / 30.0);
+    pinned("crest u_x (m)", r.crest_ux, 0.05444, 0.005);
+    pinned("max u_x (m)", r.max_ux, 0.1654, 0.005);
+    assert!(r.moved <= 0.01, "not static: {} m in 10 s", r.moved);
 }
 
 /// The shipped slope.ron's resting state (2 threads or 1: the run is deterministic):
-/// `kdmpm run scenes/slope.ron` prints surface angle 18.994° and crest u_x 22.516 m.
-const REFERENCE_ANGLE: f64 = 18.994;
-const REFERENCE_CREST_UX: f64 = 22.516;
+/// `kdmpm run scenes/slope.ron` gives surface angle 18.99398° and crest u_x 22.5158 m.
+const REFERENCE_ANGLE: f64 = 18.99398;
+const REFERENCE_CREST_UX: f64 = 22.5158;
 
 #[test]
 fn the_fast_preset_comes_to_rest_where_the_paper_settings_do() {
@@ -123,6 +170,10 @@ fn the_fast_preset_comes_to_rest_where_the_paper_settings_do() {
         println!("fast preset: {} steps, angle {angle:.3}°, crest u_x {:.3} m", s.ctx.state.step, crest.displacement[0]);
         assert!((angle - REFERENCE_ANGLE).abs() <= 0.25, "angle {angle}");
         assert!((crest.displacement[0] / REFERENCE_CREST_UX - 1.0).abs() <= 0.03, "crest u_x {}", crest.displacement[0]);
+        // And pinned to what the preset gives: 3 767 steps, 18.93675°, crest u_x 22.5185 m.
+        pinned("steps", s.ctx.state.step as f64, 3767.0, 0.01);
+        pinned("angle (°)", angle, 18.93675, 0.005 / 19.0);
+        pinned("crest u_x (m)", crest.displacement[0], 22.5185, 5e-4);
     });
 }
 
