@@ -8,7 +8,7 @@
 //!
 //! The 100k block is also run in a grid with ten times as many nodes (50 × 50 × 54 cells
 //! instead of 23 × 23 × 25): only the nodes the points reach should cost time, so the
-//! per-step cost should stay within 1.2× (issue #5).
+//! per-step cost should stay within 1.2×.
 //!
 //! And the 100k block with its points stored in random order (as after a flow has mixed
 //! them), left so (`sort_every = 0`) and after one spatial sort: what cell order is worth.

@@ -6,9 +6,8 @@
 //! loads its force, two columns of the same stride: the load matches the store in those bits,
 //! and on the AMD Zen 3 cores measured here whether the processor then takes it for a
 //! dependent load depends also on higher address bits, that is on where the run's address
-//! layout put the two columns. Some layouts made particle-to-grid 1.5–4× slower for a whole
-//! run (the 1M block on 1 thread: 31, 42 or 53 ms a step by the run; 129 ms with the two
-//! columns 512 MiB apart, 34 ms with the force column moved by one page or by half a page).
+//! layout put the two columns. Some layouts made particle-to-grid several times slower for a
+//! whole run (the measurements are in docs/performance.md, "Figures behind the code").
 //!
 //! [`Coloured`] gives each large block its own "colour": it takes a block a page and a word
 //! longer from the system and starts the large block in it at a chosen cache line of a page,

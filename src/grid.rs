@@ -105,7 +105,7 @@ pub struct Grid<D: Dim> {
     pub cell_size: f64,
     /// 1 / h (1/m). Each [`Axis`] holds it too, for the shape functions' slopes; this copy is
     /// what [`Grid::grid_coordinate`] scales by, since reading `axes[0]`'s there instead
-    /// changed the transfer kernels' code by ~10 instructions a particle-step (3D block).
+    /// lengthened the transfer kernels' code (docs/performance.md).
     pub inv_h: f64,
     /// Each axis as cell indices and shape functions use it: its cells and 1/h (unused
     /// axes: no cells).
@@ -304,7 +304,8 @@ impl<D: Dim> Grid<D> {
 }
 
 /// One axis of a grid as cell indices and shape functions use it, with the bounds they clamp
-/// to already in floating point (converting the cell count on every call cost ~3 % of a step).
+/// to already in floating point (converting the cell count on every call showed in a
+/// step's time; docs/performance.md).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Axis {
     /// Number of cells.

@@ -119,8 +119,7 @@ impl<D: Dim> Simulation<D> {
     /// The loop runs on a thread of the current rayon pool (the global one unless called
     /// inside `ThreadPool::install`). Called from any other thread, every parallel loop of
     /// every step would hand its work over to the pool and put the caller to sleep until it
-    /// is done: two thread wake-ups per loop, about 15 % of a step of the 2D slope on one
-    /// thread.
+    /// is done: two thread wake-ups per loop (their cost is in docs/performance.md).
     pub fn run(&mut self, mut observe: impl FnMut(&SolverState) + Send) -> Result<(), StepError> {
         self.run_with(|sim| {
             observe(&sim.ctx.state);

@@ -440,8 +440,8 @@ impl Material for MohrCoulomb {
     fn p_wave_modulus(&self) -> f64 {
         self.elasticity.p_wave()
     }
-    // Always: with a hint alone the one-point update was not inlined into its callers
-    // (`cargo bench --bench kernels -- Mohr`: 99 against 91 ns a plastic point).
+    // Always: with a hint alone the one-point update was not inlined into its callers,
+    // which costs a plastic point time (docs/performance.md).
     #[inline(always)]
     fn update(&self, stress: &mut Sym3, de: &Sym3, plastic: &mut PlasticStrain) {
         let (settled, correction) = self.settle(*stress + self.elasticity.stress_increment(de));

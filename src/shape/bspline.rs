@@ -43,8 +43,8 @@ impl Shape for QuadraticBSpline {
     /// Row by row along x: with v̄ = Σ_i w_i v_i and v' = Σ_i w_i' v_i over a row's three
     /// nodes, the row adds v' w_r to the x column of L, v̄ ∂w_r/∂y and v̄ ∂w_r/∂z to the
     /// others and v̄ w_r to the velocity. Node by node, each node formed its own gradient
-    /// and outer product; this is a third of the multiply-adds in 3D (slope_3d's kinematics
-    /// 1.93 → 1.27 ms a step on 2 threads), equal to them up to round-off.
+    /// and outer product; this is a third of the multiply-adds in 3D (docs/performance.md),
+    /// equal to them up to round-off.
     #[inline(always)]
     fn gather_with_gradient<D: Dim>(
         grid: &Grid<D>,
@@ -68,7 +68,7 @@ impl Shape for QuadraticBSpline {
 
     /// Row by row along x, as the gather: with P = −Vσ, node i of a row gets w_i (w_r m),
     /// w_i (w_r q) and w_i' a + w_i b, where a = P_x w_r and b = P_y ∂w_r/∂y + P_z ∂w_r/∂z:
-    /// no node forms its own gradient or σ·∇w (slope_3d's p2g 2.70 → 1.99 ms a step).
+    /// no node forms its own gradient or σ·∇w (docs/performance.md).
     #[inline(always)]
     fn scatter_with_gradient<D: Dim>(
         grid: &Grid<D>,

@@ -31,7 +31,7 @@ impl Shape for Linear {
     /// derivatives, and their x-weights are 1 − f and f with slopes ∓1/h, so with
     /// v̄ = v0 + f (v1 − v0) the row adds (v1 − v0) w_r/h to the x column of L, v̄ ∂w_r/∂y and
     /// v̄ ∂w_r/∂z to the others and v̄ w_r to the velocity: about half the arithmetic of two
-    /// nodes' outer products (kinematics 458 → 358 instructions a point in 3D).
+    /// nodes' outer products (docs/performance.md).
     #[inline(always)]
     fn gather_with_gradient<D: Dim>(
         grid: &Grid<D>,

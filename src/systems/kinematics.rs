@@ -21,8 +21,8 @@ use std::marker::PhantomData;
 ///
 /// The scatters' grouping of points ([`crate::parallel::SlabCache`]) depends on the cell of
 /// each point alone, so it is dropped only when a point moved into another cell: in a body
-/// near rest most steps keep it, and particle-to-grid skips its counting sort (about 80 of
-/// its 520 instructions a point in the 3D block).
+/// near rest most steps keep it, and particle-to-grid skips its counting sort (a sixth of
+/// its work a point; docs/performance.md).
 #[derive(Debug)]
 pub struct Kinematics<D, S> {
     gradient: bool,

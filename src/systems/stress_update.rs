@@ -19,9 +19,7 @@ use std::marker::PhantomData;
 ///
 /// Points go four at a time, one per SIMD lane ([`crate::lanes`]): the rotation always, and
 /// the material's update when the four share a material (each gets the bits it would get
-/// alone). In the 3D elastic block (1M points, 1 thread) this took the stress update from
-/// 28.8 to 12.0 ns a point; in the 2D slope, whose Mohr-Coulomb points are tested for
-/// yield in lanes, from 15.6 to 5.9 s of its 28 131 steps on 2 threads.
+/// alone); the gain is in docs/performance.md ("Figures behind the code").
 #[derive(Debug, Default)]
 pub struct StressUpdate;
 
