@@ -81,8 +81,8 @@ fn run_and_continue<D: Dim>(sim: &mut Simulation<D>) -> Rest {
     // Static: ten more seconds move nothing by more than 1 cm.
     let (mut before, mut after) = (Vec::new(), Vec::new());
     positions::<D>(&sim.ctx.world, &mut before);
-    let steps = (10.0 / sim.ctx.state.dt).ceil() as u64;
-    for _ in 0..steps {
+    let more = (10.0 / sim.ctx.state.dt).ceil() as u64;
+    for _ in 0..more {
         sim.step().expect("continuing stays stable");
     }
     positions::<D>(&sim.ctx.world, &mut after);
