@@ -315,24 +315,16 @@ fn plot(fos: &FosReport, rows: &[&Trial]) -> String {
                 .fold(u_hi, f64::min);
             let (y0, y1) = crate::output::plots::log_range([u_lo, u_hi].into_iter());
             let pad = 0.05 * (f1 - f0).max(1e-3);
-            let mut c = ChartBuilder::on(&root)
-                .caption(
-                    format!(
-                        "Strength reduction: F = {:.3} (bracket {:.4}–{:.4})",
-                        fos.factor_of_safety, fos.bracket[0], fos.bracket[1]
-                    ),
-                    ("sans-serif", 22),
-                )
-                .margin(20)
-                .x_label_area_size(50)
-                .y_label_area_size(90)
-                .build_cartesian_2d((f0 - pad)..(f1 + pad), (y0..y1).log_scale())?;
-            c.configure_mesh()
-                .x_desc("strength reduction factor F")
-                .y_desc("largest displacement (m)")
-                .y_label_formatter(&|v| format!("{v:.0e}"))
-                .label_style(("sans-serif", 15))
-                .draw()?;
+            let mut c = crate::output::plots::log_chart(
+                &root,
+                &format!(
+                    "Strength reduction: F = {:.3} (bracket {:.4}–{:.4})",
+                    fos.factor_of_safety, fos.bracket[0], fos.bracket[1]
+                ),
+                ((f0 - pad)..(f1 + pad), "strength reduction factor F"),
+                ((y0, y1), "largest displacement (m)"),
+                90,
+            )?;
             c.draw_series(std::iter::once(Rectangle::new(
                 [(fos.bracket[0], y0), (fos.bracket[1], y1)],
                 RED.mix(0.15).filled(),

@@ -148,10 +148,6 @@ fn a_checkpoint_of_another_scene_is_refused() {
 
 // ---- The binary: files on disk -------------------------------------------------------
 
-fn scratch(name: &str) -> PathBuf {
-    common::scratch("resume", name)
-}
-
 /// summary.json without the figures of wall time, memory and per-system cost.
 fn summary_numbers(dir: &Path) -> serde_json::Value {
     let text = std::fs::read_to_string(dir.join("summary.json")).unwrap();
@@ -212,7 +208,7 @@ fn copy_dir(from: &Path, to: &Path) {
 /// Runs `scene` to its end on 2 threads with checkpoints every `every` steps, keeps its
 /// results, resumes from the last checkpoint on 1 thread and compares.
 fn resume_from_last_checkpoint(scene: &str, every: u64, sets: &[&str]) {
-    let dir = scratch(scene);
+    let dir = common::scratch("resume", scene);
     let out = dir.join("run");
     let path = common::scene(scene);
     let checkpoint = format!("solver.checkpoint_every=Steps({every})");
@@ -277,7 +273,7 @@ fn the_slope_resumed_from_the_middle_of_its_run_writes_the_same_files() {
 
 #[test]
 fn ctrl_c_checkpoints_and_a_resumed_run_writes_the_files_of_one_never_interrupted() {
-    let dir = scratch("ctrl-c");
+    let dir = common::scratch("resume", "ctrl-c");
     let path = common::scene("slope.ron");
     let scene = path.to_str().unwrap();
     let (whole, cut) = (dir.join("whole"), dir.join("cut"));
@@ -327,7 +323,7 @@ fn ctrl_c_checkpoints_and_a_resumed_run_writes_the_files_of_one_never_interrupte
 
 #[test]
 fn a_new_run_into_a_directory_drops_the_checkpoint_of_the_run_before() {
-    let dir = scratch("stale");
+    let dir = common::scratch("resume", "stale");
     let out = dir.join("out");
     let (bar, column) = (common::scene("bar.ron"), common::scene("soil_column.ron"));
     let run = |scene: &Path, sets: &[&str]| {

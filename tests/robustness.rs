@@ -11,10 +11,6 @@ use kdmpm::{AnySimulation, Dim2, FnSystem, StepError};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-fn scratch(name: &str) -> PathBuf {
-    common::scratch("robust", name)
-}
-
 /// `kdmpm check` of `scene` with `sets` exits 2 with one message holding every `expect`.
 fn refused(scene: &Path, sets: &[&str], expect: &[&str]) {
     let mut args = vec!["check", scene.to_str().unwrap()];
@@ -64,7 +60,7 @@ fn a_scene_without_load_is_refused_rather_than_converged() {
 #[test]
 fn an_undefined_ratio_is_an_empty_cell_never_met_and_never_nan() {
     // With gravity ramping from 0, the first step has no external force at all.
-    let dir = scratch("undefined");
+    let dir = common::scratch("robust", "undefined");
     let out = dir.join("out");
     let sets = [
         "--set",
@@ -109,7 +105,7 @@ fn non_finite_or_negative_tension_cutoffs_are_refused() {
 
 #[test]
 fn a_material_named_twice_is_refused() {
-    let dir = scratch("twice");
+    let dir = common::scratch("robust", "twice");
     let text = std::fs::read_to_string(column()).unwrap().replace(
         "\"soil\": MohrCoulomb(",
         "\"soil\": LinearElastic(density: 1.0, youngs_modulus: 1.0, poisson_ratio: 0.0),\n        \"soil\": MohrCoulomb(",
@@ -266,7 +262,7 @@ fn overrides_are_parsed_strictly_and_errors_point_into_the_file_as_written() {
 
 #[test]
 fn an_override_on_a_file_with_an_unterminated_string_is_an_error_not_a_panic() {
-    let dir = scratch("unterminated");
+    let dir = common::scratch("robust", "unterminated");
     let scene = dir.join("s.ron");
     for text in [
         "Scene(materials: {\"soil",
@@ -290,7 +286,7 @@ fn an_override_on_a_file_with_an_unterminated_string_is_an_error_not_a_panic() {
 
 #[test]
 fn a_second_run_into_an_output_directory_in_use_is_refused() {
-    let dir = scratch("lock");
+    let dir = common::scratch("robust", "lock");
     let out = dir.join("out");
     let slope = common::scene("slope.ron");
     let mut first = Command::new(env!("CARGO_BIN_EXE_kdmpm"))
@@ -389,7 +385,7 @@ fn a_non_finite_value_stops_the_run_with_the_last_finite_state() {
 #[test]
 fn a_failed_run_writes_neither_null_nor_nan() {
     // The column without its fixed base falls through the bottom of the grid (exit 1).
-    let dir = scratch("failed");
+    let dir = common::scratch("robust", "failed");
     let out = dir.join("out");
     let column = common::scene("soil_column.ron");
     let o = common::kdmpm(&[

@@ -10,10 +10,6 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
-fn scratch(name: &str) -> PathBuf {
-    common::scratch("features", name)
-}
-
 /// `kdmpm ARGS` with `--set`s, waited for at most `limit`: a hang fails the test.
 fn kdmpm_within(args: &[&str], sets: &[&str], limit: Duration) -> Output {
     let mut cmd = Command::new(env!("CARGO_BIN_EXE_kdmpm"));
@@ -168,7 +164,7 @@ fn two_motions_over_one_node_are_refused() {
 /// max_steps for ever.
 #[test]
 fn a_load_in_billions_of_increments_stops_at_max_steps() {
-    let dir = scratch("increments");
+    let dir = common::scratch("features", "increments");
     let scene = common::scene("footing_load.ron");
     let o = kdmpm_within(
         &[
@@ -209,7 +205,7 @@ fn slope_with_strength_in_a_stage() -> PathBuf {
              reset_displacements: true)],\n    solver: ("
         ),
     );
-    let path = scratch("fos-staged").join("slope_staged_strength.ron");
+    let path = common::scratch("features", "fos-staged").join("slope_staged_strength.ron");
     std::fs::write(&path, text).unwrap();
     path
 }
@@ -274,7 +270,7 @@ fn a_bisection_finer_than_a_trial_resolves_is_refused() {
 
 #[test]
 fn fos_into_a_path_that_cannot_be_a_directory_is_bad_input() {
-    let dir = scratch("fos-out");
+    let dir = common::scratch("features", "fos-out");
     let file = dir.join("a-file");
     std::fs::write(&file, "").unwrap();
     let scene = common::scene("slope_fos.ron");
@@ -367,7 +363,7 @@ fn a_scene_over_the_address_space_limit_is_refused_quickly() {
 /// drawing it never returned.
 #[test]
 fn a_huge_tolerance_draws_its_plots_and_plot_returns() {
-    let dir = scratch("huge-tolerance");
+    let dir = common::scratch("features", "huge-tolerance");
     let scene = common::scene("bar.ron");
     let o = kdmpm_within(
         &[
@@ -392,7 +388,7 @@ fn a_huge_tolerance_draws_its_plots_and_plot_returns() {
 /// leaves nothing old looking current.
 #[test]
 fn a_new_run_leaves_no_earlier_result_or_partial_file_beside_its_history() {
-    let dir = scratch("stale-results");
+    let dir = common::scratch("features", "stale-results");
     for f in [
         "summary.json",
         "points.vtu",
@@ -436,7 +432,7 @@ fn a_new_run_leaves_no_earlier_result_or_partial_file_beside_its_history() {
 /// checkpoints and exits 130, and resumes.
 #[test]
 fn sigterm_checkpoints_like_ctrl_c() {
-    let dir = scratch("sigterm");
+    let dir = common::scratch("features", "sigterm");
     let scene = common::scene("slope.ron");
     let child = Command::new(env!("CARGO_BIN_EXE_kdmpm"))
         .args([
@@ -484,7 +480,7 @@ fn study_file(dir: &Path, name: &str, text: &str) -> PathBuf {
 /// is not static (52 %, all on the Pareto front); the study now stops and says so.
 #[test]
 fn a_study_refuses_a_reference_run_that_did_not_converge() {
-    let dir = scratch("study-reference");
+    let dir = common::scratch("features", "study-reference");
     let study = study_file(
         &dir,
         "s.ron",
@@ -521,7 +517,7 @@ fn a_study_refuses_a_reference_run_that_did_not_converge() {
 /// holding its directory, and the study exits 130.
 #[test]
 fn sigterm_to_a_study_stops_its_run_and_waits_for_it() {
-    let dir = scratch("study-sigterm");
+    let dir = common::scratch("features", "study-sigterm");
     let study = study_file(
         &dir,
         "s.ron",

@@ -5,13 +5,9 @@
 //! continues the series.
 
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 mod common;
-
-fn scratch(name: &str) -> PathBuf {
-    common::scratch("snapshots", name)
-}
 
 /// (time, file) of every DataSet of a collection, parsed as XML.
 fn read_pvd(path: &Path) -> Vec<(f64, String)> {
@@ -94,7 +90,7 @@ fn history_times(dir: &Path) -> BTreeMap<u64, f64> {
 
 #[test]
 fn the_series_reads_back_with_history_times_and_summary_values() {
-    let out = scratch("series");
+    let out = common::scratch("snapshots", "series");
     let column = common::scene("soil_column.ron");
     let o = common::kdmpm(&[
         "run",
@@ -200,7 +196,7 @@ fn a_resumed_run_continues_the_series_of_the_run_it_resumes() {
     // The bar, checkpointed every 300 steps and stopped by max_steps at 700, then resumed
     // with a longer limit: the series holds the first run's snapshots up to its checkpoint
     // (step 600) and the resumed run's after it, each once.
-    let out = scratch("resume");
+    let out = common::scratch("snapshots", "resume");
     let bar = common::scene("bar.ron");
     let first = common::kdmpm(&[
         "run",

@@ -250,6 +250,39 @@ pub(crate) fn log_range(v: impl Iterator<Item = f64>) -> (f64, f64) {
 /// The most decades a log axis spans.
 const MAX_DECADES: i32 = 40;
 
+/// A chart with a linear x axis and a log y axis.
+pub(crate) type LogChart<'a, 'b> = ChartContext<
+    'a,
+    SVGBackend<'b>,
+    Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::combinators::LogCoord<f64>>,
+>;
+
+/// The house style of a log chart: its caption, a linear x axis over `x` and a log y axis
+/// over `y` (from [`log_range`]), each with its label, ticks as powers of ten, and
+/// `y_labels` pixels for the y labels; the mesh is drawn.
+pub(crate) fn log_chart<'a, 'b>(
+    root: &'a DrawingArea<SVGBackend<'b>, plotters::coord::Shift>,
+    caption: &str,
+    x: (std::ops::Range<f64>, &str),
+    y: ((f64, f64), &str),
+    y_labels: u32,
+) -> Result<LogChart<'a, 'b>> {
+    let ((y0, y1), y_desc) = y;
+    let mut c = ChartBuilder::on(root)
+        .caption(caption, ("sans-serif", 22))
+        .margin(20)
+        .x_label_area_size(50)
+        .y_label_area_size(y_labels)
+        .build_cartesian_2d(x.0, (y0..y1).log_scale())?;
+    c.configure_mesh()
+        .x_desc(x.1)
+        .y_desc(y_desc)
+        .y_label_formatter(&|v| format!("{v:.0e}"))
+        .label_style(("sans-serif", 15))
+        .draw()?;
+    Ok(c)
+}
+
 fn time_range(t: &[f64]) -> (f64, f64) {
     let hi = t.iter().copied().filter(|x| x.is_finite()).fold(0.0f64, f64::max);
     (0.0, if hi > 0.0 { hi } else { 1.0 })
@@ -276,21 +309,13 @@ fn kinetic_energy(t: &[f64], ke: &[f64], resets: &[f64]) -> String {
     svg((960, 600), |root| {
         let (y0, y1) = log_range(ke.iter().copied());
         let (x0, x1) = time_range(t);
-        let mut c = ChartBuilder::on(&root)
-            .caption(
-                "Kinetic energy (velocities reset at each peak)",
-                ("sans-serif", 22),
-            )
-            .margin(20)
-            .x_label_area_size(50)
-            .y_label_area_size(80)
-            .build_cartesian_2d(x0..x1, (y0..y1).log_scale())?;
-        c.configure_mesh()
-            .x_desc("simulated time t (s)")
-            .y_desc("kinetic energy E_k (J)")
-            .y_label_formatter(&|v| format!("{v:.0e}"))
-            .label_style(("sans-serif", 15))
-            .draw()?;
+        let mut c = log_chart(
+            &root,
+            "Kinetic energy (velocities reset at each peak)",
+            (x0..x1, "simulated time t (s)"),
+            ((y0, y1), "kinetic energy E_k (J)"),
+            80,
+        )?;
         let pts: Vec<(f64, f64)> = t
             .iter()
             .zip(ke)
@@ -325,21 +350,13 @@ fn ratios(t: &[f64], kf: &[f64], ke: &[f64], tolerance: Option<f64>) -> String {
     svg((960, 600), |root| {
         let (y0, y1) = log_range(kf.iter().chain(ke).copied().chain(tolerance));
         let (x0, x1) = time_range(t);
-        let mut c = ChartBuilder::on(&root)
-            .caption(
-                "Convergence: force ratio K_F and energy ratio K_E",
-                ("sans-serif", 22),
-            )
-            .margin(20)
-            .x_label_area_size(50)
-            .y_label_area_size(80)
-            .build_cartesian_2d(x0..x1, (y0..y1).log_scale())?;
-        c.configure_mesh()
-            .x_desc("simulated time t (s)")
-            .y_desc("ratio (dimensionless)")
-            .y_label_formatter(&|v| format!("{v:.0e}"))
-            .label_style(("sans-serif", 15))
-            .draw()?;
+        let mut c = log_chart(
+            &root,
+            "Convergence: force ratio K_F and energy ratio K_E",
+            (x0..x1, "simulated time t (s)"),
+            ((y0, y1), "ratio (dimensionless)"),
+            80,
+        )?;
         let series = |v: &[f64]| -> Vec<(f64, f64)> {
             t.iter()
                 .zip(v)
