@@ -22,7 +22,10 @@ use crate::grid::NodeBox;
 use crate::parallel::SlabCache;
 use crate::point_components;
 use crate::simulation::Simulation;
-use crate::state::{CurvePoint, Drive, Peak, SolverState, StageResult, StopReason};
+use crate::state::{
+    Clock, Control, Convergence, CurvePoint, Drive, EnergyWindow, Peak, RankCounters, Resets, SolverState,
+    StageResult, StaticWindow,
+};
 use hecs::Archetype;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
@@ -30,7 +33,7 @@ use thiserror::Error;
 /// The first bytes of a checkpoint file.
 const MAGIC: &[u8; 8] = b"KDMPMCK\0";
 /// Format version; a file of another version is refused.
-const VERSION: u32 = 7;
+const VERSION: u32 = 8;
 /// The build that writes and reads checkpoints: the crate's version and a fingerprint of
 /// its sources (build.rs).
 pub const BUILD_ID: &str = concat!(env!("CARGO_PKG_VERSION"), "+", env!("KDMPM_SOURCE_HASH"));
@@ -227,22 +230,25 @@ fn check_ids<D: Dim>(sim: &Simulation<D>, state: &SolverState) -> Result<(), Str
         }
     }
     let settings = &sim.ctx.settings;
-    if state.drives.len() != settings.motions.len() {
+    if state.control.drives.len() != settings.motions.len() {
         return Err(format!(
             "{} motions saved, the scene has {}",
-            state.drives.len(),
+            state.control.drives.len(),
             settings.motions.len()
         ));
     }
-    if state.stage >= settings.stages.len().max(1) || state.stages.len() > settings.stages.len() {
+    if state.control.stage >= settings.stages.len().max(1)
+        || state.control.stages.len() > settings.stages.len()
+    {
         return Err(format!(
             "stage {} saved, the scene has {} stages",
-            state.stage,
+            state.control.stage,
             settings.stages.len()
         ));
     }
-    if state.load_increments.len() > settings.load_steps.len()
+    if state.control.load_increments.len() > settings.load_steps.len()
         || state
+            .control
             .load_increments
             .iter()
             .zip(&settings.load_steps)
@@ -250,11 +256,11 @@ fn check_ids<D: Dim>(sim: &Simulation<D>, state: &SolverState) -> Result<(), Str
     {
         return Err("the loads' increments saved do not fit the scene's loads".into());
     }
-    if !state.static_window_snapshot.is_empty() && state.static_window_snapshot.len() != count {
+    if !state.static_window.snapshot.is_empty() && state.static_window.snapshot.len() != count {
         return Err("the static check's saved positions do not fit the scene's points".into());
     }
-    if !(state.dt.is_finite() && state.dt > 0.0 && state.time.is_finite()) {
-        return Err("the saved time or time step is not a finite number".into());
+    if !state.clock.time.is_finite() {
+        return Err("the saved time is not a finite number".into());
     }
     Ok(())
 }
@@ -268,103 +274,219 @@ unsafe fn as_bytes<T: Copy>(column: &[T]) -> &[u8] {
     unsafe { std::slice::from_raw_parts(column.as_ptr().cast::<u8>(), std::mem::size_of_val(column)) }
 }
 
+/// The solver state, part by part. What is not saved is said here: the stop (a checkpoint
+/// is taken between steps of a run that goes on), the MPI counters (checkpoints are of one
+/// rank) and the per-step node box (rebuilt by the next step).
 fn encode_state(w: &mut Writer, s: &SolverState) {
-    w.u64(s.step);
-    w.f64(s.time);
-    w.f64(s.dt);
-    w.f64(s.kinetic_energy);
-    w.f64(s.previous_kinetic_energy);
-    w.f64(s.earlier_kinetic_energy);
-    w.f64(s.reset_fraction);
-    w.f64(s.external_work);
-    w.f64(s.force_ratio_max);
-    w.f64(s.force_ratio_mean);
-    w.f64(s.energy_ratio);
-    w.u64(s.resets);
-    w.u8(s.reset_this_step as u8);
-    w.u8(s.points_reordered as u8);
-    w.u64(s.peaks.len() as u64);
-    for p in &s.peaks {
-        w.f64(p.time);
-        w.f64(p.energy);
-    }
-    // A checkpoint is taken between steps of a run that goes on: no stop reason.
-    w.opt(s.static_window_start);
-    w.opt(s.static_window_movement);
-    w.u64(s.static_window_snapshot.len() as u64);
-    for x in &s.static_window_snapshot {
-        x.iter().for_each(|&c| w.f64(c));
-    }
-    w.u64(s.drives.len() as u64);
-    for d in &s.drives {
-        w.str(&d.name);
-        w.u8(d.axes);
-        d.velocity.iter().chain(&d.reaction).for_each(|&c| w.f64(c));
-        w.f64(d.travel);
-        w.u64(d.increments as u64);
-    }
-    w.u64(s.curve.len() as u64);
-    for c in &s.curve {
-        w.str(&c.name);
-        w.u64(c.step);
-        w.f64(c.time);
-        w.f64(c.displacement);
-        c.force.iter().for_each(|&f| w.f64(f));
-        w.opt(c.pressure);
-    }
-    w.u64(s.stage as u64);
-    w.u64(s.stages.len() as u64);
-    for st in &s.stages {
-        w.str(&st.name);
-        w.u64(st.step);
-        w.f64(st.time);
-        w.f64(st.force_ratio);
-        w.f64(st.energy_ratio);
-        w.u64(st.resets);
-    }
-    w.u64(s.load_increments.len() as u64);
-    s.load_increments.iter().for_each(|&k| w.u64(k as u64));
-    w.u8(s.force_reference.is_some() as u8);
-    s.force_reference
-        .unwrap_or_default()
-        .iter()
-        .for_each(|&f| w.f64(f));
+    let SolverState {
+        clock,
+        energy,
+        resets,
+        convergence,
+        static_window,
+        stop: _,
+        control,
+        ranks: _,
+        active_nodes: _,
+        points_reordered,
+    } = s;
+    encode_clock(w, clock);
+    energy.to_array().iter().for_each(|&e| w.f64(e));
+    encode_resets(w, resets);
+    encode_convergence(w, convergence);
+    encode_static_window(w, static_window);
+    encode_control(w, control);
+    w.u8(*points_reordered as u8);
 }
 
 fn decode_state(r: &mut Reader) -> Result<SolverState, CheckpointError> {
-    let mut s = SolverState {
+    Ok(SolverState {
+        clock: decode_clock(r)?,
+        energy: EnergyWindow::from_array([r.f64()?, r.f64()?, r.f64()?]),
+        resets: decode_resets(r)?,
+        convergence: decode_convergence(r)?,
+        static_window: decode_static_window(r)?,
+        stop: None,
+        control: decode_control(r)?,
+        ranks: RankCounters::default(),
+        active_nodes: NodeBox::default(),
+        points_reordered: r.u8()? == 1,
+    })
+}
+
+fn encode_clock(w: &mut Writer, c: &Clock) {
+    let Clock { step, time } = c;
+    w.u64(*step);
+    w.f64(*time);
+}
+
+fn decode_clock(r: &mut Reader) -> Result<Clock, CheckpointError> {
+    Ok(Clock {
         step: r.u64()?,
         time: r.f64()?,
-        dt: r.f64()?,
-        kinetic_energy: r.f64()?,
-        previous_kinetic_energy: r.f64()?,
-        earlier_kinetic_energy: r.f64()?,
-        reset_fraction: r.f64()?,
-        external_work: r.f64()?,
-        force_ratio_max: r.f64()?,
-        force_ratio_mean: r.f64()?,
-        energy_ratio: r.f64()?,
-        resets: r.u64()?,
-        reset_this_step: r.u8()? == 1,
-        points_reordered: r.u8()? == 1,
-        ..SolverState::default()
-    };
-    let peaks = r.u64()?;
-    for _ in 0..peaks {
-        s.peaks.push(Peak {
+    })
+}
+
+fn encode_resets(w: &mut Writer, s: &Resets) {
+    let Resets {
+        count,
+        peaks,
+        this_step,
+        fraction,
+    } = s;
+    w.u64(*count);
+    w.u64(peaks.len() as u64);
+    for Peak { time, energy } in peaks {
+        w.f64(*time);
+        w.f64(*energy);
+    }
+    w.u8(*this_step as u8);
+    w.f64(*fraction);
+}
+
+fn decode_resets(r: &mut Reader) -> Result<Resets, CheckpointError> {
+    let count = r.u64()?;
+    let mut peaks = Vec::new();
+    for _ in 0..r.u64()? {
+        peaks.push(Peak {
             time: r.f64()?,
             energy: r.f64()?,
         });
     }
-    s.stop = None::<StopReason>;
-    s.static_window_start = r.opt()?;
-    s.static_window_movement = r.opt()?;
-    let n = r.u64()?;
-    for _ in 0..n {
-        s.static_window_snapshot.push([r.f64()?, r.f64()?, r.f64()?]);
+    Ok(Resets {
+        count,
+        peaks,
+        this_step: r.u8()? == 1,
+        fraction: r.f64()?,
+    })
+}
+
+fn encode_convergence(w: &mut Writer, c: &Convergence) {
+    let Convergence {
+        external_work,
+        force_ratio_max,
+        force_ratio_mean,
+        energy_ratio,
+        force_reference,
+    } = c;
+    w.f64(*external_work);
+    w.f64(*force_ratio_max);
+    w.f64(*force_ratio_mean);
+    w.f64(*energy_ratio);
+    w.u8(force_reference.is_some() as u8);
+    force_reference.unwrap_or_default().iter().for_each(|&f| w.f64(f));
+}
+
+fn decode_convergence(r: &mut Reader) -> Result<Convergence, CheckpointError> {
+    Ok(Convergence {
+        external_work: r.f64()?,
+        force_ratio_max: r.f64()?,
+        force_ratio_mean: r.f64()?,
+        energy_ratio: r.f64()?,
+        force_reference: {
+            let some = r.u8()? == 1;
+            let reference = [r.f64()?, r.f64()?];
+            some.then_some(reference)
+        },
+    })
+}
+
+fn encode_static_window(w: &mut Writer, s: &StaticWindow) {
+    let StaticWindow {
+        start,
+        movement,
+        snapshot,
+    } = s;
+    w.opt(*start);
+    w.opt(*movement);
+    w.u64(snapshot.len() as u64);
+    for x in snapshot {
+        x.iter().for_each(|&c| w.f64(c));
     }
+}
+
+fn decode_static_window(r: &mut Reader) -> Result<StaticWindow, CheckpointError> {
+    let (start, movement) = (r.opt()?, r.opt()?);
+    let mut snapshot = Vec::new();
     for _ in 0..r.u64()? {
-        s.drives.push(Drive {
+        snapshot.push([r.f64()?, r.f64()?, r.f64()?]);
+    }
+    Ok(StaticWindow {
+        start,
+        movement,
+        snapshot,
+    })
+}
+
+fn encode_control(w: &mut Writer, c: &Control) {
+    let Control {
+        drives,
+        curve,
+        stage,
+        stages,
+        load_increments,
+        milestone,
+    } = c;
+    w.u64(drives.len() as u64);
+    for d in drives {
+        let Drive {
+            name,
+            axes,
+            velocity,
+            reaction,
+            travel,
+            increments,
+        } = d;
+        w.str(name);
+        w.u8(*axes);
+        velocity.iter().chain(reaction).for_each(|&c| w.f64(c));
+        w.f64(*travel);
+        w.u64(*increments as u64);
+    }
+    w.u64(curve.len() as u64);
+    for c in curve {
+        let CurvePoint {
+            name,
+            step,
+            time,
+            displacement,
+            force,
+            pressure,
+        } = c;
+        w.str(name);
+        w.u64(*step);
+        w.f64(*time);
+        w.f64(*displacement);
+        force.iter().for_each(|&f| w.f64(f));
+        w.opt(*pressure);
+    }
+    w.u64(*stage as u64);
+    w.u64(stages.len() as u64);
+    for st in stages {
+        let StageResult {
+            name,
+            step,
+            time,
+            force_ratio,
+            energy_ratio,
+            resets,
+        } = st;
+        w.str(name);
+        w.u64(*step);
+        w.f64(*time);
+        w.f64(*force_ratio);
+        w.f64(*energy_ratio);
+        w.u64(*resets);
+    }
+    w.u64(load_increments.len() as u64);
+    load_increments.iter().for_each(|&k| w.u64(k as u64));
+    w.u8(*milestone as u8);
+}
+
+fn decode_control(r: &mut Reader) -> Result<Control, CheckpointError> {
+    let mut c = Control::default();
+    for _ in 0..r.u64()? {
+        c.drives.push(Drive {
             name: r.str()?,
             axes: r.u8()?,
             velocity: [r.f64()?, r.f64()?, r.f64()?],
@@ -374,7 +496,7 @@ fn decode_state(r: &mut Reader) -> Result<SolverState, CheckpointError> {
         });
     }
     for _ in 0..r.u64()? {
-        s.curve.push(CurvePoint {
+        c.curve.push(CurvePoint {
             name: r.str()?,
             step: r.u64()?,
             time: r.f64()?,
@@ -383,9 +505,9 @@ fn decode_state(r: &mut Reader) -> Result<SolverState, CheckpointError> {
             pressure: r.opt()?,
         });
     }
-    s.stage = r.u64()? as usize;
+    c.stage = r.u64()? as usize;
     for _ in 0..r.u64()? {
-        s.stages.push(StageResult {
+        c.stages.push(StageResult {
             name: r.str()?,
             step: r.u64()?,
             time: r.f64()?,
@@ -395,12 +517,10 @@ fn decode_state(r: &mut Reader) -> Result<SolverState, CheckpointError> {
         });
     }
     for _ in 0..r.u64()? {
-        s.load_increments.push(r.u64()? as u32);
+        c.load_increments.push(r.u64()? as u32);
     }
-    let some = r.u8()? == 1;
-    let reference = [r.f64()?, r.f64()?];
-    s.force_reference = some.then_some(reference);
-    Ok(s)
+    c.milestone = r.u8()? == 1;
+    Ok(c)
 }
 
 struct Writer(Vec<u8>);

@@ -91,7 +91,7 @@ pub struct NodeVelocity<V>(pub V);
 
 /// Constrained velocity components of a node: bit `a` (0–2) set means axis `a` is held,
 /// at zero, or, when the high four bits name a prescribed motion (its index + 1 in
-/// [`crate::state::SolverState::drives`]) that drives the axis, at its velocity.
+/// [`crate::state::Control::drives`]) that drives the axis, at its velocity.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub struct NodeFixity(pub u8);
 

@@ -36,6 +36,13 @@ pub struct Context<D: Dim> {
 }
 
 impl<D: Dim> Context<D> {
+    /// The time over which this step moves the points and integrates their strain (s): Δt,
+    /// a fraction of it at an interpolated kinetic-damping reset, `None` at a plain reset
+    /// ([`crate::state::Resets::motion_dt`]).
+    pub fn motion_dt(&self) -> Option<f64> {
+        self.state.resets.motion_dt(self.settings.dt)
+    }
+
     /// The node ids this rank owns when the run has several ranks (each node is owned by
     /// one rank, so sums over owned nodes add up over the ranks); `None` with one rank.
     pub fn owned_node_ids(&self) -> Option<Range<usize>> {

@@ -246,7 +246,7 @@ fn trial_run<D: Dim>(
             s.ctx.state.stop = Some(StopReason::Interrupted);
         }
         let st = &s.ctx.state;
-        if st.stop.is_none() && st.step.is_multiple_of(every) {
+        if st.stop.is_none() && st.clock.step.is_multiple_of(every) {
             let (u, _) = max_displacements(s).unwrap_or_default();
             if u > limit {
                 s.ctx.state.stop = Some(StopReason::DisplacementLimit);

@@ -524,9 +524,9 @@ fn drive<D: Dim>(
             scene.display(),
             sim.point_count(),
             D::N,
-            sim.ctx.state.dt,
-            if sim.ctx.state.step > 0 {
-                format!(", resumed at step {}", sim.ctx.state.step)
+            sim.ctx.settings.dt,
+            if sim.ctx.state.clock.step > 0 {
+                format!(", resumed at step {}", sim.ctx.state.clock.step)
             } else {
                 String::new()
             }
@@ -534,7 +534,11 @@ fn drive<D: Dim>(
     }
     let before = header.wall_seconds;
     let start = Instant::now();
-    let mut progress = Progress::new(options.quiet, loaded.scene.solver.tolerance, sim.ctx.state.step);
+    let mut progress = Progress::new(
+        options.quiet,
+        loaded.scene.solver.tolerance,
+        sim.ctx.state.clock.step,
+    );
     let mut last_checkpoint = Instant::now();
     let every = loaded.scene.solver.checkpoint_every;
     let save = |sim: &Simulation<D>, header: &mut checkpoint::Header| -> std::io::Result<()> {
@@ -552,7 +556,7 @@ fn drive<D: Dim>(
         let interrupted = INTERRUPTED.load(Ordering::SeqCst);
         let due = st.stop.is_none()
             && match every {
-                Some(CheckpointEvery::Steps(n)) => st.step.is_multiple_of(n),
+                Some(CheckpointEvery::Steps(n)) => st.clock.step.is_multiple_of(n),
                 Some(CheckpointEvery::Seconds(t)) => last_checkpoint.elapsed().as_secs_f64() >= t,
                 None => false,
             };

@@ -97,11 +97,11 @@ impl<D: Dim> Simulation<D> {
     /// Runs one explicit step.
     pub fn step(&mut self) -> Result<(), StepError> {
         let s = &mut self.ctx.state;
-        s.step += 1;
+        s.clock.step += 1;
         // time = n·Δt rather than a running sum, so long runs do not drift.
-        s.time = s.step as f64 * s.dt;
-        s.reset_this_step = false;
-        s.milestone = false;
+        s.clock.time = s.clock.step as f64 * self.ctx.settings.dt;
+        s.resets.this_step = false;
+        s.control.milestone = false;
         let result = self.schedule.run(&mut self.ctx);
         if self.ctx.state.points_reordered {
             for t in &mut self.traced {

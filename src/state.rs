@@ -111,6 +111,8 @@ pub struct StaticCheck {
 /// Settings fixed for the whole run (but for what a loading stage changes: gravity).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Settings {
+    /// Time step Δt (s), from the scene (`solver.time_step`).
+    pub dt: f64,
     /// Update scheme.
     pub scheme: Scheme,
     /// Damping.
@@ -356,26 +358,132 @@ pub struct CurvePoint {
     pub pressure: Option<f64>,
 }
 
-/// Solver-wide quantities updated by the systems every step.
+/// Solver-wide quantities updated by the systems every step, in named parts. The parts a
+/// checkpoint holds save and load themselves (`checkpoint.rs`), each by an exhaustive
+/// destructure, so that a field added to one cannot be left out of the file.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct SolverState {
+    /// Step count and simulated time.
+    pub clock: Clock,
+    /// The kinetic energy of the last three steps, which the peak watch reads.
+    pub energy: EnergyWindow,
+    /// The kinetic-damping resets so far and this step's.
+    pub resets: Resets,
+    /// K_F, K_E and the external work.
+    pub convergence: Convergence,
+    /// The static check's window.
+    pub static_window: StaticWindow,
+    /// Set when the run should stop after this step.
+    pub stop: Option<StopReason>,
+    /// Prescribed motions, their curve, the stages and the loads under control.
+    pub control: Control,
+    /// Counters of a run over MPI ranks.
+    pub ranks: RankCounters,
+    /// The nodes the points reached this step. Every node outside holds zeros (mass,
+    /// momentum, forces, acceleration, velocity), so grid passes skip it: a scatter adds the
+    /// nodes it reaches, the grid reset zeroes the box and empties it. Rebuilt each step.
+    pub active_nodes: NodeBox,
+    /// True when this step's spatial sort moved point data between rows: holders of row
+    /// indices or entities (traced points) must look their points up again by [`PointId`].
+    ///
+    /// [`PointId`]: crate::components::PointId
+    pub points_reordered: bool,
+}
+
+/// Step count and simulated time; Δt is a setting ([`Settings::dt`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Clock {
     /// Number of the current step (1-based while the schedule runs; steps done afterwards).
     pub step: u64,
     /// Simulated time at the end of the current step (s).
     pub time: f64,
-    /// Time step (s).
-    pub dt: f64,
-    /// Kinetic energy of the points after this step's velocity update, eq. (5) (J).
-    pub kinetic_energy: f64,
-    /// Kinetic energy the peak watch compares against (J); 0 after a reset.
-    pub previous_kinetic_energy: f64,
-    /// The kinetic energy of the step before that (J); 0 after a reset. With it the peak
-    /// watch fits a parabola through the last three energies.
-    pub earlier_kinetic_energy: f64,
+}
+
+/// The kinetic energy of the last three steps (J), from which the peak watch finds a peak
+/// (paper §2.2): the energy fell, so the step before was its peak.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct EnergyWindow {
+    current: f64,
+    previous: f64,
+    earlier: f64,
+}
+
+impl EnergyWindow {
+    /// Sets this step's kinetic energy, eq. (5) (J).
+    pub fn set(&mut self, energy: f64) {
+        self.current = energy;
+    }
+
+    /// This step's kinetic energy (J); 0 after a reset.
+    pub fn current(&self) -> f64 {
+        self.current
+    }
+
+    /// The energies of the steps n − 2, n − 1 and n (J) when step n − 1 was a peak
+    /// (E(n) < E(n − 1)); `None` otherwise.
+    pub fn peak(&self) -> Option<[f64; 3]> {
+        (self.current < self.previous).then_some([self.earlier, self.previous, self.current])
+    }
+
+    /// Moves the window on by a step that was no peak.
+    pub fn push(&mut self) {
+        self.earlier = self.previous;
+        self.previous = self.current;
+    }
+
+    /// Empties the window (at a reset, or as a stage begins): the next step cannot count
+    /// as a peak.
+    pub fn reset(&mut self) {
+        *self = EnergyWindow::default();
+    }
+
+    /// The three energies, earliest first, for a checkpoint.
+    pub fn to_array(&self) -> [f64; 3] {
+        [self.earlier, self.previous, self.current]
+    }
+
+    /// The window of three energies, earliest first, from a checkpoint.
+    pub fn from_array([earlier, previous, current]: [f64; 3]) -> Self {
+        EnergyWindow {
+            current,
+            previous,
+            earlier,
+        }
+    }
+}
+
+/// The kinetic-damping resets: how many, at which peaks, and this step's.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Resets {
+    /// Resets so far.
+    pub count: u64,
+    /// Every peak at which velocities were reset.
+    pub peaks: Vec<Peak>,
+    /// True when this step's peak watch zeroed the velocities (points move only by
+    /// `fraction`; see [`Resets::motion_dt`]).
+    pub this_step: bool,
     /// At a reset step, the fraction of Δt the points still move: 0 (they stay where the
     /// previous step left them) or, with `peak_interpolation`, the fitted peak's offset
     /// from that step in (−½, ½).
-    pub reset_fraction: f64,
+    pub fraction: f64,
+}
+
+impl Resets {
+    /// The time over which this step moves the points and integrates their strain (s): Δt,
+    /// or at a kinetic-damping reset the fitted peak's offset `fraction`·Δt; `None` when a
+    /// reset leaves the points where they are.
+    pub fn motion_dt(&self, dt: f64) -> Option<f64> {
+        match (self.this_step, self.fraction) {
+            (false, _) => Some(dt),
+            (true, f) if f != 0.0 => Some(f * dt),
+            _ => None,
+        }
+    }
+}
+
+/// The measures of the stopping rule (paper eqs. 3–6).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Convergence {
     /// Cumulative external work, eq. (6) (J).
     pub external_work: f64,
     /// K_F in the max-norm, eq. (3).
@@ -384,38 +492,40 @@ pub struct SolverState {
     pub force_ratio_mean: f64,
     /// K_E, eq. (4).
     pub energy_ratio: f64,
-    /// Number of kinetic-damping resets so far.
-    pub resets: u64,
-    /// True when this step's peak watch zeroed the velocities (points move only by
-    /// `reset_fraction`; see [`SolverState::motion_dt`]).
-    pub reset_this_step: bool,
-    /// True when this step's spatial sort moved point data between rows: holders of row
-    /// indices or entities (traced points) must look their points up again by [`PointId`].
-    ///
-    /// [`PointId`]: crate::components::PointId
-    pub points_reordered: bool,
-    /// Over MPI, the traced points' displacements (m) gathered from the ranks that hold
-    /// them this step (`output::history::TracedGather`); empty with one rank.
-    pub traced_displacements: Vec<[f64; 3]>,
-    /// Over MPI, the points this rank sent to another so far.
-    pub migrations: u64,
-    /// Over MPI, how many times the cell layers were split again.
-    pub rebalances: u64,
-    /// Every peak at which velocities were reset.
-    pub peaks: Vec<Peak>,
-    /// Set when the run should stop after this step.
-    pub stop: Option<StopReason>,
-    /// Time at which the current static-check window opened (s).
-    pub static_window_start: Option<f64>,
-    /// Largest point movement over the last completed static-check window (m).
-    pub static_window_movement: Option<f64>,
+    /// The external force K_F is measured against while none is applied (N: max and sum of
+    /// |F_ext| over free degrees of freedom): the last applied load's. A stage that removes
+    /// every load (gravity set to 0) relaxes towards an unloaded state, and its
+    /// out-of-balance force is judged against the load it took away; `None` before any
+    /// load acted.
+    pub force_reference: Option<[f64; 2]>,
+}
+
+impl Convergence {
+    /// K_F in the norm the stopping rule reads.
+    pub fn force_ratio(&self, norm: ForceNorm) -> f64 {
+        match norm {
+            ForceNorm::Max => self.force_ratio_max,
+            ForceNorm::Mean => self.force_ratio_mean,
+        }
+    }
+}
+
+/// The static check's window ([`StaticCheck`]).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct StaticWindow {
+    /// Time at which the current window opened (s).
+    pub start: Option<f64>,
+    /// Largest point movement over the last completed window (m).
+    pub movement: Option<f64>,
     /// Point positions (m, x y z, by [`PointId`](crate::components::PointId)) when the
-    /// current static-check window opened.
-    pub static_window_snapshot: Vec<[f64; 3]>,
-    /// The nodes the points reached this step. Every node outside holds zeros (mass,
-    /// momentum, forces, acceleration, velocity), so grid passes skip it: a scatter adds the
-    /// nodes it reaches, the grid reset zeroes the box and empties it.
-    pub active_nodes: NodeBox,
+    /// current window opened.
+    pub snapshot: Vec<[f64; 3]>,
+}
+
+/// What the control systems keep: prescribed motions and their curve, stages, loads
+/// under load control.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Control {
     /// Prescribed motions, in scene order (a node's [`NodeFixity::driver`]).
     ///
     /// [`NodeFixity::driver`]: crate::components::NodeFixity::driver
@@ -431,11 +541,25 @@ pub struct SolverState {
     /// True when a control system consumed a static state in this step (an increment or a
     /// stage ended): snapshot writers take one.
     pub milestone: bool,
-    /// The external force K_F is measured against while none is applied (N: max and sum of
-    /// |F_ext| over free degrees of freedom): the last applied load's. A stage that removes
-    /// every load (gravity set to 0) relaxes towards an unloaded state, and its out-of-balance
-    /// force is judged against the load it took away; `None` before any load acted.
-    pub force_reference: Option<[f64; 2]>,
+}
+
+impl Control {
+    /// True while a prescribed motion moves: not a static state, however balanced.
+    pub fn driving(&self) -> bool {
+        self.drives.iter().any(|d| d.velocity != [0.0; 3])
+    }
+}
+
+/// Counters of a run over MPI ranks (empty or zero on one rank).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct RankCounters {
+    /// The traced points' displacements (m) gathered from the ranks that hold them this
+    /// step (`output::history::TracedGather`); empty with one rank.
+    pub traced_displacements: Vec<[f64; 3]>,
+    /// The points this rank sent to another so far.
+    pub migrations: u64,
+    /// How many times the cell layers were split again.
+    pub rebalances: u64,
 }
 
 impl Settings {
@@ -446,42 +570,19 @@ impl Settings {
 }
 
 impl SolverState {
-    /// The time over which this step moves the points and integrates their strain (s): Δt,
-    /// or at a kinetic-damping reset the fitted peak's offset `reset_fraction`·Δt; `None`
-    /// when a reset leaves the points where they are.
-    pub fn motion_dt(&self) -> Option<f64> {
-        match (self.reset_this_step, self.reset_fraction) {
-            (false, _) => Some(self.dt),
-            (true, f) if f != 0.0 => Some(f * self.dt),
-            _ => None,
-        }
-    }
-
-    /// True while a prescribed motion moves: not a static state, however balanced.
-    pub fn driving(&self) -> bool {
-        self.drives.iter().any(|d| d.velocity != [0.0; 3])
-    }
-
     /// Goes on after a static state that a control system consumed (an increment, a
     /// stage): the stop is lifted unless the step or time limit is reached, which ends the
     /// run even while increments are left (a load in 10⁹ increments that each balance at
     /// once would otherwise never reach `max_steps`).
     pub fn go_on(&mut self, settings: &Settings) {
-        self.static_window_start = None;
-        self.stop = if settings.max_steps.is_some_and(|m| self.step >= m) {
+        self.static_window.start = None;
+        let Clock { step, time } = self.clock;
+        self.stop = if settings.max_steps.is_some_and(|m| step >= m) {
             Some(StopReason::MaxSteps)
-        } else if settings.max_time.is_some_and(|t| self.time >= t * (1.0 - 1e-12)) {
+        } else if settings.max_time.is_some_and(|t| time >= t * (1.0 - 1e-12)) {
             Some(StopReason::MaxTime)
         } else {
             None
         };
-    }
-
-    /// K_F in the norm the stopping rule reads.
-    pub fn force_ratio(&self, norm: ForceNorm) -> f64 {
-        match norm {
-            ForceNorm::Max => self.force_ratio_max,
-            ForceNorm::Mean => self.force_ratio_mean,
-        }
     }
 }

@@ -175,8 +175,8 @@ fn resets_placed_between_steps_move_the_points_to_the_fitted_peak() {
     let mut fractions = Vec::new();
     kdmpm::with_simulation!(&mut sim, s => {
         s.run(|st| {
-            if st.reset_this_step {
-                fractions.push(st.reset_fraction);
+            if st.resets.this_step {
+                fractions.push(st.resets.fraction);
             }
         })
         .unwrap();

@@ -54,16 +54,16 @@ struct Reference {
 fn reference<D: Dim>(sim: &mut Simulation<D>) -> Reference {
     let (mut resets, mut in_window) = (Vec::new(), Vec::new());
     sim.run(|s| {
-        if s.reset_this_step {
-            resets.push(s.step);
+        if s.resets.this_step {
+            resets.push(s.clock.step);
         }
-        if s.static_window_start.is_some() {
-            in_window.push(s.step);
+        if s.static_window.start.is_some() {
+            in_window.push(s.clock.step);
         }
     })
     .unwrap();
     Reference {
-        steps: sim.ctx.state.step,
+        steps: sim.ctx.state.clock.step,
         resets,
         in_window,
         end: bits(sim),

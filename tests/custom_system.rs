@@ -13,7 +13,7 @@ fn a_user_system_inserted_after_g2p_runs_every_step() {
     assert_eq!(names[at - 1], "g2p");
     sim.run(|_| {}).unwrap();
     let speeds = record.lock().unwrap();
-    assert_eq!(speeds.len() as u64, sim.ctx.state.step);
+    assert_eq!(speeds.len() as u64, sim.ctx.state.clock.step);
     // The bar's end moves at about F/(ρcA) = 1e-3 at the first peak.
     let peak = speeds.iter().cloned().fold(0.0, f64::max);
     assert!(peak > 5e-4 && peak < 3e-3, "peak speed {peak}");
@@ -23,7 +23,7 @@ fn a_user_system_inserted_after_g2p_runs_every_step() {
         .into_iter()
         .find(|t| t.name == "max_speed_probe")
         .unwrap();
-    assert_eq!(probe.calls, sim.ctx.state.step);
+    assert_eq!(probe.calls, sim.ctx.state.clock.step);
 }
 
 #[test]
@@ -40,6 +40,6 @@ fn run_steps_on_a_pool_thread_so_parallel_loops_do_not_wake_the_caller() {
     assert!(rayon::current_thread_index().is_none());
     sim.run(|_| {}).unwrap();
     let on_pool = on_pool.lock().unwrap();
-    assert_eq!(on_pool.len() as u64, sim.ctx.state.step);
+    assert_eq!(on_pool.len() as u64, sim.ctx.state.clock.step);
     assert!(on_pool.iter().all(|&p| p), "a step ran on the caller's thread");
 }

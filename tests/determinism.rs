@@ -47,8 +47,8 @@ fn run(threads: usize, overrides: &[&str], regroup: bool) -> Vec<u64> {
         }
         sim.run(|_| {}).unwrap();
         let mut bits = vec![
-            sim.ctx.state.force_ratio_max.to_bits(),
-            sim.ctx.state.energy_ratio.to_bits(),
+            sim.ctx.state.convergence.force_ratio_max.to_bits(),
+            sim.ctx.state.convergence.energy_ratio.to_bits(),
         ];
         for arch in points_with::<Stress<PlanarSym3>>(&sim.ctx.world) {
             for x in col::<Position<glam::DVec2>>(arch).iter() {

@@ -58,7 +58,7 @@ fn run(dimension: usize) -> Vec<[f64; 5]> {
             s.step().unwrap();
             let t = s.traced_results();
             let (c, toe) = (t[0].displacement, t[1].displacement);
-            rows.push([c[0], c[1], toe[0], toe[1], s.ctx.state.force_ratio_max]);
+            rows.push([c[0], c[1], toe[0], toe[1], s.ctx.state.convergence.force_ratio_max]);
         }
         rows
     })

@@ -340,7 +340,7 @@ fn a_non_finite_value_stops_the_run_with_the_last_finite_state() {
     let sim = &mut s;
     {
         let poison = FnSystem::new("poison", |ctx: &mut kdmpm::Context<Dim2>| {
-            if ctx.state.step == 40 {
+            if ctx.state.clock.step == 40 {
                 let n = kdmpm::columns::nodes(&ctx.world);
                 let mut a = kdmpm::columns::col_mut::<NodeAcceleration<glam::DVec2>>(n);
                 for x in a.iter_mut() {

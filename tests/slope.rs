@@ -63,12 +63,12 @@ fn run_and_continue<D: Dim>(sim: &mut Simulation<D>) -> Rest {
         s.stop,
         Some(StopReason::Converged),
         "t = {}, K_F = {}, K_E = {}",
-        s.time,
-        s.force_ratio_max,
-        s.energy_ratio
+        s.clock.time,
+        s.convergence.force_ratio_max,
+        s.convergence.energy_ratio
     );
-    let (t_stop, steps, norm) = (s.time, s.step, sim.ctx.settings.force_norm);
-    assert!(s.force_ratio(norm) <= 0.01 && s.energy_ratio <= 0.01);
+    let (t_stop, steps, norm) = (s.clock.time, s.clock.step, sim.ctx.settings.force_norm);
+    assert!(s.convergence.force_ratio(norm) <= 0.01 && s.convergence.energy_ratio <= 0.01);
     let angle = surface_angle(sim).expect("a surface").degrees;
     let (_, max_ux) = max_displacements(sim).expect("the slope scenes keep displacements");
     let crest = sim
@@ -81,7 +81,7 @@ fn run_and_continue<D: Dim>(sim: &mut Simulation<D>) -> Rest {
     // Static: ten more seconds move nothing by more than 1 cm.
     let (mut before, mut after) = (Vec::new(), Vec::new());
     positions::<D>(&sim.ctx.world, &mut before);
-    let more = (10.0 / sim.ctx.state.dt).ceil() as u64;
+    let more = (10.0 / sim.ctx.settings.dt).ceil() as u64;
     for _ in 0..more {
         sim.step().expect("continuing stays stable");
     }
@@ -134,7 +134,7 @@ fn a_creeping_slope_is_not_declared_static() {
         s.run(|_| {}).expect("runs");
         let st = &s.ctx.state;
         assert_eq!(st.stop, Some(StopReason::MaxTime));
-        let moved = st.static_window_movement.expect("K_F and K_E were met and a 10 s window closed");
+        let moved = st.static_window.movement.expect("K_F and K_E were met and a 10 s window closed");
         assert!(moved > 0.01, "a window moved only {moved} m");
     });
 }
@@ -167,11 +167,11 @@ fn the_fast_preset_comes_to_rest_where_the_paper_settings_do() {
         assert_eq!(s.ctx.state.stop, Some(StopReason::Converged));
         let angle = surface_angle(s).expect("a surface").degrees;
         let crest = s.traced_results().into_iter().find(|t| t.name == "crest").unwrap();
-        println!("fast preset: {} steps, angle {angle:.3}°, crest u_x {:.3} m", s.ctx.state.step, crest.displacement[0]);
+        println!("fast preset: {} steps, angle {angle:.3}°, crest u_x {:.3} m", s.ctx.state.clock.step, crest.displacement[0]);
         assert!((angle - REFERENCE_ANGLE).abs() <= 0.25, "angle {angle}");
         assert!((crest.displacement[0] / REFERENCE_CREST_UX - 1.0).abs() <= 0.03, "crest u_x {}", crest.displacement[0]);
         // And pinned to what the preset gives: 3 767 steps, 18.93675°, crest u_x 22.5185 m.
-        pinned("steps", s.ctx.state.step as f64, 3767.0, 0.01);
+        pinned("steps", s.ctx.state.clock.step as f64, 3767.0, 0.01);
         pinned("angle (°)", angle, 18.93675, 0.005 / 19.0);
         pinned("crest u_x (m)", crest.displacement[0], 22.5185, 5e-4);
     });
@@ -198,7 +198,7 @@ fn the_fast_preset_still_refuses_the_creeping_slope() {
             s.run(|_| {}).expect("runs");
             let st = &s.ctx.state;
             assert_eq!(st.stop, Some(StopReason::MaxTime), "{extra:?}");
-            if let Some(moved) = st.static_window_movement {
+            if let Some(moved) = st.static_window.movement {
                 assert!(moved > 0.01, "{extra:?}: a window moved only {moved} m");
             } else {
                 assert!(extra.is_empty(), "{extra:?}: no window closed");

@@ -122,29 +122,29 @@ impl<D: Dim> System<D> for History<D> {
     fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
         let s = &ctx.state;
         let last = s.stop.is_some();
-        if !s.step.is_multiple_of(self.every) && !last {
+        if !s.clock.step.is_multiple_of(self.every) && !last {
             return Ok(());
         }
         let mut row = vec![
-            s.step.to_string(),
-            format!("{:.9e}", s.time),
-            format!("{:.9e}", s.kinetic_energy),
-            format!("{:.9e}", s.external_work),
-            ratio_cell(s.force_ratio_max, 9),
-            ratio_cell(s.force_ratio_mean, 9),
-            ratio_cell(s.energy_ratio, 9),
-            s.resets.to_string(),
+            s.clock.step.to_string(),
+            format!("{:.9e}", s.clock.time),
+            format!("{:.9e}", s.energy.current()),
+            format!("{:.9e}", s.convergence.external_work),
+            ratio_cell(s.convergence.force_ratio_max, 9),
+            ratio_cell(s.convergence.force_ratio_mean, 9),
+            ratio_cell(s.convergence.energy_ratio, 9),
+            s.resets.count.to_string(),
         ];
         for (k, t) in self.traced.iter().enumerate() {
             // Over MPI the point may be on another rank: [`TracedGather`] brought it here.
             // With one rank, a handful of traced points: an entity lookup is fine here.
-            let u = match ctx.state.traced_displacements.get(k) {
+            let u = match ctx.state.ranks.traced_displacements.get(k) {
                 Some(u) => *u,
                 None => t.displacement::<D>(&ctx.world),
             };
             row.extend(u.iter().take(D::N).map(|c| format!("{c:.9e}")));
         }
-        for d in &s.drives {
+        for d in &s.control.drives {
             row.push(format!("{:.9e}", d.travel));
             row.extend(d.reaction.iter().take(D::N).map(|c| format!("{c:.9e}")));
         }
@@ -158,7 +158,7 @@ impl<D: Dim> System<D> for History<D> {
 }
 
 /// Over MPI, gathers the traced points' displacements from the ranks that hold them into
-/// [`crate::state::SolverState::traced_displacements`] each step, on every rank, for
+/// [`crate::state::RankCounters::traced_displacements`] each step, on every rank, for
 /// [`History`] to write on rank 0. Runs on every rank, before `history`.
 pub struct TracedGather {
     traced: Vec<TracedPoint>,
@@ -179,7 +179,7 @@ impl<D: Dim> System<D> for TracedGather {
     }
     fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
         let values = traced_values(ctx, &mut self.traced);
-        ctx.state.traced_displacements = values.into_iter().map(|(u, _)| u).collect();
+        ctx.state.ranks.traced_displacements = values.into_iter().map(|(u, _)| u).collect();
         Ok(())
     }
 }

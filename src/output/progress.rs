@@ -62,24 +62,24 @@ impl Progress {
             return;
         }
         self.last = Instant::now();
-        let kf = st.force_ratio_max;
+        let kf = st.convergence.force_ratio_max;
         if is_defined(kf) && kf > 0.0 {
             if self.trend.len() == TREND {
                 self.trend.pop_front();
             }
-            self.trend.push_back((st.step as f64, kf.ln()));
+            self.trend.push_back((st.clock.step as f64, kf.ln()));
         }
-        let rate = (st.step - self.start_step) as f64 / self.start.elapsed().as_secs_f64().max(1e-9);
+        let rate = (st.clock.step - self.start_step) as f64 / self.start.elapsed().as_secs_f64().max(1e-9);
         let eta = self
             .eta(kf, rate)
             .map_or("?".into(), |s| format!("~{}", duration(s)));
         let text = format!(
             "step {:>8}  t = {:<9.4} s  K_F = {}  K_E = {}  resets {:>4}  {:>7.0} steps/s  K_F ≤ {:e} in {eta}",
-            st.step,
-            st.time,
+            st.clock.step,
+            st.clock.time,
             ratio_text(kf, 3),
-            ratio_text(st.energy_ratio, 3),
-            st.resets,
+            ratio_text(st.convergence.energy_ratio, 3),
+            st.resets.count,
             rate,
             self.tolerance
         );

@@ -151,14 +151,14 @@ impl Recorder {
         }
         let file = dir.file("history.csv");
         let history = match history {
-            None => History::<D>::create(&file, history_every, &sim.traced, &sim.ctx.state.drives)?,
+            None => History::<D>::create(&file, history_every, &sim.traced, &sim.ctx.state.control.drives)?,
             Some(mark) => History::<D>::resume(&file, mark, history_every, &sim.traced)?,
         };
         let rows = history.rows();
         sim.schedule.push(history);
         let snapshots = match snapshots {
             Some(spec) => {
-                let resumed = history_bytes.map(|_| sim.ctx.state.time);
+                let resumed = history_bytes.map(|_| sim.ctx.state.clock.time);
                 let (system, writer) = Snapshots::<D>::start(dir.path(), spec, resumed)?;
                 sim.schedule.push(system);
                 Some(writer)
@@ -199,14 +199,14 @@ impl Recorder {
                 }
             ));
         }
-        if !sim.ctx.state.stages.is_empty() {
+        if !sim.ctx.state.control.stages.is_empty() {
             dir.write_atomic(STAGES, |out| {
-                out.write_all(stages_csv(&sim.ctx.state.stages).as_bytes())
+                out.write_all(stages_csv(&sim.ctx.state.control.stages).as_bytes())
             })?;
         }
-        if !sim.ctx.state.curve.is_empty() {
+        if !sim.ctx.state.control.curve.is_empty() {
             dir.write_atomic(CURVE, |out| {
-                out.write_all(curve_csv::<D>(&sim.ctx.state.curve).as_bytes())
+                out.write_all(curve_csv::<D>(&sim.ctx.state.control.curve).as_bytes())
             })?;
         }
         // After the output, so that the peak memory covers the whole run.

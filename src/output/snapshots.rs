@@ -131,18 +131,21 @@ impl<D: Dim> Snapshots<D> {
 
     fn due(&self, ctx: &Context<D>) -> bool {
         let st = &ctx.state;
-        let by_steps = self.spec.every_steps.is_some_and(|n| st.step.is_multiple_of(n));
+        let by_steps = self
+            .spec
+            .every_steps
+            .is_some_and(|n| st.clock.step.is_multiple_of(n));
         // A snapshot in each step that crosses a multiple of T: decided from this step
         // alone, so a resumed run takes the snapshots the uninterrupted one takes.
         let by_time = self
             .spec
             .every_time
-            .is_some_and(|t| (st.time / t).floor() > ((st.time - st.dt) / t).floor());
+            .is_some_and(|t| (st.clock.time / t).floor() > ((st.clock.time - ctx.settings.dt) / t).floor());
         // Every static state a control system consumed (an increment, a stage) too.
         by_steps
             || by_time
-            || (self.spec.at_resets && st.reset_this_step)
-            || st.milestone
+            || (self.spec.at_resets && st.resets.this_step)
+            || st.control.milestone
             || st.stop.is_some()
     }
 }
@@ -158,7 +161,7 @@ impl<D: Dim> System<D> for Snapshots<D> {
         let mut sender = lock(&self.sender);
         let Some(tx) = sender.as_ref() else { return Ok(()) };
         let mut frame = self.written.try_recv().unwrap_or_default();
-        frame.refill::<D>(&ctx.world, ctx.state.step, ctx.state.time);
+        frame.refill::<D>(&ctx.world, ctx.state.clock.step, ctx.state.clock.time);
         let start = Instant::now();
         if tx.send(frame).is_err() {
             // The writer stopped on an error; finish() reports it. Stepping goes on.

@@ -207,20 +207,21 @@ impl Summary {
         comm.max(&mut largest);
         let max_u = (largest[0] >= 0.0).then_some((largest[0], largest[1]));
         let ranks = (comm.size() > 1).then(|| {
-            let mut migrations = [s.migrations as f64, comm.sent_bytes() as f64];
+            let mut migrations = [s.ranks.migrations as f64, comm.sent_bytes() as f64];
             comm.sum(&mut migrations);
             Ranks {
                 count: comm.size(),
                 points: points.iter().map(|&p| p as u64).collect(),
                 migrations: migrations[0] as u64,
-                rebalances: s.rebalances,
+                rebalances: s.ranks.rebalances,
                 bounds: sim.ctx.decomposition.bounds.clone(),
-                bytes_per_step: migrations[1] / s.step.max(1) as f64,
+                bytes_per_step: migrations[1] / s.clock.step.max(1) as f64,
             }
         });
         // Under load control a static state may follow a collapse (the body rests again on
         // what it heaved): the largest pressure is a limit only under displacement control.
         let displacement_control: Vec<CurvePoint> = s
+            .control
             .curve
             .iter()
             .filter(|c| st.motions.iter().any(|m| m.name == c.name))
@@ -240,25 +241,25 @@ impl Summary {
             converged: s.stop == Some(StopReason::Converged),
             stop_reason: if error.is_some() { None } else { s.stop },
             error,
-            steps: s.step,
-            time: s.time,
-            time_step: s.dt,
-            force_ratio: s.force_ratio(st.force_norm),
+            steps: s.clock.step,
+            time: s.clock.time,
+            time_step: st.dt,
+            force_ratio: s.convergence.force_ratio(st.force_norm),
             force_norm: st.force_norm,
-            force_ratio_max: s.force_ratio_max,
-            force_ratio_mean: s.force_ratio_mean,
-            energy_ratio: s.energy_ratio,
+            force_ratio_max: s.convergence.force_ratio_max,
+            force_ratio_mean: s.convergence.force_ratio_mean,
+            energy_ratio: s.convergence.energy_ratio,
             tolerance: st.tolerance,
-            static_window_movement: s.static_window_movement,
-            kinetic_resets: s.resets,
-            first_peak: s.peaks.first().copied(),
-            kinetic_energy: s.kinetic_energy,
-            external_work: s.external_work,
+            static_window_movement: s.static_window.movement,
+            kinetic_resets: s.resets.count,
+            first_peak: s.resets.peaks.first().copied(),
+            kinetic_energy: s.energy.current(),
+            external_work: s.convergence.external_work,
             particles,
             total_mass,
             wall_seconds,
             particle_steps_per_second: if wall_seconds > 0.0 {
-                particles as f64 * s.step as f64 / wall_seconds
+                particles as f64 * s.clock.step as f64 / wall_seconds
             } else {
                 0.0
             },
@@ -276,8 +277,8 @@ impl Summary {
             output_wait_seconds: None,
             limit_pressure: limit_pressure(&displacement_control),
             last_increment_rise: last_increment_rise(&displacement_control),
-            curve: s.curve.clone(),
-            stages: s.stages.clone(),
+            curve: s.control.curve.clone(),
+            stages: s.control.stages.clone(),
             ranks,
         }
     }

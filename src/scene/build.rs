@@ -14,7 +14,7 @@ use crate::materials::{MaterialModel, MaterialState, StateVisitor};
 use crate::parallel::SlabCache;
 use crate::shape::{for_each_node, Linear, QuadraticBSpline, ShapeKind, UniformGimp};
 use crate::simulation::{AnySimulation, Simulation, TracedPoint};
-use crate::state::{Gravity, LoadStage, MotionSpec, Settings, SolverState};
+use crate::state::{Control, Gravity, LoadStage, MotionSpec, Settings, SolverState};
 use crate::systems::spatial_sort::sort_points;
 use crate::systems::{check_names, default_names, schedule_from_names, Needs};
 use hecs::{ColumnBatchBuilder, ColumnBatchType, Entity, World};
@@ -544,6 +544,7 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
     }
 
     let settings = Settings {
+        dt,
         scheme: s.solver.scheme,
         damping: s.solver.damping,
         tolerance: s.solver.tolerance,
@@ -602,8 +603,10 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         estimate,
     };
     let state = SolverState {
-        dt,
-        drives: s.motions.iter().map(MotionSpec::drive).collect(),
+        control: Control {
+            drives: s.motions.iter().map(MotionSpec::drive).collect(),
+            ..Control::default()
+        },
         ..SolverState::default()
     };
     let materials = table.into_iter().map(|(_, m)| m).collect();

@@ -32,7 +32,7 @@ impl<D: Dim> System<D> for Boundary {
         let (fix, nm) = (col::<NodeFixity>(n), col::<NodeMass>(n));
         // Plain slices: the column guards cannot be shared with the pool.
         let (fix, nm) = (&*fix, &*nm);
-        let drives = &ctx.state.drives[..];
+        let drives = &ctx.state.control.drives[..];
         let velocities: Vec<[f64; 3]> = drives.iter().map(|d| d.velocity).collect();
         let velocities = &velocities[..];
         let mut np = col_mut::<NodeMomentum<D::Vec>>(n);
@@ -68,7 +68,7 @@ impl<D: Dim> System<D> for Boundary {
             }
             reactions
         });
-        for (d, drive) in ctx.state.drives.iter_mut().enumerate() {
+        for (d, drive) in ctx.state.control.drives.iter_mut().enumerate() {
             drive.reaction = parts
                 .iter()
                 .fold([0.0; 3], |s, p| std::array::from_fn(|a| s[a] + p[d][a]));

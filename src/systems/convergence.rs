@@ -90,7 +90,7 @@ pub fn force_norms<D: Dim>(ctx: &Context<D>) -> ForceNorms {
     let fix = col::<NodeFixity>(n);
     // Plain slices: the column guards cannot be shared with the pool.
     let (nm, nf, ne, fix) = (&*nm, &*nf, &*ne, &*fix);
-    let drives = &ctx.state.drives[..];
+    let drives = &ctx.state.control.drives[..];
     let grid = &ctx.grid;
     // Over MPI each rank sums the nodes it owns; the ranks' parts are combined below.
     let owned = ctx.owned_node_ids();
@@ -155,31 +155,31 @@ pub struct Convergence;
 
 impl Convergence {
     fn confirm_static<D: Dim>(&mut self, ctx: &mut Context<D>, met: bool, check: StaticCheck) -> bool {
-        let now = ctx.state.time;
-        match ctx.state.static_window_start {
+        let now = ctx.state.clock.time;
+        match ctx.state.static_window.start {
             Some(start) if now >= start + check.window * (1.0 - 1e-12) => {
-                let mut current = Vec::with_capacity(ctx.state.static_window_snapshot.len());
+                let mut current = Vec::with_capacity(ctx.state.static_window.snapshot.len());
                 positions::<D>(&ctx.world, &mut current);
                 ctx.comm.merge_by_id(&mut current);
-                let moved = max_movement(&ctx.state.static_window_snapshot, &current);
-                ctx.state.static_window_movement = Some(moved);
-                ctx.state.static_window_start = None;
+                let moved = max_movement(&ctx.state.static_window.snapshot, &current);
+                ctx.state.static_window.movement = Some(moved);
+                ctx.state.static_window.start = None;
                 if met && moved <= check.max_displacement {
                     return true;
                 }
                 if met {
                     // Still balanced but moving: a creeping state. Watch a new window.
-                    ctx.state.static_window_start = Some(now);
-                    ctx.state.static_window_snapshot = current;
+                    ctx.state.static_window.start = Some(now);
+                    ctx.state.static_window.snapshot = current;
                 }
                 false
             }
             Some(_) => false,
             None => {
                 if met {
-                    ctx.state.static_window_start = Some(now);
-                    positions::<D>(&ctx.world, &mut ctx.state.static_window_snapshot);
-                    ctx.comm.merge_by_id(&mut ctx.state.static_window_snapshot);
+                    ctx.state.static_window.start = Some(now);
+                    positions::<D>(&ctx.world, &mut ctx.state.static_window.snapshot);
+                    ctx.comm.merge_by_id(&mut ctx.state.static_window.snapshot);
                 }
                 false
             }
@@ -193,8 +193,8 @@ impl<D: Dim> System<D> for Convergence {
     }
     fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
         let norms = force_norms(ctx);
-        let ratios = norms.ratios(ctx.state.force_reference);
-        let dw = if let Some(dt) = ctx.state.motion_dt() {
+        let ratios = norms.ratios(ctx.state.convergence.force_reference);
+        let dw = if let Some(dt) = ctx.motion_dt() {
             let n = nodes(&ctx.world);
             let ne = col::<NodeExternalForce<D::Vec>>(n);
             let nv = col::<NodeVelocity<D::Vec>>(n);
@@ -220,37 +220,39 @@ impl<D: Dim> System<D> for Convergence {
             0.0
         };
         let s = &mut ctx.state;
-        s.external_work += dw;
-        [s.force_ratio_max, s.force_ratio_mean] = ratios;
+        s.convergence.external_work += dw;
+        [s.convergence.force_ratio_max, s.convergence.force_ratio_mean] = ratios;
         if norms.external[0] > 0.0 {
-            s.force_reference = Some(norms.external);
+            s.convergence.force_reference = Some(norms.external);
         }
-        s.energy_ratio = if s.external_work > 0.0 {
-            s.kinetic_energy / s.external_work
+        s.convergence.energy_ratio = if s.convergence.external_work > 0.0 {
+            s.energy.current() / s.convergence.external_work
         } else {
             UNDEFINED
         };
         // Energy balance: W_ext = E_k + stored + dissipated, so K_E ≤ 1 in a sound run.
         // Well above that the scheme is creating energy; stop before it turns into NaN.
-        if s.energy_ratio > UNSTABLE_ENERGY_RATIO && s.external_work > 0.0 {
+        if s.convergence.energy_ratio > UNSTABLE_ENERGY_RATIO && s.convergence.external_work > 0.0 {
             return Err(StepError::Unstable {
-                step: s.step,
-                kinetic_energy: s.kinetic_energy,
-                external_work: s.external_work,
-                ratio: s.energy_ratio,
+                step: s.clock.step,
+                kinetic_energy: s.energy.current(),
+                external_work: s.convergence.external_work,
+                ratio: s.convergence.energy_ratio,
             });
         }
         let tol = ctx.settings.tolerance;
-        let (step, time) = (s.step, s.time);
+        let (step, time) = (s.clock.step, s.clock.time);
         // A load still ramping up, or a prescribed motion still moving, is not a static
         // state, however balanced this step is.
         let loading = ctx
             .settings
             .gravity
-            .is_some_and(|g| g.step_factor(time, s.dt) < 1.0)
-            || s.driving();
+            .is_some_and(|g| g.step_factor(time, ctx.settings.dt) < 1.0)
+            || s.control.driving();
         // An undefined ratio (NaN) compares false: it never meets the tolerance.
-        let met = !loading && s.force_ratio(ctx.settings.force_norm) <= tol && s.energy_ratio <= tol;
+        let met = !loading
+            && s.convergence.force_ratio(ctx.settings.force_norm) <= tol
+            && s.convergence.energy_ratio <= tol;
         let converged = match ctx.settings.static_check {
             None => met,
             Some(check) => self.confirm_static(ctx, met, check),

@@ -41,7 +41,7 @@ impl<D: Dim, S: Shape> System<D> for G2p<D, S> {
         "g2p"
     }
     fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
-        let (grid, dt) = (&ctx.grid, ctx.state.dt);
+        let (grid, dt) = (&ctx.grid, ctx.settings.dt);
         let n = nodes(&ctx.world);
         let nag = col::<NodeAcceleration<D::Vec>>(n);
         let na: &[NodeAcceleration<D::Vec>] = &nag;
@@ -92,13 +92,13 @@ impl<D: Dim, S: Shape> System<D> for G2p<D, S> {
         let [twice_ek] = twice_ek;
         if !twice_ek.is_finite() {
             return Err(StepError::NonFinite {
-                step: ctx.state.step,
+                step: ctx.state.clock.step,
                 system: "g2p",
                 what: "velocity",
                 location: first_non_finite_velocity::<D>(&ctx.world),
             });
         }
-        ctx.state.kinetic_energy = 0.5 * twice_ek;
+        ctx.state.energy.set(0.5 * twice_ek);
         Ok(())
     }
 }

@@ -21,7 +21,7 @@ impl<D: Dim> System<D> for Gravity {
         let Some(spec) = ctx.settings.gravity else {
             return Ok(());
         };
-        let g = spec.step_factor(ctx.state.time, ctx.state.dt);
+        let g = spec.step_factor(ctx.state.clock.time, ctx.settings.dt);
         let a = spec.acceleration;
         let gv = D::vec_from([a[0] * g, a[1] * g, a[2] * g]);
         let n = nodes(&ctx.world);

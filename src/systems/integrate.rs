@@ -26,7 +26,7 @@ impl<D: Dim> System<D> for Integrate {
         "integrate"
     }
     fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
-        let dt = ctx.state.dt;
+        let dt = ctx.settings.dt;
         let beta2 = match ctx.settings.damping {
             Damping::Viscous { beta } => 2.0 * beta,
             _ => 0.0,
@@ -44,7 +44,7 @@ impl<D: Dim> System<D> for Integrate {
         let fix = col::<NodeFixity>(n);
         // Plain slices: the column guards cannot be shared with the pool.
         let (nm, np, nf, fix) = (&*nm, &*np, &*nf, &*fix);
-        let drives = &ctx.state.drives[..];
+        let drives = &ctx.state.control.drives[..];
         let driven = !drives.is_empty();
         let mut na = col_mut::<NodeAcceleration<D::Vec>>(n);
         let mut nv = col_mut::<NodeVelocity<D::Vec>>(n);

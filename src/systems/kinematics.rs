@@ -63,10 +63,10 @@ impl<D: Dim, S: Shape> System<D> for Kinematics<D, S> {
     }
 
     fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
-        let Some(dt) = ctx.state.motion_dt() else {
+        let Some(dt) = ctx.motion_dt() else {
             return Ok(());
         };
-        let (grid, step) = (&ctx.grid, ctx.state.step);
+        let (grid, step) = (&ctx.grid, ctx.state.clock.step);
         let name = self.name_static();
         let (gradient, motion) = (self.gradient, self.motion);
         let n = nodes(&ctx.world);

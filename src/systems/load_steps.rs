@@ -51,8 +51,13 @@ impl<D: Dim> System<D> for LoadControl {
 
     fn prepare(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
         let n = ctx.settings.load_steps.len();
-        ctx.state.load_increments.resize(n, 0);
-        for (load, &done) in ctx.settings.load_steps.iter().zip(&ctx.state.load_increments) {
+        ctx.state.control.load_increments.resize(n, 0);
+        for (load, &done) in ctx
+            .settings
+            .load_steps
+            .iter()
+            .zip(&ctx.state.control.load_increments)
+        {
             let k = (done + 1).min(load.increments);
             set_point_loads(ctx, &load.points, k as f64 / load.increments as f64);
         }
@@ -65,7 +70,7 @@ impl<D: Dim> System<D> for LoadControl {
         }
         let mut more = false;
         for (k, load) in ctx.settings.load_steps.iter().enumerate() {
-            let done = ctx.state.load_increments[k];
+            let done = ctx.state.control.load_increments[k];
             if done >= load.increments {
                 continue;
             }
@@ -76,16 +81,16 @@ impl<D: Dim> System<D> for LoadControl {
                 .fold([0.0; 3], |s, p| std::array::from_fn(|a| s[a] + p.1[a] * fraction));
             let displacement = settlement(ctx, load);
             let s = &mut ctx.state;
-            s.curve.push(CurvePoint {
+            s.control.curve.push(CurvePoint {
                 name: load.name.clone(),
-                step: s.step,
-                time: s.time,
+                step: s.clock.step,
+                time: s.clock.time,
                 displacement,
                 force,
                 pressure: Some(load.pressure * fraction),
             });
-            s.load_increments[k] = done + 1;
-            s.milestone = true;
+            s.control.load_increments[k] = done + 1;
+            s.control.milestone = true;
             if done + 1 < load.increments {
                 set_point_loads(ctx, &load.points, (done + 2) as f64 / load.increments as f64);
                 more = true;

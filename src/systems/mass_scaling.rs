@@ -77,7 +77,7 @@ impl<D: Dim, S: Shape> System<D> for MassScaling<D, S> {
             ));
         }
         let (dt, min_mass, floor) = (
-            ctx.state.dt,
+            ctx.settings.dt,
             ctx.settings.min_node_mass,
             ctx.settings.virtual_mass_floor,
         );

@@ -42,7 +42,7 @@ pub const IMBALANCE_LIMIT: f64 = 1.2;
 /// ranks' loads differ by more than [`IMBALANCE_LIMIT`] (a failing slope moves its points
 /// down and out), and moves the points to their new ranks; true when it did. A collective.
 pub fn rebalance<D: Dim>(ctx: &mut Context<D>) -> bool {
-    if ctx.comm.size() == 1 || !ctx.state.step.is_multiple_of(REBALANCE_EVERY) {
+    if ctx.comm.size() == 1 || !ctx.state.clock.step.is_multiple_of(REBALANCE_EVERY) {
         return false;
     }
     let mut counts: Vec<f64> = layer_counts(ctx).iter().map(|&c| c as f64).collect();
@@ -60,7 +60,7 @@ pub fn rebalance<D: Dim>(ctx: &mut Context<D>) -> bool {
         return false;
     }
     ctx.decomposition = next;
-    ctx.state.rebalances += 1;
+    ctx.state.ranks.rebalances += 1;
     migrate(ctx);
     true
 }
@@ -130,7 +130,7 @@ fn migrate_once<D: Dim>(ctx: &mut Context<D>) -> (usize, usize, bool) {
     for e in down.iter().chain(&up) {
         ctx.world.despawn(*e).expect("a point found above");
     }
-    ctx.state.migrations += (down.len() + up.len()) as u64;
+    ctx.state.ranks.migrations += (down.len() + up.len()) as u64;
     let from_below = ctx.comm.exchange(above, &to_above, below);
     let from_above = ctx.comm.exchange(below, &to_below, above);
     let (mut came, mut astray) = (0, false);

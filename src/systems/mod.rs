@@ -637,6 +637,7 @@ mod tests {
 
     fn settings(scheme: Scheme, damping: Damping, gravity: bool) -> Settings {
         Settings {
+            dt: 1e-3,
             scheme,
             damping,
             tolerance: 0.01,

@@ -20,7 +20,7 @@ pub fn velocity_from_momentum<D: Dim>(ctx: &Context<D>) {
     // Plain slices: the column guards cannot be shared with the pool.
     let (nm, np, fix) = (&*nm, &*np, &*fix);
     let mut nv = col_mut::<NodeVelocity<D::Vec>>(n);
-    let (grid, drives) = (&ctx.grid, &ctx.state.drives[..]);
+    let (grid, drives) = (&ctx.grid, &ctx.state.control.drives[..]);
     for_each_box_node(
         grid,
         ctx.state.active_nodes,

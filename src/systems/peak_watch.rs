@@ -27,36 +27,28 @@ impl<D: Dim> System<D> for PeakWatch {
         "peak_watch"
     }
     fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
-        let interpolate = ctx.settings.peak_interpolation;
+        let (interpolate, dt) = (ctx.settings.peak_interpolation, ctx.settings.dt);
         let s = &mut ctx.state;
-        if s.kinetic_energy < s.previous_kinetic_energy {
-            let (e2, e1, e0) = (
-                s.earlier_kinetic_energy,
-                s.previous_kinetic_energy,
-                s.kinetic_energy,
-            );
+        if let Some([e2, e1, e0]) = s.energy.peak() {
             let curvature = e2 - 2.0 * e1 + e0;
-            s.reset_fraction = if interpolate && e2 > 0.0 && curvature < 0.0 {
+            s.resets.fraction = if interpolate && e2 > 0.0 && curvature < 0.0 {
                 ((e2 - e0) / (2.0 * curvature)).clamp(-0.5, 0.5)
             } else {
                 0.0
             };
             // The peak was the energy of the previous step, which ended at t − Δt.
-            s.peaks.push(Peak {
-                time: s.time - s.dt,
-                energy: s.previous_kinetic_energy,
+            s.resets.peaks.push(Peak {
+                time: s.clock.time - dt,
+                energy: e1,
             });
-            s.resets += 1;
-            s.reset_this_step = true;
-            s.kinetic_energy = 0.0;
-            s.previous_kinetic_energy = 0.0;
-            s.earlier_kinetic_energy = 0.0;
+            s.resets.count += 1;
+            s.resets.this_step = true;
+            s.energy.reset();
             for arch in points_with::<Velocity<D::Vec>>(&ctx.world) {
                 col_mut::<Velocity<D::Vec>>(arch).fill(Velocity(D::Vec::ZERO));
             }
         } else {
-            s.earlier_kinetic_energy = s.previous_kinetic_energy;
-            s.previous_kinetic_energy = s.kinetic_energy;
+            s.energy.push();
         }
         Ok(())
     }

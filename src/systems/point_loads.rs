@@ -48,7 +48,7 @@ impl<D: Dim, S: Shape> System<D> for PointLoads<D, S> {
                 });
                 if carried <= 0.0 {
                     return Err(StepError::LoadLost {
-                        step: ctx.state.step,
+                        step: ctx.state.clock.step,
                         point: id[p].0,
                         position: D::vec_to3(x[p].0),
                     });

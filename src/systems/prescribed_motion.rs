@@ -29,7 +29,7 @@ pub struct PrescribedMotion {
 }
 
 impl PrescribedMotion {
-    /// The system for these motions (in scene order: [`crate::state::SolverState::drives`]).
+    /// The system for these motions (in scene order: [`crate::state::Control::drives`]).
     pub fn new(motions: Vec<MotionSpec>) -> Self {
         PrescribedMotion { motions }
     }
@@ -49,7 +49,7 @@ impl<D: Dim> System<D> for PrescribedMotion {
                 if in_box(m, x, D::N, grid.cell_size) {
                     // Face conditions on other axes stay (a footing on a symmetry
                     // plane keeps its roller).
-                    *f = NodeFixity::driven(f.0 | ctx.state.drives[k].axes, k);
+                    *f = NodeFixity::driven(f.0 | ctx.state.control.drives[k].axes, k);
                 }
             }
         }
@@ -58,15 +58,15 @@ impl<D: Dim> System<D> for PrescribedMotion {
 
     fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
         let s = &mut ctx.state;
-        let dt = s.motion_dt().unwrap_or(0.0);
-        for (m, d) in self.motions.iter().zip(&mut s.drives) {
+        let dt = s.resets.motion_dt(ctx.settings.dt).unwrap_or(0.0);
+        for (m, d) in self.motions.iter().zip(&mut s.control.drives) {
             if d.velocity == [0.0; 3] {
                 continue;
             }
             let speed = d.velocity.iter().map(|v| v * v).sum::<f64>().sqrt();
             d.travel += speed * dt;
             let left = target(m, d.increments) - d.travel;
-            let full = m.speed() * s.dt;
+            let full = m.speed() * ctx.settings.dt;
             d.velocity = if left <= 1e-12 * m.travel {
                 [0.0; 3]
             } else if left < full {
@@ -81,19 +81,19 @@ impl<D: Dim> System<D> for PrescribedMotion {
         }
         // Every motion holds (a moving one blocks convergence): a static state.
         let mut more = false;
-        for (m, d) in self.motions.iter().zip(&mut s.drives) {
+        for (m, d) in self.motions.iter().zip(&mut s.control.drives) {
             let v = m.vector().map(|c| c / m.speed());
             let along: f64 = (0..3).map(|a| d.reaction[a] * v[a]).sum();
-            s.curve.push(CurvePoint {
+            s.control.curve.push(CurvePoint {
                 name: m.name.clone(),
-                step: s.step,
-                time: s.time,
+                step: s.clock.step,
+                time: s.clock.time,
                 displacement: d.travel,
                 force: d.reaction,
                 pressure: m.area.map(|a| along / a),
             });
             d.increments += 1;
-            s.milestone = true;
+            s.control.milestone = true;
             if d.travel < m.travel * (1.0 - 1e-9) {
                 d.velocity = m.vector();
                 more = true;

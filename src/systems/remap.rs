@@ -31,7 +31,7 @@ impl<D: Dim, S: Shape> System<D> for Remap<D, S> {
     }
     fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
         let n = nodes(&ctx.world);
-        if ctx.state.reset_this_step {
+        if ctx.state.resets.this_step {
             let mut nv = col_mut::<NodeVelocity<D::Vec>>(n);
             fill_box(
                 &ctx.grid,

@@ -74,15 +74,16 @@ impl<D: Dim> System<D> for SpatialSort {
 
     fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
         ctx.state.points_reordered = false;
-        if !ctx.state.step.is_multiple_of(self.every) {
+        if !ctx.state.clock.step.is_multiple_of(self.every) {
             return Ok(());
         }
         let sorted = sort_points(&ctx.world, &ctx.grid);
         if sorted != Ok(false) {
             ctx.slabs.invalidate();
         }
-        ctx.state.points_reordered =
-            sorted.map_err(|ForeignComponent| StepError::Unsortable { step: ctx.state.step })?;
+        ctx.state.points_reordered = sorted.map_err(|ForeignComponent| StepError::Unsortable {
+            step: ctx.state.clock.step,
+        })?;
         Ok(())
     }
 }

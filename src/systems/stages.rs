@@ -27,7 +27,7 @@ fn apply<D: Dim>(ctx: &mut Context<D>, stage: &LoadStage, start: f64) {
         ctx.settings.gravity = Some(Gravity { start, ..g });
     }
     if let Some(masks) = &stage.fixity {
-        let drives = &ctx.state.drives;
+        let drives = &ctx.state.control.drives;
         let mut fix = col_mut::<NodeFixity>(nodes(&ctx.world));
         for (f, &mask) in fix.iter_mut().zip(masks) {
             *f = match f.driver() {
@@ -76,15 +76,15 @@ impl<D: Dim> System<D> for Stages {
     fn prepare(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
         // The stages so far, in order (a resumed run starts inside one).
         let stages = ctx.settings.stages.clone();
-        for (k, stage) in stages[..=ctx.state.stage.min(stages.len() - 1)]
+        for (k, stage) in stages[..=ctx.state.control.stage.min(stages.len() - 1)]
             .iter()
             .enumerate()
         {
             // A stage starts when the one before it ended.
-            let start = k.checked_sub(1).map_or(0.0, |j| ctx.state.stages[j].time);
+            let start = k.checked_sub(1).map_or(0.0, |j| ctx.state.control.stages[j].time);
             // A fresh run begins in the first stage with the scene's masses; a resumed one
             // has the masses of its stage in its checkpoint.
-            if k == 0 && ctx.state.step == 0 {
+            if k == 0 && ctx.state.clock.step == 0 {
                 reweigh(ctx, stage);
             }
             apply(ctx, stage, start);
@@ -98,25 +98,23 @@ impl<D: Dim> System<D> for Stages {
         }
         let s = &mut ctx.state;
         let stages = &ctx.settings.stages;
-        s.stages.push(StageResult {
-            name: stages[s.stage].name.clone(),
-            step: s.step,
-            time: s.time,
-            force_ratio: s.force_ratio(ctx.settings.force_norm),
-            energy_ratio: s.energy_ratio,
-            resets: s.resets,
+        s.control.stages.push(StageResult {
+            name: stages[s.control.stage].name.clone(),
+            step: s.clock.step,
+            time: s.clock.time,
+            force_ratio: s.convergence.force_ratio(ctx.settings.force_norm),
+            energy_ratio: s.convergence.energy_ratio,
+            resets: s.resets.count,
         });
-        s.milestone = true;
-        if s.stage + 1 >= stages.len() {
+        s.control.milestone = true;
+        if s.control.stage + 1 >= stages.len() {
             return Ok(());
         }
-        s.stage += 1;
+        s.control.stage += 1;
         s.go_on(&ctx.settings);
-        s.kinetic_energy = 0.0;
-        s.previous_kinetic_energy = 0.0;
-        s.earlier_kinetic_energy = 0.0;
-        let stage = stages[s.stage].clone();
-        let start = ctx.state.time;
+        s.energy.reset();
+        let stage = stages[s.control.stage].clone();
+        let start = ctx.state.clock.time;
         reweigh(ctx, &stage);
         apply(ctx, &stage, start);
         if stage.reset_displacements {

@@ -28,7 +28,7 @@ impl<D: Dim> System<D> for StressUpdate {
         "stress_update"
     }
     fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
-        let Some(dt) = ctx.state.motion_dt() else {
+        let Some(dt) = ctx.motion_dt() else {
             return Ok(());
         };
         for arch in points_with::<Stress<D::Stress>>(&ctx.world) {

@@ -51,7 +51,7 @@ impl<D: Dim, S: Shape> System<D> for VolumetricSmoothing<D, S> {
         "volumetric_smoothing"
     }
     fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
-        if ctx.state.motion_dt().is_none() {
+        if ctx.motion_dt().is_none() {
             return Ok(());
         }
         let grid = &ctx.grid;
