@@ -323,225 +323,23 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         estimate,
     } = checked;
     let s: &Scene = &loaded.scene;
-    let n = D::N;
-    let mut cells = [0usize; 3];
-    cells[..n].copy_from_slice(&s.grid.cells);
-    let mut grid = Grid::<D>::new(D::vec_from(pad3(&s.grid.origin)), s.grid.cell_size, cells);
-    // Uniform GIMP: a point's box is its share of a cell, the same for every body
-    // (validation), 1/(2n) cell along an axis with n points a side.
-    if let Some(b) = s.bodies.first() {
-        for (axis, &per) in grid.axes.iter_mut().zip(&b.points_per_cell) {
-            axis.particle_half_width = 0.5 / per as f64;
-        }
-    }
+    let grid = new_grid::<D>(s);
     let mut world = World::new();
-
-    // Grid nodes, one archetype, spawned in id order.
-    let fixity = face_fixity(&grid, &s.boundaries);
-    let z = D::Vec::ZERO;
-    world.spawn_batch(fixity.into_iter().map(|f| {
-        (
-            NodeMass(0.0),
-            NodeMomentum(z),
-            NodeForce(z),
-            NodeExternalForce(z),
-            NodeAcceleration(z),
-            NodeVelocity(z),
-            f,
-        )
-    }));
-
-    // Material points, body by body.
-    let cell_volume = s.grid.cell_size.powi(n as i32);
-    // Mass of a node inside a filled region, ρ·h^D, for the lightest material in use.
-    let mut full_node_mass = f64::INFINITY;
-    let (gmin, gmax) = (D::vec_to3(grid.origin), D::vec_to3(grid.max_corner()));
-    let mut next_id = 0u32;
-    // The ids of each body's points (spawn order).
-    let mut body_ids: Vec<std::ops::Range<u32>> = Vec::new();
-    for (b, body) in s.bodies.iter().enumerate() {
-        let (lo, hi) = region_bounds(&body.region, n);
-        if (0..n).any(|a| lo[a] < gmin[a] - 1e-9 || hi[a] > gmax[a] + 1e-9) {
-            return Err(loaded.invalid(
-                &format!("bodies[{b}].region"),
-                format!(
-                    "the body spans {:?}..{:?}, outside the grid {:?}..{:?}",
-                    &lo[..n],
-                    &hi[..n],
-                    &gmin[..n],
-                    &gmax[..n]
-                ),
-            ));
-        }
-        let points = fill_points(&grid, &body.region, &body.points_per_cell);
-        // Bodies may not overlap: a point inside two bodies would be two points, its mass
-        // counted twice. Split the region or change one body's material instead.
-        let earlier = &s.bodies[..b];
-        let mut count = 0usize;
-        for x in points.clone() {
-            if let Some(o) = earlier.iter().position(|e| region_contains(&e.region, x, n)) {
-                return Err(loaded.invalid(
-                    &format!("bodies[{b}].region"),
-                    format!(
-                        "overlaps bodies[{o}] (at {:?}): bodies must not overlap, as a point in two \
-                         bodies would count its mass twice",
-                        &x[..n]
-                    ),
-                ));
-            }
-            count += 1;
-        }
-        let xs = Counted {
-            left: count,
-            inner: points.zip(next_id..),
-        };
-        if xs.left == 0 {
-            return Err(loaded.invalid(
-                &format!("bodies[{b}].region"),
-                "the body holds no material point (is it smaller than a sub-cell?)",
-            ));
-        }
-        let mat = table
-            .iter()
-            .position(|(name, _)| *name == body.material)
-            .expect("validated");
-        let model = &table[mat].1;
-        // The points carry the state of every model their material takes, from the start.
-        let state = carried_state(loaded, &table, &body.material).expect("validated");
-        let volume = cell_volume / body.points_per_cell.iter().product::<usize>() as f64;
-        let mass = model.density() * volume;
-        full_node_mass = full_node_mass.min(model.density() * cell_volume);
-        let first = next_id;
-        next_id = u32::try_from(count)
-            .ok()
-            .and_then(|c| next_id.checked_add(c))
-            .ok_or_else(|| {
-                loaded.invalid(
-                    &format!("bodies[{b}].points_per_cell"),
-                    "more than 4 294 967 295 points in all",
-                )
-            })?;
-        body_ids.push(first..next_id);
-        // One column batch: the columns every point has, then the optional ones, the
-        // material's state only where it has one and displacements only when asked for.
-        // A new point column is one more `add` and one fill here. The spawned entities are
-        // not kept: points are found again through the columns, which keeps the set-up's
-        // peak memory near the run's.
-        let mut columns = ColumnBatchType::new();
-        columns.add_bundle::<(
-            PointId,
-            Position<D::Vec>,
-            Velocity<D::Vec>,
-            Mass,
-            Volume,
-            Stress<D::Stress>,
-            VelocityGradient<D::Mat>,
-            MaterialId,
-        )>();
-        state.visit_state(&mut AddState(&mut columns));
-        if s.output.displacements {
-            columns.add::<Displacement<D::Vec>>();
-        }
-        let batch = columns.into_batch(count as u32);
-        fill(&batch, xs.clone().map(|(_, id)| PointId(id)));
-        fill(&batch, xs.map(|(x, _)| Position(D::vec_from(x))));
-        fill(&batch, std::iter::repeat_n(Velocity(z), count));
-        fill(&batch, std::iter::repeat_n(Mass(mass), count));
-        fill(&batch, std::iter::repeat_n(Volume(volume), count));
-        fill(&batch, std::iter::repeat_n(Stress(D::Stress::default()), count));
-        fill(&batch, std::iter::repeat_n(VelocityGradient(D::MAT_ZERO), count));
-        fill(&batch, std::iter::repeat_n(MaterialId(mat as u16), count));
-        state.visit_state(&mut FillState(&batch, count));
-        fill(&batch, std::iter::repeat_n(Displacement(z), count));
-        world.spawn_column_batch(batch.build().expect("every column of the batch is filled"));
-    }
-
-    // Which nodes the points touch at the start.
-    let mut touched = vec![false; grid.node_count()];
-    for arch in points_with::<Position<D::Vec>>(&world) {
-        for x in col::<Position<D::Vec>>(arch).iter() {
-            visit_support(&grid, s.shape, x.0, |i, w| touched[i] |= w > 0.0);
-        }
-    }
-
+    spawn_nodes(&mut world, &grid, &s.boundaries);
+    let Bodies {
+        ids: body_ids,
+        next_id,
+        full_node_mass,
+    } = spawn_bodies(loaded, &grid, &table, &mut world)?;
+    let touched = touched_nodes(&world, &grid, s.shape);
     check_motion_boxes(loaded, &grid, &touched)?;
-
-    // Point loads: massless carriers that move with the body.
-    let mut load_ids = Vec::new();
-    for (i, l) in s.point_loads.iter().enumerate() {
-        let x = D::vec_from(pad3(&l.position));
-        if !grid.contains(x) {
-            return Err(loaded.invalid(
-                &format!("point_loads[{i}].position"),
-                "the load lies outside the grid",
-            ));
-        }
-        let mut on_body = false;
-        visit_support(&grid, s.shape, x, |node, w| on_body |= w > 0.0 && touched[node]);
-        if !on_body {
-            return Err(loaded.invalid(
-                &format!("point_loads[{i}].position"),
-                format!(
-                    "load \"{}\" acts on no node that carries mass: put it on a body",
-                    l.name
-                ),
-            ));
-        }
-        load_ids.push((l.name.clone(), next_id));
-        let carrier = world.spawn((
-            PointId(next_id),
-            Position(x),
-            Velocity(z),
-            Mass(0.0),
-            VelocityGradient(D::MAT_ZERO),
-            PointLoad(D::vec_from(pad3(&l.force))),
-        ));
-        next_id = next_id.checked_add(1).ok_or_else(|| {
-            loaded.invalid(
-                &format!("point_loads[{i}]"),
-                "more than 4 294 967 295 points in all",
-            )
-        })?;
-        if s.output.displacements {
-            world.insert_one(carrier, Displacement(z)).expect("just spawned");
-        }
-    }
-
+    let (load_ids, _) = spawn_point_loads(loaded, &grid, &mut world, &touched, next_id)?;
     let placed = super::tractions::place::<D>(&mut world, loaded, &body_ids)?;
 
     // Bodies are filled row of points by row of points; cell order keeps the points that
     // share nodes together in memory from the first step.
     sort_points(&world, &grid).expect("set-up spawns only kdmpm components");
-
-    // Traced points: the nearest point within one cell.
-    let mut traced = Vec::new();
-    for (i, t) in s.traced.iter().enumerate() {
-        let want = pad3(&t.position);
-        let dist = |x: &[f64; 3]| (0..3).map(|a| (x[a] - want[a]).powi(2)).sum::<f64>().sqrt();
-        let mut query = world.query::<(Entity, &Position<D::Vec>, &PointId)>();
-        let best = query
-            .iter()
-            .map(|(e, x, id)| (D::vec_to3(x.0), e, *id))
-            .min_by(|a, b| dist(&a.0).total_cmp(&dist(&b.0)));
-        match best {
-            Some((x, entity, id)) if dist(&x) <= s.grid.cell_size => traced.push(TracedPoint {
-                name: t.name.clone(),
-                id,
-                entity,
-                initial_position: x,
-            }),
-            _ => {
-                return Err(loaded.invalid(
-                    &format!("traced[{i}].position"),
-                    format!(
-                        "no material point within one cell ({} m) of {:?}",
-                        s.grid.cell_size,
-                        &want[..n]
-                    ),
-                ))
-            }
-        }
-    }
+    let traced = find_traced::<D>(loaded, &world)?;
 
     let settings = Settings {
         dt,
@@ -631,4 +429,295 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         },
         derived,
     ))
+}
+
+/// The scene's grid; with uniform GIMP a point's box is its share of a cell, the same for
+/// every body (validation), 1/(2n) cell along an axis with n points a side.
+fn new_grid<D: Dim>(s: &Scene) -> Grid<D> {
+    let n = D::N;
+    let mut cells = [0usize; 3];
+    cells[..n].copy_from_slice(&s.grid.cells);
+    let mut grid = Grid::<D>::new(D::vec_from(pad3(&s.grid.origin)), s.grid.cell_size, cells);
+    if let Some(b) = s.bodies.first() {
+        for (axis, &per) in grid.axes.iter_mut().zip(&b.points_per_cell) {
+            axis.particle_half_width = 0.5 / per as f64;
+        }
+    }
+    grid
+}
+
+/// Spawns the grid's nodes, one archetype, in id order, held by the face conditions.
+fn spawn_nodes<D: Dim>(world: &mut World, grid: &Grid<D>, boundaries: &[BoundarySpec]) {
+    let fixity = face_fixity(grid, boundaries);
+    let z = D::Vec::ZERO;
+    world.spawn_batch(fixity.into_iter().map(|f| {
+        (
+            NodeMass(0.0),
+            NodeMomentum(z),
+            NodeForce(z),
+            NodeExternalForce(z),
+            NodeAcceleration(z),
+            NodeVelocity(z),
+            f,
+        )
+    }));
+}
+
+/// The ids of each body's points, the next free id and the mass ρ·h^D of a node inside the
+/// lightest body, after spawning every body's points.
+struct Bodies {
+    ids: Vec<std::ops::Range<u32>>,
+    next_id: u32,
+    full_node_mass: f64,
+}
+
+/// Fills every body with points (refusing one outside the grid, one that overlaps an
+/// earlier body and one with no point) and spawns them.
+fn spawn_bodies<D: Dim>(
+    loaded: &LoadedScene,
+    grid: &Grid<D>,
+    table: &[(String, MaterialModel)],
+    world: &mut World,
+) -> Result<Bodies, SceneError> {
+    let s = &loaded.scene;
+    let n = D::N;
+    // Mass of a node inside a filled region, ρ·h^D, for the lightest material in use.
+    let mut full_node_mass = f64::INFINITY;
+    let (gmin, gmax) = (D::vec_to3(grid.origin), D::vec_to3(grid.max_corner()));
+    let mut next_id = 0u32;
+    // The ids of each body's points (spawn order).
+    let mut body_ids: Vec<std::ops::Range<u32>> = Vec::new();
+    for (b, body) in s.bodies.iter().enumerate() {
+        let (lo, hi) = region_bounds(&body.region, n);
+        if (0..n).any(|a| lo[a] < gmin[a] - 1e-9 || hi[a] > gmax[a] + 1e-9) {
+            return Err(loaded.invalid(
+                &format!("bodies[{b}].region"),
+                format!(
+                    "the body spans {:?}..{:?}, outside the grid {:?}..{:?}",
+                    &lo[..n],
+                    &hi[..n],
+                    &gmin[..n],
+                    &gmax[..n]
+                ),
+            ));
+        }
+        let points = fill_points(grid, &body.region, &body.points_per_cell);
+        // Bodies may not overlap: a point inside two bodies would be two points, its mass
+        // counted twice. Split the region or change one body's material instead.
+        let earlier = &s.bodies[..b];
+        let mut count = 0usize;
+        for x in points.clone() {
+            if let Some(o) = earlier.iter().position(|e| region_contains(&e.region, x, n)) {
+                return Err(loaded.invalid(
+                    &format!("bodies[{b}].region"),
+                    format!(
+                        "overlaps bodies[{o}] (at {:?}): bodies must not overlap, as a point in two \
+                         bodies would count its mass twice",
+                        &x[..n]
+                    ),
+                ));
+            }
+            count += 1;
+        }
+        let xs = Counted {
+            left: count,
+            inner: points.zip(next_id..),
+        };
+        if xs.left == 0 {
+            return Err(loaded.invalid(
+                &format!("bodies[{b}].region"),
+                "the body holds no material point (is it smaller than a sub-cell?)",
+            ));
+        }
+        let spawned = spawn_body::<D>(loaded, b, table, world, xs, count, next_id)?;
+        full_node_mass = full_node_mass.min(spawned.full_node_mass);
+        body_ids.push(next_id..spawned.next_id);
+        next_id = spawned.next_id;
+    }
+
+    Ok(Bodies {
+        ids: body_ids,
+        next_id,
+        full_node_mass,
+    })
+}
+
+/// What [`spawn_body`] spawned: the next free point id and the mass ρ·h^D of a node inside
+/// the body.
+struct Spawned {
+    next_id: u32,
+    full_node_mass: f64,
+}
+
+/// Spawns body `b`'s `count` points `xs` (positions and ids from `first`) as one column batch
+/// of its material's columns.
+fn spawn_body<D: Dim>(
+    loaded: &LoadedScene,
+    b: usize,
+    table: &[(String, MaterialModel)],
+    world: &mut World,
+    xs: Counted<impl Iterator<Item = ([f64; 3], u32)> + Clone>,
+    count: usize,
+    first: u32,
+) -> Result<Spawned, SceneError> {
+    let s = &loaded.scene;
+    let body = &s.bodies[b];
+    let z = D::Vec::ZERO;
+    let cell_volume = s.grid.cell_size.powi(D::N as i32);
+    let mat = table
+        .iter()
+        .position(|(name, _)| *name == body.material)
+        .expect("validated");
+    let model = &table[mat].1;
+    // The points carry the state of every model their material takes, from the start.
+    let state = carried_state(loaded, table, &body.material).expect("validated");
+    let volume = cell_volume / body.points_per_cell.iter().product::<usize>() as f64;
+    let mass = model.density() * volume;
+    let next_id = u32::try_from(count)
+        .ok()
+        .and_then(|c| first.checked_add(c))
+        .ok_or_else(|| {
+            loaded.invalid(
+                &format!("bodies[{b}].points_per_cell"),
+                "more than 4 294 967 295 points in all",
+            )
+        })?;
+    // One column batch: the columns every point has, then the optional ones, the
+    // material's state only where it has one and displacements only when asked for.
+    // A new point column is one more `add` and one fill here. The spawned entities are
+    // not kept: points are found again through the columns, which keeps the set-up's
+    // peak memory near the run's.
+    let mut columns = ColumnBatchType::new();
+    columns.add_bundle::<(
+        PointId,
+        Position<D::Vec>,
+        Velocity<D::Vec>,
+        Mass,
+        Volume,
+        Stress<D::Stress>,
+        VelocityGradient<D::Mat>,
+        MaterialId,
+    )>();
+    state.visit_state(&mut AddState(&mut columns));
+    if s.output.displacements {
+        columns.add::<Displacement<D::Vec>>();
+    }
+    let batch = columns.into_batch(count as u32);
+    fill(&batch, xs.clone().map(|(_, id)| PointId(id)));
+    fill(&batch, xs.map(|(x, _)| Position(D::vec_from(x))));
+    fill(&batch, std::iter::repeat_n(Velocity(z), count));
+    fill(&batch, std::iter::repeat_n(Mass(mass), count));
+    fill(&batch, std::iter::repeat_n(Volume(volume), count));
+    fill(&batch, std::iter::repeat_n(Stress(D::Stress::default()), count));
+    fill(&batch, std::iter::repeat_n(VelocityGradient(D::MAT_ZERO), count));
+    fill(&batch, std::iter::repeat_n(MaterialId(mat as u16), count));
+    state.visit_state(&mut FillState(&batch, count));
+    fill(&batch, std::iter::repeat_n(Displacement(z), count));
+    world.spawn_column_batch(batch.build().expect("every column of the batch is filled"));
+    Ok(Spawned {
+        next_id,
+        full_node_mass: model.density() * cell_volume,
+    })
+}
+
+/// Which nodes the points touch at the start.
+fn touched_nodes<D: Dim>(world: &World, grid: &Grid<D>, shape: ShapeKind) -> Vec<bool> {
+    let mut touched = vec![false; grid.node_count()];
+    for arch in points_with::<Position<D::Vec>>(world) {
+        for x in col::<Position<D::Vec>>(arch).iter() {
+            visit_support(grid, shape, x.0, |i, w| touched[i] |= w > 0.0);
+        }
+    }
+
+    touched
+}
+
+/// Spawns the point loads' carriers, massless points that move with the body, from id
+/// `next_id` on; returns each load's name and id, and the next free id.
+fn spawn_point_loads<D: Dim>(
+    loaded: &LoadedScene,
+    grid: &Grid<D>,
+    world: &mut World,
+    touched: &[bool],
+    mut next_id: u32,
+) -> Result<(Vec<(String, u32)>, u32), SceneError> {
+    let s = &loaded.scene;
+    let z = D::Vec::ZERO;
+    let mut load_ids = Vec::new();
+    for (i, l) in s.point_loads.iter().enumerate() {
+        let x = D::vec_from(pad3(&l.position));
+        if !grid.contains(x) {
+            return Err(loaded.invalid(
+                &format!("point_loads[{i}].position"),
+                "the load lies outside the grid",
+            ));
+        }
+        let mut on_body = false;
+        visit_support(grid, s.shape, x, |node, w| on_body |= w > 0.0 && touched[node]);
+        if !on_body {
+            return Err(loaded.invalid(
+                &format!("point_loads[{i}].position"),
+                format!(
+                    "load \"{}\" acts on no node that carries mass: put it on a body",
+                    l.name
+                ),
+            ));
+        }
+        load_ids.push((l.name.clone(), next_id));
+        let carrier = world.spawn((
+            PointId(next_id),
+            Position(x),
+            Velocity(z),
+            Mass(0.0),
+            VelocityGradient(D::MAT_ZERO),
+            PointLoad(D::vec_from(pad3(&l.force))),
+        ));
+        next_id = next_id.checked_add(1).ok_or_else(|| {
+            loaded.invalid(
+                &format!("point_loads[{i}]"),
+                "more than 4 294 967 295 points in all",
+            )
+        })?;
+        if s.output.displacements {
+            world.insert_one(carrier, Displacement(z)).expect("just spawned");
+        }
+    }
+
+    Ok((load_ids, next_id))
+}
+
+/// The traced points: the nearest point within one cell of each position asked for.
+fn find_traced<D: Dim>(loaded: &LoadedScene, world: &World) -> Result<Vec<TracedPoint>, SceneError> {
+    let s = &loaded.scene;
+    let n = D::N;
+    let mut traced = Vec::new();
+    for (i, t) in s.traced.iter().enumerate() {
+        let want = pad3(&t.position);
+        let dist = |x: &[f64; 3]| (0..3).map(|a| (x[a] - want[a]).powi(2)).sum::<f64>().sqrt();
+        let mut query = world.query::<(Entity, &Position<D::Vec>, &PointId)>();
+        let best = query
+            .iter()
+            .map(|(e, x, id)| (D::vec_to3(x.0), e, *id))
+            .min_by(|a, b| dist(&a.0).total_cmp(&dist(&b.0)));
+        match best {
+            Some((x, entity, id)) if dist(&x) <= s.grid.cell_size => traced.push(TracedPoint {
+                name: t.name.clone(),
+                id,
+                entity,
+                initial_position: x,
+            }),
+            _ => {
+                return Err(loaded.invalid(
+                    &format!("traced[{i}].position"),
+                    format!(
+                        "no material point within one cell ({} m) of {:?}",
+                        s.grid.cell_size,
+                        &want[..n]
+                    ),
+                ))
+            }
+        }
+    }
+
+    Ok(traced)
 }

@@ -15,6 +15,21 @@ pub fn line_column(text: &str, at: usize) -> (usize, usize) {
     (line, col)
 }
 
+/// Where a RON parse error of `text` is, for scenes and study files alike: its line and
+/// column (1-based) and the field it concerns, unless the message names it already. A
+/// missing field is reported at the closing bracket of the struct that lacks it, so the
+/// struct's own field names the place.
+pub fn parse_error_place(text: &str, e: &ron::error::SpannedError) -> (usize, usize, Option<String>) {
+    let message = e.code.to_string();
+    let (line, column) = (e.span.start.line, e.span.start.col);
+    let field = match e.code {
+        ron::Error::MissingStructField { .. } => enclosing_field(text, line, column),
+        _ => field_before(text, line, column),
+    }
+    .filter(|f| !message.contains(&format!("`{f}`")));
+    (line, column, field)
+}
+
 /// The name of the field whose value holds 1-based (line, column): the nearest `name:`
 /// before it, outside comments and strings.
 pub fn field_before(text: &str, line: usize, column: usize) -> Option<String> {

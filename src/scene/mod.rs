@@ -472,14 +472,7 @@ impl LoadedScene {
         }
         let scene: Scene = ron_options().from_str(&text).map_err(|e| {
             let message = e.code.to_string();
-            let (line, column) = (e.span.start.line, e.span.start.col);
-            // A missing field is reported at the closing bracket of the struct that lacks
-            // it, so the struct's own field names the place.
-            let field = match e.code {
-                ron::Error::MissingStructField { .. } => locate::enclosing_field(&text, line, column),
-                _ => locate::field_before(&text, line, column),
-            }
-            .filter(|f| !message.contains(&format!("`{f}`")));
+            let (line, column, field) = locate::parse_error_place(&text, &e);
             let at = locate::offset(&text, line, column);
             let (line, column, inside) = Self::place(original, &edits, at);
             // A parser often notices a bad value just before or after it: name the

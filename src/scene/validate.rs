@@ -436,36 +436,95 @@ fn check_faces(list: &[BoundarySpec], field: &str, n: usize) -> Result<(), (Stri
     Ok(())
 }
 
-/// Checks every rule that does not need the points.
-pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
-    let s = &loaded.scene;
-    let bad = |field: &str, rule: String| Err(loaded.invalid(field, rule));
-    if s.dimension != 2 && s.dimension != 3 {
-        return bad("dimension", format!("must be 2 or 3, found {}", s.dimension));
+/// The scene and its dimension, for the checks of each part: each names a field and the
+/// rule it breaks through [`Rules::bad`].
+struct Rules<'a> {
+    loaded: &'a LoadedScene,
+    /// 2 or 3.
+    n: usize,
+}
+
+impl Rules<'_> {
+    /// The error for `field`, breaking `rule`.
+    fn bad<T>(&self, field: &str, rule: String) -> Result<T, SceneError> {
+        Err(self.loaded.invalid(field, rule))
     }
-    let n = s.dimension as usize;
-    let len = |field: &str, v: usize| -> Result<(), SceneError> {
+
+    /// A vector of one entry per axis.
+    fn len(&self, field: &str, v: usize) -> Result<(), SceneError> {
+        let n = self.n;
         if v != n {
-            return Err(loaded.invalid(field, format!("needs {n} entries (dimension {n}), found {v}")));
+            return Err(self
+                .loaded
+                .invalid(field, format!("needs {n} entries (dimension {n}), found {v}")));
         }
         Ok(())
-    };
-    // Every coordinate, force and acceleration is a finite number: a NaN or infinity in
-    // the input would reach the state and be written out.
-    let finite = |field: &str, v: &[f64], unit: &str| -> Result<(), SceneError> {
+    }
+
+    /// Every coordinate, force and acceleration is a finite number: a NaN or infinity in
+    /// the input would reach the state and be written out.
+    fn finite(&self, field: &str, v: &[f64], unit: &str) -> Result<(), SceneError> {
         match v.iter().position(|x| !x.is_finite()) {
-            Some(k) => Err(loaded.invalid(
+            Some(k) => Err(self.loaded.invalid(
                 field,
                 format!("entry {k} must be a finite number ({unit}), found {}", v[k]),
             )),
             None => Ok(()),
         }
+    }
+}
+
+/// Checks every rule that does not need the points, part by part.
+pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
+    let s = &loaded.scene;
+    if s.dimension != 2 && s.dimension != 3 {
+        return Err(loaded.invalid("dimension", format!("must be 2 or 3, found {}", s.dimension)));
+    }
+    let r = Rules {
+        loaded,
+        n: s.dimension as usize,
     };
-    len("grid.origin", s.grid.origin.len())?;
-    finite("grid.origin", &s.grid.origin, "m")?;
-    len("grid.cells", s.grid.cells.len())?;
+    check_grid(&r)?;
+    let table = check_materials(&r)?;
+    check_solver(&r)?;
+    check_bodies(&r)?;
+    check_loads(&r, &table)?;
+    check_motions_and_analyses(&r)?;
+    check_tractions_and_traced(&r)?;
+    check_has_load(&r)?;
+    let step = time_step(&r, &table)?;
+    check_stages(&r, &table, step.p_wave_speed)?;
+    let estimate = check_memory(&r, &table)?;
+    Ok(Checked {
+        materials: table,
+        p_wave_speed: step.p_wave_speed,
+        critical_time_step: step.critical,
+        time_step: step.dt,
+        unused_materials: step.unused_materials,
+        estimate,
+    })
+}
+
+/// The time step and what set it.
+struct StepChoice {
+    /// Largest (smallest with mass scaling) P-wave speed of the materials bodies use (m/s).
+    p_wave_speed: f64,
+    /// h / c_p (s).
+    critical: f64,
+    /// The time step (s).
+    dt: f64,
+    /// Materials no body uses, in name order.
+    unused_materials: Vec<String>,
+}
+
+/// The grid: origin, cells and cell size.
+fn check_grid(r: &Rules) -> Result<(), SceneError> {
+    let (s, n) = (&r.loaded.scene, r.n);
+    r.len("grid.origin", s.grid.origin.len())?;
+    r.finite("grid.origin", &s.grid.origin, "m")?;
+    r.len("grid.cells", s.grid.cells.len())?;
     if !positive(s.grid.cell_size) {
-        return bad(
+        return r.bad(
             "grid.cell_size",
             format!("must be > 0 m, found {}", s.grid.cell_size),
         );
@@ -476,7 +535,7 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
             .iter()
             .position(|b| b.points_per_cell != s.bodies[0].points_per_cell)
         {
-            return bad(
+            return r.bad(
                 &format!("bodies[{i}].points_per_cell"),
                 "UniformGimp sizes every point's box from its points a cell side: every body needs the same as bodies[0]".to_string(),
             );
@@ -487,7 +546,7 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
     // size of 1e-200 m would give cells of zero volume and points of zero mass.
     let cell_volume = s.grid.cell_size.powi(n as i32);
     if !(cell_volume.is_normal() && cell_volume.is_finite()) {
-        return bad(
+        return r.bad(
             "grid.cell_size",
             format!(
                 "h = {:e} m gives a cell volume h^{n} = {cell_volume:e}, which is not a finite number > 0",
@@ -498,13 +557,13 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
     if let Some(a) =
         (0..n).find(|&a| !(s.grid.origin[a] + s.grid.cell_size * s.grid.cells[a] as f64).is_finite())
     {
-        return bad(
+        return r.bad(
             "grid.cells",
             format!("the grid's far corner along axis {a} is not a finite coordinate"),
         );
     }
     if let Some(c) = s.grid.cells.iter().find(|&&c| c < min_cells) {
-        return bad(
+        return r.bad(
             "grid.cells",
             format!(
                 "every axis needs at least {min_cells} cell(s) with {:?} shape functions, found {c}",
@@ -512,8 +571,14 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
             ),
         );
     }
+    Ok(())
+}
+
+/// Every material, checked by its own scene entry; the models in name order.
+fn check_materials(r: &Rules) -> Result<Vec<(String, MaterialModel)>, SceneError> {
+    let (loaded, s) = (r.loaded, &r.loaded.scene);
     if s.materials.is_empty() {
-        return bad("materials", "the scene defines no material".into());
+        return r.bad("materials", "the scene defines no material".into());
     }
     let mut table = Vec::new();
     for (name, m) in &s.materials {
@@ -523,15 +588,21 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
             .map_err(|(field, rule)| loaded.invalid(&field, rule))?;
         table.push((name.clone(), model));
     }
+    Ok(table)
+}
+
+/// The solver's and the output's settings that stand alone.
+fn check_solver(r: &Rules) -> Result<(), SceneError> {
+    let s = &r.loaded.scene;
     if !positive(s.solver.tolerance) {
-        return bad(
+        return r.bad(
             "solver.tolerance",
             format!("must be > 0, found {}", s.solver.tolerance),
         );
     }
     if let crate::state::Damping::Viscous { beta } = s.solver.damping {
         if !non_negative(beta) {
-            return bad(
+            return r.bad(
                 "solver.damping",
                 format!("viscous β must be ≥ 0 (1/s), found {beta}"),
             );
@@ -539,29 +610,29 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
     }
     if let Some(snap) = s.output.snapshots {
         if snap.every_steps == Some(0) {
-            return bad("output.snapshots.every_steps", "must be ≥ 1 step".to_string());
+            return r.bad("output.snapshots.every_steps", "must be ≥ 1 step".to_string());
         }
         if let Some(t) = snap.every_time {
             if !positive(t) {
-                return bad("output.snapshots.every_time", format!("must be > 0 s, found {t}"));
+                return r.bad("output.snapshots.every_time", format!("must be > 0 s, found {t}"));
             }
         }
         if snap.every_steps.is_none() && snap.every_time.is_none() && !snap.at_resets {
-            return bad(
+            return r.bad(
                 "output.snapshots",
                 "takes no snapshot but the last: set every_steps, every_time or at_resets".to_string(),
             );
         }
     }
     if s.solver.peak_interpolation && s.solver.damping != crate::state::Damping::Kinetic {
-        return bad(
+        return r.bad(
             "solver.peak_interpolation",
             "places kinetic-damping resets: it needs `damping: Kinetic`".to_string(),
         );
     }
     if let crate::state::Damping::Local { alpha } = s.solver.damping {
         if !(non_negative(alpha) && alpha < 1.0) {
-            return bad(
+            return r.bad(
                 "solver.damping",
                 format!("local damping α must be in [0, 1), found {alpha}"),
             );
@@ -569,13 +640,13 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
     }
     if let Some(c) = s.solver.static_check {
         if !positive(c.window) {
-            return bad(
+            return r.bad(
                 "solver.static_check.window",
                 format!("must be > 0 s, found {}", c.window),
             );
         }
         if !positive(c.max_displacement) {
-            return bad(
+            return r.bad(
                 "solver.static_check.max_displacement",
                 format!("must be > 0 m, found {}", c.max_displacement),
             );
@@ -586,38 +657,38 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
         ("solver.virtual_mass_floor", s.solver.virtual_mass_floor),
     ] {
         if !(0.0..1.0).contains(&value) {
-            return bad(
+            return r.bad(
                 field,
                 format!("must be in [0, 1) (a fraction of a full node's mass), found {value}"),
             );
         }
     }
     if !(0.0..=1.0).contains(&s.solver.flip) {
-        return bad(
+        return r.bad(
             "solver.flip",
             format!("must be in [0, 1] (1 = FLIP, 0 = PIC), found {}", s.solver.flip),
         );
     }
     if s.solver.max_steps.is_none() && s.solver.max_time.is_none() {
-        return bad(
+        return r.bad(
             "solver",
             "set max_steps or max_time, so that a run that never converges still ends".into(),
         );
     }
     if s.solver.max_steps == Some(0) {
-        return bad("solver.max_steps", "must be ≥ 1".into());
+        return r.bad("solver.max_steps", "must be ≥ 1".into());
     }
     if let Some(t) = s.solver.max_time {
         if !positive(t) {
-            return bad("solver.max_time", format!("must be > 0 s, found {t}"));
+            return r.bad("solver.max_time", format!("must be > 0 s, found {t}"));
         }
     }
     match s.solver.checkpoint_every {
         Some(super::CheckpointEvery::Steps(0)) => {
-            return bad("solver.checkpoint_every", "Steps(n) needs n ≥ 1".into());
+            return r.bad("solver.checkpoint_every", "Steps(n) needs n ≥ 1".into());
         }
         Some(super::CheckpointEvery::Seconds(t)) if !positive(t) => {
-            return bad(
+            return r.bad(
                 "solver.checkpoint_every",
                 format!("Seconds(t) needs a wall time t > 0 s, found {t}"),
             );
@@ -625,10 +696,16 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
         _ => {}
     }
     if s.output.history_every == 0 {
-        return bad("output.history_every", "must be ≥ 1".into());
+        return r.bad("output.history_every", "must be ≥ 1".into());
     }
+    Ok(())
+}
+
+/// The bodies: material, points per cell, region.
+fn check_bodies(r: &Rules) -> Result<(), SceneError> {
+    let (s, n) = (&r.loaded.scene, r.n);
     if s.bodies.is_empty() {
-        return bad(
+        return r.bad(
             "bodies",
             "the scene has no body: there is nothing to simulate".into(),
         );
@@ -636,7 +713,7 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
     for (b, body) in s.bodies.iter().enumerate() {
         if !s.materials.contains_key(&body.material) {
             let known: Vec<_> = s.materials.keys().map(String::as_str).collect();
-            return bad(
+            return r.bad(
                 &format!("bodies[{b}].material"),
                 format!(
                     "unknown material \"{}\" (defined: {})",
@@ -645,24 +722,24 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
                 ),
             );
         }
-        len(
+        r.len(
             &format!("bodies[{b}].points_per_cell"),
             body.points_per_cell.len(),
         )?;
         if body.points_per_cell.contains(&0) {
-            return bad(
+            return r.bad(
                 &format!("bodies[{b}].points_per_cell"),
                 "every entry must be ≥ 1".into(),
             );
         }
         match &body.region {
             Region::Box { min, max } => {
-                len(&format!("bodies[{b}].region.min"), min.len())?;
-                len(&format!("bodies[{b}].region.max"), max.len())?;
-                finite(&format!("bodies[{b}].region.min"), min, "m")?;
-                finite(&format!("bodies[{b}].region.max"), max, "m")?;
+                r.len(&format!("bodies[{b}].region.min"), min.len())?;
+                r.len(&format!("bodies[{b}].region.max"), max.len())?;
+                r.finite(&format!("bodies[{b}].region.min"), min, "m")?;
+                r.finite(&format!("bodies[{b}].region.max"), max, "m")?;
                 if min.iter().zip(max).any(|(a, b)| !positive(b - a)) {
-                    return bad(
+                    return r.bad(
                         &format!("bodies[{b}].region"),
                         "box needs min < max on every axis".into(),
                     );
@@ -670,34 +747,34 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
             }
             Region::Polygon { vertices, z } => {
                 if vertices.len() < 3 {
-                    return bad(
+                    return r.bad(
                         &format!("bodies[{b}].region.vertices"),
                         "a polygon needs at least 3 vertices".into(),
                     );
                 }
                 if let Some(k) = vertices.iter().position(|v| v.len() != 2) {
-                    return bad(
+                    return r.bad(
                         &format!("bodies[{b}].region.vertices"),
                         format!("vertex {k} needs 2 entries [x, y], found {}", vertices[k].len()),
                     );
                 }
                 for (k, v) in vertices.iter().enumerate() {
-                    finite(&format!("bodies[{b}].region.vertices[{k}]"), v, "m")?;
+                    r.finite(&format!("bodies[{b}].region.vertices[{k}]"), v, "m")?;
                 }
                 if let Some(z) = z {
                     if n == 2 {
-                        return bad(
+                        return r.bad(
                             &format!("bodies[{b}].region.z"),
                             "a 2D polygon has no extent along z: remove z (it is for 3D scenes)".into(),
                         );
                     }
-                    finite(&format!("bodies[{b}].region.z"), z, "m")?;
+                    r.finite(&format!("bodies[{b}].region.z"), z, "m")?;
                 }
                 if let Some(rule) = polygon_fault(vertices) {
-                    return bad(&format!("bodies[{b}].region.vertices"), rule);
+                    return r.bad(&format!("bodies[{b}].region.vertices"), rule);
                 }
                 if n == 3 && !z.as_ref().is_some_and(|z| z.len() == 2 && positive(z[1] - z[0])) {
-                    return bad(
+                    return r.bad(
                         &format!("bodies[{b}].region"),
                         "in 3D a polygon needs z: [z_min, z_max] with z_min < z_max".into(),
                     );
@@ -705,29 +782,41 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
             }
         }
     }
+    Ok(())
+}
+
+/// Face conditions, gravity, point loads, and what the materials make of them.
+fn check_loads(r: &Rules, table: &[(String, MaterialModel)]) -> Result<(), SceneError> {
+    let (loaded, s, n) = (r.loaded, &r.loaded.scene, r.n);
     check_faces(&s.boundaries, "boundaries", n).map_err(|(field, rule)| loaded.invalid(&field, rule))?;
     if let Some(g) = &s.gravity {
-        len("gravity.acceleration", g.acceleration.len())?;
-        finite("gravity.acceleration", &g.acceleration, "m/s²")?;
+        r.len("gravity.acceleration", g.acceleration.len())?;
+        r.finite("gravity.acceleration", &g.acceleration, "m/s²")?;
         if !non_negative(g.ramp_time) {
-            return bad(
+            return r.bad(
                 "gravity.ramp_time",
                 format!("must be ≥ 0 s, found {}", g.ramp_time),
             );
         }
     }
-    check_mass_finite(loaded, &table, n)?;
+    check_mass_finite(loaded, table, n)?;
     if s.solver.volumetric_smoothing {
         check_smoothing(loaded)?;
     }
     for (i, l) in s.point_loads.iter().enumerate() {
-        len(&format!("point_loads[{i}].position"), l.position.len())?;
-        len(&format!("point_loads[{i}].force"), l.force.len())?;
-        finite(&format!("point_loads[{i}].position"), &l.position, "m")?;
-        finite(&format!("point_loads[{i}].force"), &l.force, "N")?;
+        r.len(&format!("point_loads[{i}].position"), l.position.len())?;
+        r.len(&format!("point_loads[{i}].force"), l.force.len())?;
+        r.finite(&format!("point_loads[{i}].position"), &l.position, "m")?;
+        r.finite(&format!("point_loads[{i}].force"), &l.force, "N")?;
     }
+    Ok(())
+}
+
+/// Motions, names, and the strength-reduction analysis.
+fn check_motions_and_analyses(r: &Rules) -> Result<(), SceneError> {
+    let (loaded, s) = (r.loaded, &r.loaded.scene);
     if s.motions.len() > NodeFixity::MAX_DRIVES {
-        return bad(
+        return r.bad(
             "motions",
             format!(
                 "at most {} motions, found {}",
@@ -741,80 +830,93 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
             .map_err(|(field, rule)| loaded.invalid(&format!("motions[{i}].{field}"), rule))?;
     }
     unique_names(s).map_err(|(field, rule)| loaded.invalid(&field, rule))?;
-    if let Some(r) = &s.strength_reduction {
-        let ok = matches!(r.bracket[..], [lo, hi] if lo.is_finite() && hi.is_finite() && 0.0 < lo && lo < hi);
+    if let Some(spec) = &s.strength_reduction {
+        let ok =
+            matches!(spec.bracket[..], [lo, hi] if lo.is_finite() && hi.is_finite() && 0.0 < lo && lo < hi);
         if !ok {
-            return bad(
+            return r.bad(
                 "strength_reduction.bracket",
-                format!("needs two factors 0 < low < high, found {:?}", r.bracket),
+                format!("needs two factors 0 < low < high, found {:?}", spec.bracket),
             );
         }
-        let hi = r.bracket[1];
-        if !(r.tolerance.is_finite() && r.tolerance >= MIN_FOS_TOLERANCE * hi) {
-            return bad(
+        let hi = spec.bracket[1];
+        if !(spec.tolerance.is_finite() && spec.tolerance >= MIN_FOS_TOLERANCE * hi) {
+            return r.bad(
                 "strength_reduction.tolerance",
                 format!(
                     "must be at least {MIN_FOS_TOLERANCE:e} of the bracket's high end ({:e}), found {:e}: \
                      each halving of the bracket is a whole run, and a factor finer than that is \
                      below what a trial resolves",
                     MIN_FOS_TOLERANCE * hi,
-                    r.tolerance
+                    spec.tolerance
                 ),
             );
         }
-        if !(r.failure_displacement.is_finite() && r.failure_displacement > 0.0) {
-            return bad(
+        if !(spec.failure_displacement.is_finite() && spec.failure_displacement > 0.0) {
+            return r.bad(
                 "strength_reduction.failure_displacement",
                 "must be above 0 (m)".into(),
             );
         }
-        if r.check_every == 0 {
-            return bad(
+        if spec.check_every == 0 {
+            return r.bad(
                 "strength_reduction.check_every",
                 "must be at least 1 (steps)".into(),
             );
         }
         if !s.output.displacements {
-            return bad(
+            return r.bad(
                 "output.displacements",
                 "strength reduction judges trials by displacement: keep them (true)".into(),
             );
         }
     }
+    Ok(())
+}
+
+/// Tractions and traced points.
+fn check_tractions_and_traced(r: &Rules) -> Result<(), SceneError> {
+    let (s, n) = (&r.loaded.scene, r.n);
     for (i, t) in s.tractions.iter().enumerate() {
-        len(&format!("tractions[{i}].min"), t.min.len())?;
-        len(&format!("tractions[{i}].max"), t.max.len())?;
-        len(&format!("tractions[{i}].traction"), t.traction.len())?;
-        finite(&format!("tractions[{i}].min"), &t.min, "m")?;
-        finite(&format!("tractions[{i}].max"), &t.max, "m")?;
-        finite(&format!("tractions[{i}].traction"), &t.traction, "Pa")?;
+        r.len(&format!("tractions[{i}].min"), t.min.len())?;
+        r.len(&format!("tractions[{i}].max"), t.max.len())?;
+        r.len(&format!("tractions[{i}].traction"), t.traction.len())?;
+        r.finite(&format!("tractions[{i}].min"), &t.min, "m")?;
+        r.finite(&format!("tractions[{i}].max"), &t.max, "m")?;
+        r.finite(&format!("tractions[{i}].traction"), &t.traction, "Pa")?;
         if t.min.iter().zip(&t.max).any(|(lo, hi)| lo > hi) {
-            return bad(
+            return r.bad(
                 &format!("tractions[{i}].max"),
                 "every entry must be at least min's".into(),
             );
         }
         if t.increments == Some(0) {
-            return bad(&format!("tractions[{i}].increments"), "must be at least 1".into());
+            return r.bad(&format!("tractions[{i}].increments"), "must be at least 1".into());
         }
         if t.increments.is_some() && !s.output.displacements {
-            return bad(
+            return r.bad(
                 &format!("tractions[{i}].increments"),
                 "the curve follows the loaded points' displacement: keep them (output.displacements: true)"
                     .into(),
             );
         }
         if t.surface.axis_side().0 >= n {
-            return bad(
+            return r.bad(
                 &format!("tractions[{i}].surface"),
                 format!("{:?} is not a face of a {n}D grid", t.surface),
             );
         }
     }
     for (i, t) in s.traced.iter().enumerate() {
-        len(&format!("traced[{i}].position"), t.position.len())?;
-        finite(&format!("traced[{i}].position"), &t.position, "m")?;
+        r.len(&format!("traced[{i}].position"), t.position.len())?;
+        r.finite(&format!("traced[{i}].position"), &t.position, "m")?;
     }
+    Ok(())
+}
+
+/// A scene without load is static as it stands.
+fn check_has_load(r: &Rules) -> Result<(), SceneError> {
+    let s = &r.loaded.scene;
     // A scene without load is static as it stands: K_F and K_E are 0/0 at every step and
     // there is nothing to solve. Say so rather than run it.
     let gravity = s
@@ -824,7 +926,7 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
     let loads = s.point_loads.iter().any(|l| l.force.iter().any(|&f| f != 0.0))
         || s.tractions.iter().any(|t| t.traction.iter().any(|&f| f != 0.0));
     if !gravity && !loads && s.motions.is_empty() {
-        return bad(
+        return r.bad(
             if s.gravity.is_some() {
                 "gravity.acceleration"
             } else {
@@ -835,6 +937,12 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
                 .into(),
         );
     }
+    Ok(())
+}
+
+/// The time step: the critical one of the materials bodies use, and the scheme's limits.
+fn time_step(r: &Rules, table: &[(String, MaterialModel)]) -> Result<StepChoice, SceneError> {
+    let s = &r.loaded.scene;
     // Only materials that bodies use set the time step: a stiff material kept in a scene
     // for later would otherwise make every run take more steps for nothing.
     let used = |name: &str| s.bodies.iter().any(|b| b.material == name);
@@ -855,7 +963,7 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
         .collect();
     let dt_crit = s.grid.cell_size / c_p;
     if !positive(dt_crit) {
-        return bad(
+        return r.bad(
             "grid.cell_size",
             format!(
                 "the critical time step h/c_p = {} m / {c_p} m/s = {dt_crit} s is not a finite number > 0",
@@ -866,13 +974,13 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
     let dt = match s.solver.time_step {
         TimeStep::Fixed(dt) => {
             if !positive(dt) {
-                return bad(
+                return r.bad(
                     "solver.time_step",
                     format!("Fixed(Δt) needs Δt > 0 s, found {dt}"),
                 );
             }
             if dt > dt_crit {
-                return bad(
+                return r.bad(
                     "solver.time_step",
                     format!(
                         "Δt = {dt} s is above the critical step h/c_p = {dt_crit:.6} s (c_p = {c_p:.4} m/s) \
@@ -885,7 +993,7 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
         }
         TimeStep::Courant(a) => {
             if !(positive(a) && a <= 1.0) {
-                return bad(
+                return r.bad(
                     "solver.time_step",
                     format!("Courant(α) needs 0 < α ≤ 1, found {a}"),
                 );
@@ -894,7 +1002,7 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
         }
     };
     if s.solver.mass_scaling && dt > MASS_SCALING_COURANT_LIMIT * dt_crit * (1.0 + 1e-12) {
-        return bad(
+        return r.bad(
             "solver.time_step",
             format!(
                 "Δt = {dt:.6e} s is Courant {:.3} of the slowest material; with mass scaling the \
@@ -905,7 +1013,7 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
         );
     }
     if s.solver.scheme == Scheme::Usl && dt > USL_COURANT_LIMIT * dt_crit * (1.0 + 1e-12) {
-        return bad(
+        return r.bad(
             "solver.time_step",
             format!(
                 "Δt = {dt:.6e} s is Courant {:.3}; USL is unstable above Courant {USL_COURANT_LIMIT} \
@@ -919,7 +1027,7 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
     // βΔt = 1 that factor is below −1 and the velocities grow without bound.
     if let crate::state::Damping::Viscous { beta } = s.solver.damping {
         if beta * dt > 1.0 {
-            return bad(
+            return r.bad(
                 "solver.damping",
                 format!(
                     "viscous β = {beta:e} 1/s with Δt = {dt:.6e} s gives βΔt = {:.3e}: explicit viscous \
@@ -933,7 +1041,7 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
     // A time step that rounds to zero or to a subnormal never advances the clock: the run
     // would write history rows for ever without getting anywhere.
     if !dt.is_normal() {
-        return bad(
+        return r.bad(
             "solver.time_step",
             format!("gives Δt = {dt:e} s, too small to advance the simulated time"),
         );
@@ -941,7 +1049,7 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
     if let (Some(t), None) = (s.solver.max_time, s.solver.max_steps) {
         let steps = t / dt;
         if steps > MAX_IMPLIED_STEPS {
-            return bad(
+            return r.bad(
                 "solver.max_time",
                 format!(
                     "{t} s at Δt = {dt:e} s is {steps:.3e} steps (more than {MAX_IMPLIED_STEPS:e}): \
@@ -950,10 +1058,21 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
             );
         }
     }
+    Ok(StepChoice {
+        p_wave_speed: c_p,
+        critical: dt_crit,
+        dt,
+        unused_materials,
+    })
+}
+
+/// The stages: each material, load, face condition and gravity they set.
+fn check_stages(r: &Rules, table: &[(String, MaterialModel)], c_p: f64) -> Result<(), SceneError> {
+    let (loaded, s, n) = (r.loaded, &r.loaded.scene, r.n);
     for (k, st) in s.stages.iter().enumerate() {
         for (name, spec) in &st.materials {
             if !s.materials.contains_key(name) {
-                return bad(
+                return r.bad(
                     &format!("stages[{k}].materials"),
                     format!("\"{name}\" is not a material of the scene: a stage replaces one"),
                 );
@@ -963,10 +1082,10 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
                 .model(&at)
                 .map_err(|(field, rule)| loaded.invalid(&field, rule))?;
             // A point carries one model's state for the whole run.
-            if let Some(carried) = carried_state(loaded, &table, name) {
+            if let Some(carried) = carried_state(loaded, table, name) {
                 if let (Some(a), Some(b)) = (carried.state_name(), model.state_name()) {
                     if a != b {
-                        return bad(
+                        return r.bad(
                             &format!("stages[{k}].materials.{name}"),
                             format!(
                                 "{} has another internal state than {}, which \"{name}\" takes \
@@ -981,7 +1100,7 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
             }
             let speed = (model.p_wave_modulus() / model.density()).sqrt();
             if speed > c_p * (1.0 + 1e-12) {
-                return bad(
+                return r.bad(
                     &at("youngs_modulus"),
                     format!(
                         "a P-wave speed of {speed:.6} m/s, above the {c_p:.6} m/s that set the time \
@@ -993,28 +1112,28 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
         }
         for (name, force) in &st.point_loads {
             if !s.point_loads.iter().any(|l| l.name == *name) {
-                return bad(
+                return r.bad(
                     &format!("stages[{k}].point_loads"),
                     format!("\"{name}\" is not a point load of the scene"),
                 );
             }
-            len(&format!("stages[{k}].point_loads.{name}"), force.len())?;
-            finite(&format!("stages[{k}].point_loads.{name}"), force, "N")?;
+            r.len(&format!("stages[{k}].point_loads.{name}"), force.len())?;
+            r.finite(&format!("stages[{k}].point_loads.{name}"), force, "N")?;
         }
         for (name, traction) in &st.tractions {
             let field = format!("stages[{k}].tractions.{name}");
             match s.tractions.iter().find(|t| t.name == *name) {
-                None => return bad(&field, format!("\"{name}\" is not a traction of the scene")),
+                None => return r.bad(&field, format!("\"{name}\" is not a traction of the scene")),
                 Some(t) if t.increments.is_some() => {
-                    return bad(
+                    return r.bad(
                         &field,
                         "this traction is applied in increments: a stage cannot set it too".into(),
                     )
                 }
                 Some(_) => {}
             }
-            len(&field, traction.len())?;
-            finite(&field, traction, "Pa")?;
+            r.len(&field, traction.len())?;
+            r.finite(&field, traction, "Pa")?;
         }
         if let Some(b) = &st.boundaries {
             check_faces(b, &format!("stages[{k}].boundaries"), n)
@@ -1022,32 +1141,38 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
         }
         if let Some(g) = &st.gravity {
             if s.gravity.is_none() {
-                return bad(
+                return r.bad(
                     &format!("stages[{k}].gravity"),
                     "the scene has no gravity: give it one (even [0, 0]) for a stage to change".into(),
                 );
             }
-            len(&format!("stages[{k}].gravity.acceleration"), g.acceleration.len())?;
-            finite(
+            r.len(&format!("stages[{k}].gravity.acceleration"), g.acceleration.len())?;
+            r.finite(
                 &format!("stages[{k}].gravity.acceleration"),
                 &g.acceleration,
                 "m/s²",
             )?;
             if !non_negative(g.ramp_time) {
-                return bad(&format!("stages[{k}].gravity.ramp_time"), "must be ≥ 0 s".into());
+                return r.bad(&format!("stages[{k}].gravity.ramp_time"), "must be ≥ 0 s".into());
             }
         }
         if st.reset_displacements && !s.output.displacements {
-            return bad(
+            return r.bad(
                 &format!("stages[{k}].reset_displacements"),
                 "needs the displacements kept (output.displacements: true)".into(),
             );
         }
     }
-    let estimate = estimate(loaded, &table)?;
+    Ok(())
+}
+
+/// The memory bound against what the process may have.
+fn check_memory(r: &Rules, table: &[(String, MaterialModel)]) -> Result<Estimate, SceneError> {
+    let loaded = r.loaded;
+    let estimate = estimate(loaded, table)?;
     if let Some((total, what)) = memory_limit() {
         if estimate.bytes > total {
-            return bad(
+            return r.bad(
                 "grid",
                 format!(
                     "the scene needs up to {:.3} GB ({} points, {} nodes at most), more than {what}, {:.3} GB: \
@@ -1060,12 +1185,5 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
             );
         }
     }
-    Ok(Checked {
-        materials: table,
-        p_wave_speed: c_p,
-        critical_time_step: dt_crit,
-        time_step: dt,
-        unused_materials,
-        estimate,
-    })
+    Ok(estimate)
 }

@@ -176,11 +176,9 @@ impl Study {
             .with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME)
             .from_str(text)
             .map_err(|e| {
-                let (line, column) = (e.span.start.line, e.span.start.col);
                 let message = e.code.to_string();
-                let field = locate::field_before(text, line, column)
-                    .filter(|f| !message.contains(&format!("`{f}`")))
-                    .map_or(String::new(), |f| format!("field `{f}`: "));
+                let (line, column, field) = locate::parse_error_place(text, &e);
+                let field = field.map_or(String::new(), |f| format!("field `{f}`: "));
                 SceneError::Syntax {
                     path: path.to_path_buf(),
                     line,
