@@ -107,6 +107,14 @@ impl OutputDir {
     }
 }
 
+/// Removes `path`; one that is not there is fine.
+pub(crate) fn remove_if_there(path: &Path) -> std::io::Result<()> {
+    match std::fs::remove_file(path) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(e),
+        _ => Ok(()),
+    }
+}
+
 /// Removes the `*.partial-<pid>` temporaries of [`write_atomic`] in `dir` and its
 /// `snapshots/` folder.
 fn remove_partials(dir: &Path) -> std::io::Result<()> {

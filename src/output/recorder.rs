@@ -101,24 +101,16 @@ fn clear_earlier_results(dir: &OutputDir) -> std::io::Result<()> {
     ];
     let names = fixed.iter().chain(&crate::output::plots::FILES);
     for name in names {
-        remove_if_there(&dir.file(name))?;
+        crate::output::dir::remove_if_there(&dir.file(name))?;
     }
     for e in std::fs::read_dir(dir.path())?.flatten() {
         let name = e.file_name().to_string_lossy().into_owned();
         // Over MPI, each rank's points.
         if name.starts_with("points_") && name.ends_with(".vtu") {
-            remove_if_there(&e.path())?;
+            crate::output::dir::remove_if_there(&e.path())?;
         }
     }
     crate::output::snapshots::clear(dir.path())
-}
-
-/// Removes `path`; one that is not there is fine.
-pub(crate) fn remove_if_there(path: &Path) -> std::io::Result<()> {
-    match std::fs::remove_file(path) {
-        Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(e),
-        _ => Ok(()),
-    }
 }
 
 /// The outputs a run writes into its directory: `history.csv` every `history_every` steps,

@@ -255,5 +255,5 @@ pub(crate) fn clear(dir: &Path) -> std::io::Result<()> {
             }
         }
     }
-    crate::output::recorder::remove_if_there(&dir.join(PVD))
+    crate::output::dir::remove_if_there(&dir.join(PVD))
 }
