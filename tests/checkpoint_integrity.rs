@@ -153,17 +153,7 @@ fn resume_refuses_a_checkpoint_beside_another_runs_history() {
     let (a, b) = (dir.join("a"), dir.join("b"));
     let bar = common::scene("bar.ron");
     let run = |out: &Path, sets: &[&str]| {
-        let mut args = vec![
-            "run",
-            bar.to_str().unwrap(),
-            "--quiet",
-            "--out",
-            out.to_str().unwrap(),
-        ];
-        for s in sets {
-            args.extend(["--set", s]);
-        }
-        let o = common::kdmpm(&args);
+        let o = common::run_into(&bar, out, sets);
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     };
     run(&a, &["solver.checkpoint_every=Steps(300)"]);

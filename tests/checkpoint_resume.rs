@@ -295,15 +295,8 @@ fn ctrl_c_checkpoints_and_a_resumed_run_writes_the_files_of_one_never_interrupte
         .spawn()
         .unwrap();
     // Interrupt once the run is under way (its history has rows beyond the header).
-    let history = cut.join("history.csv");
-    while std::fs::read_to_string(&history).map_or(0, |t| t.lines().count()) < 3 {
-        std::thread::sleep(std::time::Duration::from_millis(20));
-    }
-    let sent = Command::new("kill")
-        .args(["-INT", &child.id().to_string()])
-        .status()
-        .unwrap();
-    assert!(sent.success());
+    common::wait_until_running(&cut);
+    common::signal(child.id(), "INT");
     let o = child.wait_with_output().unwrap();
     assert_eq!(
         o.status.code(),
@@ -327,17 +320,7 @@ fn a_new_run_into_a_directory_drops_the_checkpoint_of_the_run_before() {
     let out = dir.join("out");
     let (bar, column) = (common::scene("bar.ron"), common::scene("soil_column.ron"));
     let run = |scene: &Path, sets: &[&str]| {
-        let mut args = vec![
-            "run",
-            scene.to_str().unwrap(),
-            "--quiet",
-            "--out",
-            out.to_str().unwrap(),
-        ];
-        for s in sets {
-            args.extend(["--set", s]);
-        }
-        let o = common::kdmpm(&args);
+        let o = common::run_into(scene, &out, sets);
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     };
     run(&bar, &["solver.checkpoint_every=Steps(300)"]);

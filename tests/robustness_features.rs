@@ -29,6 +29,18 @@ fn kdmpm_within(args: &[&str], sets: &[&str], limit: Duration) -> Output {
     child.wait_with_output().unwrap()
 }
 
+/// `kdmpm run SCENE --quiet --out OUT --set ...`, waited for at most `limit`.
+fn run_within(scene: &Path, out: &Path, sets: &[&str], limit: Duration) -> Output {
+    let args = [
+        "run",
+        scene.to_str().unwrap(),
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    kdmpm_within(&args, sets, limit)
+}
+
 /// `kdmpm check SCENE --set ...` exits 2 with one line holding every `expect`.
 fn refused(scene: &str, sets: &[&str], expect: &[&str]) {
     let path = common::scene(scene);
@@ -166,14 +178,9 @@ fn two_motions_over_one_node_are_refused() {
 fn a_load_in_billions_of_increments_stops_at_max_steps() {
     let dir = common::scratch("features", "increments");
     let scene = common::scene("footing_load.ron");
-    let o = kdmpm_within(
-        &[
-            "run",
-            scene.to_str().unwrap(),
-            "--quiet",
-            "--out",
-            dir.to_str().unwrap(),
-        ],
+    let o = run_within(
+        &scene,
+        &dir,
         &["tractions[0].increments=4294967295", "solver.max_steps=3000"],
         Duration::from_secs(120),
     );
@@ -365,17 +372,7 @@ fn a_scene_over_the_address_space_limit_is_refused_quickly() {
 fn a_huge_tolerance_draws_its_plots_and_plot_returns() {
     let dir = common::scratch("features", "huge-tolerance");
     let scene = common::scene("bar.ron");
-    let o = kdmpm_within(
-        &[
-            "run",
-            scene.to_str().unwrap(),
-            "--quiet",
-            "--out",
-            dir.to_str().unwrap(),
-        ],
-        &["solver.tolerance=5e307"],
-        Duration::from_secs(60),
-    );
+    let o = run_within(&scene, &dir, &["solver.tolerance=5e307"], Duration::from_secs(60));
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let o = kdmpm_within(&["plot", dir.to_str().unwrap()], &[], Duration::from_secs(60));
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
@@ -413,10 +410,7 @@ fn a_new_run_leaves_no_earlier_result_or_partial_file_beside_its_history() {
         .arg(&dir)
         .spawn()
         .unwrap();
-    let history = dir.join("history.csv");
-    while std::fs::read_to_string(&history).map_or(0, |t| t.lines().count()) < 3 {
-        std::thread::sleep(Duration::from_millis(20));
-    }
+    common::wait_until_running(&dir);
     child.kill().unwrap();
     child.wait().unwrap();
     let left: Vec<String> = std::fs::read_dir(&dir)
@@ -447,15 +441,8 @@ fn sigterm_checkpoints_like_ctrl_c() {
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
-    let history = dir.join("history.csv");
-    while std::fs::read_to_string(&history).map_or(0, |t| t.lines().count()) < 3 {
-        std::thread::sleep(Duration::from_millis(20));
-    }
-    assert!(Command::new("kill")
-        .args(["-TERM", &child.id().to_string()])
-        .status()
-        .unwrap()
-        .success());
+    common::wait_until_running(&dir);
+    common::signal(child.id(), "TERM");
     let o = child.wait_with_output().unwrap();
     assert_eq!(
         o.status.code(),
@@ -535,15 +522,8 @@ fn sigterm_to_a_study_stops_its_run_and_waits_for_it() {
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
-    let history = out.join("run-001").join("history.csv");
-    while std::fs::read_to_string(&history).map_or(0, |t| t.lines().count()) < 3 {
-        std::thread::sleep(Duration::from_millis(20));
-    }
-    assert!(Command::new("kill")
-        .args(["-TERM", &child.id().to_string()])
-        .status()
-        .unwrap()
-        .success());
+    common::wait_until_running(&out.join("run-001"));
+    common::signal(child.id(), "TERM");
     let o = child.wait_with_output().unwrap();
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(130), "{err}");

@@ -47,6 +47,39 @@ pub fn kdmpm(args: &[&str]) -> std::process::Output {
         .expect("kdmpm starts")
 }
 
+/// Runs `kdmpm run SCENE --quiet --out OUT --set ...` and waits for it.
+pub fn run_into(scene: &Path, out: &Path, sets: &[&str]) -> std::process::Output {
+    let mut args = vec![
+        "run",
+        scene.to_str().unwrap(),
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    for s in sets {
+        args.extend(["--set", s]);
+    }
+    kdmpm(&args)
+}
+
+/// Waits until the run writing into `dir` has written rows beyond the header of its
+/// history: the run is under way.
+pub fn wait_until_running(dir: &Path) {
+    let history = dir.join("history.csv");
+    while std::fs::read_to_string(&history).map_or(0, |t| t.lines().count()) < 3 {
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+}
+
+/// Sends `signal` (`INT`, `TERM`) to the process `pid`.
+pub fn signal(pid: u32, signal: &str) {
+    let sent = std::process::Command::new("kill")
+        .args([&format!("-{signal}"), &pid.to_string()])
+        .status()
+        .unwrap();
+    assert!(sent.success(), "kill -{signal} {pid}");
+}
+
 /// An empty scratch directory for test group `group`, case `name`, unique to this process.
 pub fn scratch(group: &str, name: &str) -> std::path::PathBuf {
     let d = std::env::temp_dir().join(format!("kdmpm-{group}-{}-{name}", std::process::id()));
