@@ -1,7 +1,7 @@
 //! Building a simulation from a valid scene: grid nodes, material points, loads, tracing
 //! and the schedule. Only what the scene uses is created.
 
-use super::validate::{self, carried_state, Checked, Derived};
+use super::validate::{self, carried_state, Checked, Derived, StageModels};
 use super::{pad3, BoundarySpec, Condition, LoadedScene, Region, Scene};
 use crate::columns::{col, points_with};
 use crate::components::*;
@@ -260,26 +260,17 @@ fn check_motion_boxes<D: Dim>(
     Ok(())
 }
 
-/// The scene's stages with their materials built (indexed as `table`) and their loads by
-/// carrier id (`load_ids`).
+/// The scene's stages with the materials the check built (`stage_materials`) and their
+/// loads by carrier id (`load_ids`).
 fn stages<D: Dim>(
     grid: &Grid<D>,
     loaded: &LoadedScene,
-    table: &[(String, MaterialModel)],
+    stage_materials: StageModels,
     load_ids: &[(String, u32)],
     shares: &[(String, Vec<(u32, f64)>)],
-) -> Result<Vec<LoadStage>, SceneError> {
+) -> Vec<LoadStage> {
     let mut out = Vec::new();
-    for (k, st) in loaded.scene.stages.iter().enumerate() {
-        let mut materials = Vec::new();
-        for (name, spec) in &st.materials {
-            let at = |f: &str| format!("stages[{k}].materials.{name}.{f}");
-            let model = spec
-                .model(&at)
-                .map_err(|(field, rule)| loaded.invalid(&field, rule))?;
-            let id = table.iter().position(|(n, _)| n == name).expect("validated");
-            materials.push((id as u16, model));
-        }
+    for (st, materials) in loaded.scene.stages.iter().zip(stage_materials) {
         let mut loads: Vec<(u32, [f64; 3])> = st
             .point_loads
             .iter()
@@ -310,12 +301,13 @@ fn stages<D: Dim>(
             reset_displacements: st.reset_displacements,
         });
     }
-    Ok(out)
+    out
 }
 
 fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulation<D>, Derived), SceneError> {
     let Checked {
         materials: table,
+        stage_materials,
         p_wave_speed: c_p,
         critical_time_step: dt_crit,
         time_step: dt,
@@ -369,7 +361,7 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         }),
         min_node_mass: s.solver.node_mass_cutoff * full_node_mass,
         motions: s.motions.clone(),
-        stages: stages(&grid, loaded, &table, &load_ids, &placed.shares)?,
+        stages: stages(&grid, loaded, stage_materials, &load_ids, &placed.shares),
         load_steps: placed.steps,
         virtual_mass_floor: s.solver.virtual_mass_floor * full_node_mass,
     };

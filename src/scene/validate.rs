@@ -43,11 +43,16 @@ pub struct Derived {
     pub estimate: Estimate,
 }
 
+/// Each stage's materials, built once: the index in the scene's table and the model.
+pub type StageModels = Vec<Vec<(u16, MaterialModel)>>;
+
 /// What [`check`] establishes.
 #[derive(Clone, Debug)]
 pub struct Checked {
     /// Every material the scene defines, in name order.
     pub materials: Vec<(String, MaterialModel)>,
+    /// The materials each stage sets (by index in `materials`), in stage order.
+    pub stage_materials: StageModels,
     /// Largest P-wave speed sqrt(M/ρ) over the materials the bodies use (m/s).
     pub p_wave_speed: f64,
     /// Critical time step h / c_p (s).
@@ -493,10 +498,11 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
     check_tractions_and_traced(&r)?;
     check_has_load(&r)?;
     let step = time_step(&r, &table)?;
-    check_stages(&r, &table, step.p_wave_speed)?;
+    let stage_materials = check_stages(&r, &table, step.p_wave_speed)?;
     let estimate = check_memory(&r, &table)?;
     Ok(Checked {
         materials: table,
+        stage_materials,
         p_wave_speed: step.p_wave_speed,
         critical_time_step: step.critical,
         time_step: step.dt,
@@ -1067,9 +1073,11 @@ fn time_step(r: &Rules, table: &[(String, MaterialModel)]) -> Result<StepChoice,
 }
 
 /// The stages: each material, load, face condition and gravity they set.
-fn check_stages(r: &Rules, table: &[(String, MaterialModel)], c_p: f64) -> Result<(), SceneError> {
+fn check_stages(r: &Rules, table: &[(String, MaterialModel)], c_p: f64) -> Result<StageModels, SceneError> {
     let (loaded, s, n) = (r.loaded, &r.loaded.scene, r.n);
+    let mut built = Vec::with_capacity(s.stages.len());
     for (k, st) in s.stages.iter().enumerate() {
+        let mut models = Vec::with_capacity(st.materials.len());
         for (name, spec) in &st.materials {
             if !s.materials.contains_key(name) {
                 return r.bad(
@@ -1109,7 +1117,10 @@ fn check_stages(r: &Rules, table: &[(String, MaterialModel)], c_p: f64) -> Resul
                     ),
                 );
             }
+            let id = table.iter().position(|(n, _)| n == name).expect("checked above");
+            models.push((id as u16, model));
         }
+        built.push(models);
         for (name, force) in &st.point_loads {
             if !s.point_loads.iter().any(|l| l.name == *name) {
                 return r.bad(
@@ -1163,7 +1174,7 @@ fn check_stages(r: &Rules, table: &[(String, MaterialModel)], c_p: f64) -> Resul
             );
         }
     }
-    Ok(())
+    Ok(built)
 }
 
 /// The memory bound against what the process may have.
