@@ -295,15 +295,7 @@ fn ctrl_c_checkpoints_and_a_resumed_run_writes_the_files_of_one_never_interrupte
         .spawn()
         .unwrap();
     // Interrupt once the run is under way (its history has rows beyond the header).
-    common::wait_until_running(&cut);
-    common::signal(child.id(), "INT");
-    let o = child.wait_with_output().unwrap();
-    assert_eq!(
-        o.status.code(),
-        Some(130),
-        "{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
+    common::interrupt(child, &cut, "INT");
     let summary = summary_numbers(&cut);
     assert_eq!(summary["outcome"], "interrupted");
     assert!(summary["steps"].as_u64().unwrap() < 6000);

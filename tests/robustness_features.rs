@@ -41,6 +41,18 @@ fn run_within(scene: &Path, out: &Path, sets: &[&str], limit: Duration) -> Outpu
     kdmpm_within(&args, sets, limit)
 }
 
+/// `kdmpm fos SCENE --quiet --out OUT`, waited for at most `limit`.
+fn fos_within(scene: &Path, out: &Path, limit: Duration) -> Output {
+    let args = [
+        "fos",
+        scene.to_str().unwrap(),
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    kdmpm_within(&args, &[], limit)
+}
+
 /// `kdmpm check SCENE --set ...` exits 2 with one line holding every `expect`.
 fn refused(scene: &str, sets: &[&str], expect: &[&str]) {
     let path = common::scene(scene);
@@ -225,17 +237,7 @@ fn slope_with_strength_in_a_stage() -> PathBuf {
 fn fos_reduces_the_strength_that_a_stage_gives() {
     let scene = slope_with_strength_in_a_stage();
     let out = scene.parent().unwrap().join("out");
-    let o = kdmpm_within(
-        &[
-            "fos",
-            scene.to_str().unwrap(),
-            "--quiet",
-            "--out",
-            out.to_str().unwrap(),
-        ],
-        &[],
-        Duration::from_secs(300),
-    );
+    let o = fos_within(&scene, &out, Duration::from_secs(300));
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let s = summary(&out);
     assert_eq!(s["bracket"], serde_json::json!([1.40625, 1.421875]));
@@ -281,17 +283,7 @@ fn fos_into_a_path_that_cannot_be_a_directory_is_bad_input() {
     let file = dir.join("a-file");
     std::fs::write(&file, "").unwrap();
     let scene = common::scene("slope_fos.ron");
-    let o = kdmpm_within(
-        &[
-            "fos",
-            scene.to_str().unwrap(),
-            "--quiet",
-            "--out",
-            file.to_str().unwrap(),
-        ],
-        &[],
-        Duration::from_secs(60),
-    );
+    let o = fos_within(&scene, &file, Duration::from_secs(60));
     assert_eq!(o.status.code(), Some(2), "{}", String::from_utf8_lossy(&o.stderr));
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -441,15 +433,7 @@ fn sigterm_checkpoints_like_ctrl_c() {
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
-    common::wait_until_running(&dir);
-    common::signal(child.id(), "TERM");
-    let o = child.wait_with_output().unwrap();
-    assert_eq!(
-        o.status.code(),
-        Some(130),
-        "{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
+    common::interrupt(child, &dir, "TERM");
     assert_eq!(summary(&dir)["outcome"], "interrupted");
     assert!(dir.join("checkpoint.kdc").exists());
     let _ = std::fs::remove_dir_all(&dir);

@@ -80,6 +80,21 @@ pub fn signal(pid: u32, signal: &str) {
     assert!(sent.success(), "kill -{signal} {pid}");
 }
 
+/// Waits until `child`, a run writing into `dir`, is under way, sends it `signal` and
+/// waits for it: it must stop as interrupted (exit 130). Returns its output.
+pub fn interrupt(child: std::process::Child, dir: &Path, signal_name: &str) -> std::process::Output {
+    wait_until_running(dir);
+    signal(child.id(), signal_name);
+    let o = child.wait_with_output().unwrap();
+    assert_eq!(
+        o.status.code(),
+        Some(130),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    o
+}
+
 /// An empty scratch directory for test group `group`, case `name`, unique to this process.
 pub fn scratch(group: &str, name: &str) -> std::path::PathBuf {
     let d = std::env::temp_dir().join(format!("kdmpm-{group}-{}-{name}", std::process::id()));
