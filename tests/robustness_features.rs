@@ -372,6 +372,24 @@ fn a_huge_tolerance_draws_its_plots_and_plot_returns() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// Starts the failing slope (a run of some seconds) into `dir`, its stderr piped.
+fn start_slope(dir: &Path) -> std::process::Child {
+    let scene = common::scene("slope.ron");
+    Command::new(env!("CARGO_BIN_EXE_kdmpm"))
+        .args([
+            "run",
+            scene.to_str().unwrap(),
+            "--quiet",
+            "--set",
+            "output.snapshots=None",
+            "--out",
+        ])
+        .arg(dir)
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap()
+}
+
 /// A new run into a directory removes what the run before left as results and what a
 /// killed process left half-written, before it writes anything: a crash of the new run
 /// leaves nothing old looking current.
@@ -389,19 +407,7 @@ fn a_new_run_leaves_no_earlier_result_or_partial_file_beside_its_history() {
         std::fs::write(dir.join(f), "from an earlier run").unwrap();
     }
     std::fs::write(dir.join("summary.json.partial-999999"), "half").unwrap();
-    let scene = common::scene("slope.ron");
-    let mut child = Command::new(env!("CARGO_BIN_EXE_kdmpm"))
-        .args([
-            "run",
-            scene.to_str().unwrap(),
-            "--quiet",
-            "--set",
-            "output.snapshots=None",
-            "--out",
-        ])
-        .arg(&dir)
-        .spawn()
-        .unwrap();
+    let mut child = start_slope(&dir);
     common::wait_until_running(&dir);
     child.kill().unwrap();
     child.wait().unwrap();
@@ -419,20 +425,7 @@ fn a_new_run_leaves_no_earlier_result_or_partial_file_beside_its_history() {
 #[test]
 fn sigterm_checkpoints_like_ctrl_c() {
     let dir = common::scratch("features", "sigterm");
-    let scene = common::scene("slope.ron");
-    let child = Command::new(env!("CARGO_BIN_EXE_kdmpm"))
-        .args([
-            "run",
-            scene.to_str().unwrap(),
-            "--quiet",
-            "--set",
-            "output.snapshots=None",
-            "--out",
-        ])
-        .arg(&dir)
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
+    let child = start_slope(&dir);
     common::interrupt(child, &dir, "TERM");
     assert_eq!(summary(&dir)["outcome"], "interrupted");
     assert!(dir.join("checkpoint.kdc").exists());
