@@ -399,6 +399,20 @@ pub struct Clock {
     pub time: f64,
 }
 
+impl Clock {
+    /// The limit this step reached, if any: `max_steps`, then `max_time` (to round-off of
+    /// n·Δt).
+    pub fn limit(&self, settings: &Settings) -> Option<StopReason> {
+        if settings.max_steps.is_some_and(|m| self.step >= m) {
+            Some(StopReason::MaxSteps)
+        } else if settings.max_time.is_some_and(|t| self.time >= t * (1.0 - 1e-12)) {
+            Some(StopReason::MaxTime)
+        } else {
+            None
+        }
+    }
+}
+
 /// The kinetic energy of the last three steps (J), from which the peak watch finds a peak
 /// (paper §2.2): the energy fell, so the step before was its peak.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -576,13 +590,6 @@ impl SolverState {
     /// once would otherwise never reach `max_steps`).
     pub fn go_on(&mut self, settings: &Settings) {
         self.static_window.start = None;
-        let Clock { step, time } = self.clock;
-        self.stop = if settings.max_steps.is_some_and(|m| step >= m) {
-            Some(StopReason::MaxSteps)
-        } else if settings.max_time.is_some_and(|t| time >= t * (1.0 - 1e-12)) {
-            Some(StopReason::MaxTime)
-        } else {
-            None
-        };
+        self.stop = self.clock.limit(settings);
     }
 }

@@ -30,20 +30,21 @@ pub fn is_defined(ratio: f64) -> bool {
 /// is undefined (pandas, R and spreadsheets read an empty cell as missing, where a word
 /// would turn the whole column into text).
 pub fn ratio_cell(ratio: f64, digits: usize) -> String {
-    if is_defined(ratio) {
-        format!("{ratio:.digits$e}")
-    } else {
-        String::new()
-    }
+    ratio_or(ratio, digits, "")
 }
 
 /// A ratio as text for people: in scientific notation with `digits` decimals, or
 /// `undefined`.
 pub fn ratio_text(ratio: f64, digits: usize) -> String {
+    ratio_or(ratio, digits, "undefined")
+}
+
+/// A ratio in scientific notation with `digits` decimals, or `undefined` where it has none.
+fn ratio_or(ratio: f64, digits: usize, undefined: &str) -> String {
     if is_defined(ratio) {
         format!("{ratio:.digits$e}")
     } else {
-        "undefined".into()
+        undefined.into()
     }
 }
 
@@ -241,7 +242,7 @@ impl<D: Dim> System<D> for Convergence {
             });
         }
         let tol = ctx.settings.tolerance;
-        let (step, time) = (s.clock.step, s.clock.time);
+        let time = s.clock.time;
         // A load still ramping up, or a prescribed motion still moving, is not a static
         // state, however balanced this step is.
         let loading = ctx
@@ -260,10 +261,8 @@ impl<D: Dim> System<D> for Convergence {
         let s = &mut ctx.state;
         if converged {
             s.stop = Some(StopReason::Converged);
-        } else if ctx.settings.max_steps.is_some_and(|m| step >= m) {
-            s.stop = Some(StopReason::MaxSteps);
-        } else if ctx.settings.max_time.is_some_and(|t| time >= t * (1.0 - 1e-12)) {
-            s.stop = Some(StopReason::MaxTime);
+        } else if let Some(limit) = s.clock.limit(&ctx.settings) {
+            s.stop = Some(limit);
         }
         Ok(())
     }
