@@ -100,8 +100,7 @@ pub static STOP: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::
 /// that sets a material (a geostatic stage, then the soil's strength).
 pub fn reduced(loaded: &LoadedScene, factor: f64) -> LoadedScene {
     let mut l = loaded.clone();
-    let staged = l.scene.stages.iter_mut().flat_map(|st| st.materials.values_mut());
-    for m in l.scene.materials.values_mut().chain(staged) {
+    for (_, m) in l.scene.every_material_mut() {
         m.reduce_strength(factor);
     }
     l
@@ -109,12 +108,10 @@ pub fn reduced(loaded: &LoadedScene, factor: f64) -> LoadedScene {
 
 /// True when some material of the scene or of a stage has a strength to reduce.
 fn has_strength(loaded: &LoadedScene) -> bool {
-    let s = &loaded.scene;
-    let staged = s.stages.iter().flat_map(|st| st.materials.values());
-    s.materials
-        .values()
-        .chain(staged)
-        .any(|m| m.clone().reduce_strength(1.0))
+    loaded
+        .scene
+        .every_material()
+        .any(|(_, m)| m.clone().reduce_strength(1.0))
 }
 
 /// Runs the analysis of `loaded` into `out`; `report` sees each trial as it ends.

@@ -450,6 +450,20 @@ fn ron_options() -> ron::Options {
         .with_default_extension(Extensions::IMPLICIT_SOME | Extensions::UNWRAP_VARIANT_NEWTYPES)
 }
 
+impl Scene {
+    /// Every material entry, the scene's then those its stages set, in order, by name.
+    pub fn every_material(&self) -> impl Iterator<Item = (&String, &MaterialSpec)> {
+        let staged = self.stages.iter().flat_map(|st| st.materials.iter());
+        self.materials.iter().chain(staged)
+    }
+
+    /// [`Scene::every_material`], to change them (strength reduction).
+    pub fn every_material_mut(&mut self) -> impl Iterator<Item = (&String, &mut MaterialSpec)> {
+        let staged = self.stages.iter_mut().flat_map(|st| st.materials.iter_mut());
+        self.materials.iter_mut().chain(staged)
+    }
+}
+
 impl LoadedScene {
     /// Reads and parses a scene file, applying `overrides` (`path.to.field=value`) first.
     pub fn from_file(path: &Path, overrides: &[String]) -> Result<Self, SceneError> {

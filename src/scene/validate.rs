@@ -389,8 +389,7 @@ fn check_mass_finite(
 /// limit pressure falls 12 % below Prandtl–Reissner and the footing then sinks without end.
 fn check_smoothing(loaded: &LoadedScene) -> Result<(), SceneError> {
     let s = &loaded.scene;
-    let staged = s.stages.iter().flat_map(|st| st.materials.iter());
-    for (name, m) in s.materials.iter().chain(staged) {
+    for (name, m) in s.every_material() {
         let psi = m.dilatancy_angle();
         if psi > 0.0 {
             return Err(loaded.invalid(
