@@ -62,22 +62,8 @@ fn an_undefined_ratio_is_an_empty_cell_never_met_and_never_nan() {
     // With gravity ramping from 0, the first step has no external force at all.
     let dir = common::scratch("robust", "undefined");
     let out = dir.join("out");
-    let sets = [
-        "--set",
-        "gravity.ramp_time=1.0",
-        "--set",
-        "output.history_every=1",
-    ];
-    let c = column();
-    let mut args = vec![
-        "run",
-        c.to_str().unwrap(),
-        "--quiet",
-        "--out",
-        out.to_str().unwrap(),
-    ];
-    args.extend(sets);
-    let o = common::kdmpm(&args);
+    let sets = ["gravity.ramp_time=1.0", "output.history_every=1"];
+    let o = common::run_into(&column(), &out, &sets);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let history = std::fs::read_to_string(out.join("history.csv")).unwrap();
     // step, time, E_k, W_ext, then K_F (max), K_F (mean) and K_E: empty at step 1.

@@ -22,18 +22,13 @@ fn slope(overrides: &[String]) -> LoadedScene {
 #[test]
 fn a_softening_soil_whose_residual_is_its_peak_runs_as_mohr_coulomb_bit_for_bit() {
     let scene = common::scene("slope_fos.ron");
-    let scene = scene.to_str().expect("a UTF-8 path");
     let (plain, soft) = (
         common::scratch("softening", "plain"),
         common::scratch("softening", "soft"),
     );
     let same = softening(10.0e3, 20.0, 0.01);
     for (out, extra) in [(&plain, None), (&soft, Some(same.as_str()))] {
-        let mut args = vec!["run", scene, "--quiet", "--out", out.to_str().expect("UTF-8")];
-        if let Some(set) = extra {
-            args.extend(["--set", set]);
-        }
-        let o = common::kdmpm(&args);
+        let o = common::run_into(&scene, out, extra.as_slice());
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     }
     // The state column, its sort and its output (`plastic_strain`) included.
