@@ -172,229 +172,22 @@ impl Study {
 
     /// Parses study text; `path` names it in messages and anchors the scene path.
     pub fn from_text(path: &Path, text: &str) -> Result<Self, SceneError> {
-        let spec: StudySpec = ron::Options::default()
-            .with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME)
-            .from_str(text)
-            .map_err(|e| {
-                let message = e.code.to_string();
-                let (line, column, field) = locate::parse_error_place(text, &e);
-                let field = field.map_or(String::new(), |f| format!("field `{f}`: "));
-                SceneError::Syntax {
-                    path: path.to_path_buf(),
-                    line,
-                    column,
-                    field,
-                    message,
-                }
-            })?;
-        let invalid = |field: &str, rule: String| {
-            let (line, column) = locate::field_position(text, field).unwrap_or((0, 0));
-            SceneError::Invalid {
-                path: path.to_path_buf(),
-                line,
-                column,
-                field: field.to_string(),
-                note: String::new(),
-                rule,
-            }
-        };
+        let spec = parse(path, text)?;
+        let at = Place { path, text };
         let scene_path = path.parent().unwrap_or(Path::new("")).join(&spec.scene);
         let base = LoadedScene::from_file(&scene_path, &spec.set)
-            .map_err(|e| invalid("scene", format!("the base scene with the study's `set`: {e}")))?;
-        if spec.axes.is_empty() {
-            return Err(invalid("axes", "a study varies at least one setting".into()));
-        }
-        for (i, axis) in spec.axes.iter().enumerate() {
-            let values = axis.values();
-            if values.is_empty() {
-                return Err(invalid(
-                    &format!("axes[{i}]"),
-                    "an axis needs at least one value".into(),
-                ));
-            }
-            if let Axis::Refine(f) = axis {
-                if f.contains(&0) {
-                    return Err(invalid(
-                        &format!("axes[{i}]"),
-                        "refinement factors are ≥ 1".into(),
-                    ));
-                }
-            }
-            if spec.axes[..i].iter().any(|a| a.name() == axis.name()) {
-                return Err(invalid(
-                    &format!("axes[{i}]"),
-                    format!("`{}` is varied by an earlier axis", axis.name()),
-                ));
-            }
-        }
-        if let Some(limit) = spec.run_limit {
-            if !(limit.is_finite() && limit > 0.0) {
-                return Err(invalid(
-                    "run_limit",
-                    format!("must be a positive number of seconds, found {limit}"),
-                ));
-            }
-        }
-        let combos: Vec<Vec<String>> = match &spec.combine {
-            Combine::Product => product(&spec.axes),
-            Combine::Listed(list) => {
-                for (k, combo) in list.iter().enumerate() {
-                    let field = format!("combine[{k}]");
-                    if combo.len() != spec.axes.len() {
-                        return Err(invalid(
-                            &field,
-                            format!("lists {} values for {} axes", combo.len(), spec.axes.len()),
-                        ));
-                    }
-                    for (v, axis) in combo.iter().zip(&spec.axes) {
-                        if !axis.values().contains(v) {
-                            return Err(invalid(
-                                &field,
-                                format!("`{v}` is not a value of axis `{}`", axis.name()),
-                            ));
-                        }
-                    }
-                }
-                list.clone()
-            }
-        };
-        if combos.is_empty() {
-            return Err(invalid("combine", "the study has no run".into()));
-        }
-        let mut runs = Vec::with_capacity(combos.len());
-        for (k, values) in combos.into_iter().enumerate() {
-            let mut overrides = spec.set.clone();
-            for (i, (axis, v)) in spec.axes.iter().zip(&values).enumerate() {
-                let field = || format!("axes[{i}]");
-                match axis {
-                    Axis::Set { path, .. } => overrides.push(format!("{path}={v}")),
-                    Axis::Refine(_) => {
-                        let r: u32 = v
-                            .parse()
-                            .map_err(|_| invalid(&field(), format!("`{v}` is not a factor")))?;
-                        let g = &base.scene.grid;
-                        let cells: Vec<String> =
-                            g.cells.iter().map(|&n| (n * r as usize).to_string()).collect();
-                        overrides.push(format!("grid.cell_size={:e}", g.cell_size / r as f64));
-                        overrides.push(format!("grid.cells=[{}]", cells.join(", ")));
-                    }
-                }
-            }
-            runs.push(Planned {
-                id: format!("run-{:03}", k + 1),
-                values,
-                overrides,
-                refused: None,
-            });
-        }
+            .map_err(|e| at.invalid("scene", format!("the base scene with the study's `set`: {e}")))?;
+        check_axes(&spec, &at)?;
+        let combos = combinations(&spec, &at)?;
+        let mut runs = plan_runs(&spec, &base, combos, &at)?;
         let mut reference = spec.reference.as_ref().map(|r| Planned {
             id: "reference".into(),
             values: Vec::new(),
             overrides: spec.set.iter().chain(r).cloned().collect(),
             refused: None,
         });
-        // Every run's overrides must apply and parse: a typo is reported now, at the axis that
-        // set it, rather than as a failed row an hour later. A scene that parses but breaks a
-        // rule (a Courant number above a scheme's limit, say) is a row: studies map limits.
-        for run in reference.iter_mut().chain(runs.iter_mut()) {
-            let field = if run.id == "reference" {
-                "reference"
-            } else {
-                "axes"
-            };
-            let with = if run.values.is_empty() {
-                String::new()
-            } else {
-                format!(" with {}", run.values.join(", "))
-            };
-            let loaded = LoadedScene::from_file(&scene_path, &run.overrides)
-                .map_err(|e| invalid(field, format!("run {}{with}: {e}", run.id)))?;
-            if let Err(e) = scene::check(&loaded) {
-                if run.id == "reference" {
-                    return Err(invalid(field, format!("the reference run: {e}")));
-                }
-                run.refused = Some(e.to_string());
-            }
-        }
-        let traced: Vec<&str> = base.scene.traced.iter().map(|t| t.name.as_str()).collect();
-        let dim = base.scene.dimension as usize;
-        if spec.quantities.is_empty() {
-            return Err(invalid(
-                "quantities",
-                "a study measures at least one quantity".into(),
-            ));
-        }
-        for (k, q) in spec.quantities.iter().enumerate() {
-            let field = format!("quantities[{k}]");
-            match &q.of {
-                Quantity::Displacement { point, component } => {
-                    if !traced.contains(&point.as_str()) {
-                        return Err(invalid(&field, format!("the scene traces no point `{point}`")));
-                    }
-                    if *component >= dim {
-                        return Err(invalid(
-                            &field,
-                            format!("component {component} of a {dim}D displacement"),
-                        ));
-                    }
-                }
-                Quantity::Stress { point, component } => {
-                    if !traced.contains(&point.as_str()) {
-                        return Err(invalid(&field, format!("the scene traces no point `{point}`")));
-                    }
-                    if !STRESS_COMPONENTS.contains(&component.as_str()) {
-                        return Err(invalid(
-                            &field,
-                            format!("stress component `{component}` is none of xx yy zz xy yz zx"),
-                        ));
-                    }
-                }
-                Quantity::SurfaceAngle if !base.scene.output.surface_angle => {
-                    return Err(invalid(
-                        &field,
-                        "the scene does not measure the surface angle (output.surface_angle)".into(),
-                    ));
-                }
-                _ => {}
-            }
-            match &q.compare {
-                Compare::Analytic(v) if !(v.is_finite() && *v != 0.0) => {
-                    return Err(invalid(
-                        &field,
-                        format!(
-                            "an analytic value must be finite and non-zero for a relative error, found {v}"
-                        ),
-                    ));
-                }
-                Compare::Polynomial { axis, coefficients } => {
-                    if *axis >= dim || coefficients.is_empty() || coefficients.iter().any(|c| !c.is_finite())
-                    {
-                        return Err(invalid(
-                            &field,
-                            "a polynomial needs a coordinate axis of the scene and finite coefficients"
-                                .into(),
-                        ));
-                    }
-                    if !matches!(q.of, Quantity::Displacement { .. } | Quantity::Stress { .. }) {
-                        return Err(invalid(
-                            &field,
-                            "a polynomial is evaluated at a traced point: use it with Displacement or Stress"
-                                .into(),
-                        ));
-                    }
-                }
-                Compare::Reference if reference.is_none() => {
-                    return Err(invalid(
-                        &field,
-                        "compares with the reference run, but the study names none (`reference`)".into(),
-                    ));
-                }
-                _ => {}
-            }
-            if spec.quantities[..k].iter().any(|p| p.name == q.name) {
-                return Err(invalid(&field, format!("the name `{}` is used twice", q.name)));
-            }
-        }
+        check_runs(&scene_path, reference.as_mut(), &mut runs, &at)?;
+        check_quantities(&spec, &base, reference.is_some(), &at)?;
         Ok(Study {
             path: path.to_path_buf(),
             scene: scene_path,
@@ -403,6 +196,259 @@ impl Study {
             runs,
         })
     }
+}
+
+/// Where a study file's rules are checked: its path and text, to place an error.
+struct Place<'a> {
+    path: &'a Path,
+    text: &'a str,
+}
+
+impl Place<'_> {
+    /// The error for `field` of the study file, breaking `rule`.
+    fn invalid(&self, field: &str, rule: String) -> SceneError {
+        let (line, column) = locate::field_position(self.text, field).unwrap_or((0, 0));
+        SceneError::Invalid {
+            path: self.path.to_path_buf(),
+            line,
+            column,
+            field: field.to_string(),
+            note: String::new(),
+            rule,
+        }
+    }
+}
+
+/// The study file's RON, its syntax errors placed as a scene's are.
+fn parse(path: &Path, text: &str) -> Result<StudySpec, SceneError> {
+    ron::Options::default()
+        .with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME)
+        .from_str(text)
+        .map_err(|e| {
+            let message = e.code.to_string();
+            let (line, column, field) = locate::parse_error_place(text, &e);
+            let field = field.map_or(String::new(), |f| format!("field `{f}`: "));
+            SceneError::Syntax {
+                path: path.to_path_buf(),
+                line,
+                column,
+                field,
+                message,
+            }
+        })
+}
+
+/// The axes: at least one, each with values, refinement factors ≥ 1, none varied twice;
+/// and the run limit.
+fn check_axes(spec: &StudySpec, at: &Place) -> Result<(), SceneError> {
+    if spec.axes.is_empty() {
+        return Err(at.invalid("axes", "a study varies at least one setting".into()));
+    }
+    for (i, axis) in spec.axes.iter().enumerate() {
+        let values = axis.values();
+        if values.is_empty() {
+            return Err(at.invalid(&format!("axes[{i}]"), "an axis needs at least one value".into()));
+        }
+        if let Axis::Refine(f) = axis {
+            if f.contains(&0) {
+                return Err(at.invalid(&format!("axes[{i}]"), "refinement factors are ≥ 1".into()));
+            }
+        }
+        if spec.axes[..i].iter().any(|a| a.name() == axis.name()) {
+            return Err(at.invalid(
+                &format!("axes[{i}]"),
+                format!("`{}` is varied by an earlier axis", axis.name()),
+            ));
+        }
+    }
+    if let Some(limit) = spec.run_limit {
+        if !(limit.is_finite() && limit > 0.0) {
+            return Err(at.invalid(
+                "run_limit",
+                format!("must be a positive number of seconds, found {limit}"),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The combinations of axis values to run: every one, or the listed ones (each a value of
+/// its axis).
+fn combinations(spec: &StudySpec, at: &Place) -> Result<Vec<Vec<String>>, SceneError> {
+    let combos: Vec<Vec<String>> = match &spec.combine {
+        Combine::Product => product(&spec.axes),
+        Combine::Listed(list) => {
+            for (k, combo) in list.iter().enumerate() {
+                let field = format!("combine[{k}]");
+                if combo.len() != spec.axes.len() {
+                    return Err(at.invalid(
+                        &field,
+                        format!("lists {} values for {} axes", combo.len(), spec.axes.len()),
+                    ));
+                }
+                for (v, axis) in combo.iter().zip(&spec.axes) {
+                    if !axis.values().contains(v) {
+                        return Err(
+                            at.invalid(&field, format!("`{v}` is not a value of axis `{}`", axis.name()))
+                        );
+                    }
+                }
+            }
+            list.clone()
+        }
+    };
+    if combos.is_empty() {
+        return Err(at.invalid("combine", "the study has no run".into()));
+    }
+    Ok(combos)
+}
+
+/// One planned run a combination: the study's `set` and each axis's overrides.
+fn plan_runs(
+    spec: &StudySpec,
+    base: &LoadedScene,
+    combos: Vec<Vec<String>>,
+    at: &Place,
+) -> Result<Vec<Planned>, SceneError> {
+    let mut runs = Vec::with_capacity(combos.len());
+    for (k, values) in combos.into_iter().enumerate() {
+        let mut overrides = spec.set.clone();
+        for (i, (axis, v)) in spec.axes.iter().zip(&values).enumerate() {
+            let field = || format!("axes[{i}]");
+            match axis {
+                Axis::Set { path, .. } => overrides.push(format!("{path}={v}")),
+                Axis::Refine(_) => {
+                    let r: u32 = v
+                        .parse()
+                        .map_err(|_| at.invalid(&field(), format!("`{v}` is not a factor")))?;
+                    let g = &base.scene.grid;
+                    let cells: Vec<String> = g.cells.iter().map(|&n| (n * r as usize).to_string()).collect();
+                    overrides.push(format!("grid.cell_size={:e}", g.cell_size / r as f64));
+                    overrides.push(format!("grid.cells=[{}]", cells.join(", ")));
+                }
+            }
+        }
+        runs.push(Planned {
+            id: format!("run-{:03}", k + 1),
+            values,
+            overrides,
+            refused: None,
+        });
+    }
+    Ok(runs)
+}
+
+/// Every run's overrides must apply and parse: a typo is reported now, at the axis that set
+/// it, rather than as a failed row an hour later. A scene that parses but breaks a rule (a
+/// Courant number above a scheme's limit, say) is a row: studies map limits. The reference
+/// must be valid.
+fn check_runs(
+    scene_path: &Path,
+    reference: Option<&mut Planned>,
+    runs: &mut [Planned],
+    at: &Place,
+) -> Result<(), SceneError> {
+    for run in reference.into_iter().chain(runs.iter_mut()) {
+        let field = if run.id == "reference" {
+            "reference"
+        } else {
+            "axes"
+        };
+        let with = if run.values.is_empty() {
+            String::new()
+        } else {
+            format!(" with {}", run.values.join(", "))
+        };
+        let loaded = LoadedScene::from_file(scene_path, &run.overrides)
+            .map_err(|e| at.invalid(field, format!("run {}{with}: {e}", run.id)))?;
+        if let Err(e) = scene::check(&loaded) {
+            if run.id == "reference" {
+                return Err(at.invalid(field, format!("the reference run: {e}")));
+            }
+            run.refused = Some(e.to_string());
+        }
+    }
+    Ok(())
+}
+
+/// The quantities: at least one, each of a traced point or a measured figure of the scene,
+/// compared with something that exists, each name once.
+fn check_quantities(
+    spec: &StudySpec,
+    base: &LoadedScene,
+    has_reference: bool,
+    at: &Place,
+) -> Result<(), SceneError> {
+    let traced: Vec<&str> = base.scene.traced.iter().map(|t| t.name.as_str()).collect();
+    let dim = base.scene.dimension as usize;
+    if spec.quantities.is_empty() {
+        return Err(at.invalid("quantities", "a study measures at least one quantity".into()));
+    }
+    for (k, q) in spec.quantities.iter().enumerate() {
+        let field = format!("quantities[{k}]");
+        match &q.of {
+            Quantity::Displacement { point, component } => {
+                if !traced.contains(&point.as_str()) {
+                    return Err(at.invalid(&field, format!("the scene traces no point `{point}`")));
+                }
+                if *component >= dim {
+                    return Err(at.invalid(&field, format!("component {component} of a {dim}D displacement")));
+                }
+            }
+            Quantity::Stress { point, component } => {
+                if !traced.contains(&point.as_str()) {
+                    return Err(at.invalid(&field, format!("the scene traces no point `{point}`")));
+                }
+                if !STRESS_COMPONENTS.contains(&component.as_str()) {
+                    return Err(at.invalid(
+                        &field,
+                        format!("stress component `{component}` is none of xx yy zz xy yz zx"),
+                    ));
+                }
+            }
+            Quantity::SurfaceAngle if !base.scene.output.surface_angle => {
+                return Err(at.invalid(
+                    &field,
+                    "the scene does not measure the surface angle (output.surface_angle)".into(),
+                ));
+            }
+            _ => {}
+        }
+        match &q.compare {
+            Compare::Analytic(v) if !(v.is_finite() && *v != 0.0) => {
+                return Err(at.invalid(
+                    &field,
+                    format!("an analytic value must be finite and non-zero for a relative error, found {v}"),
+                ));
+            }
+            Compare::Polynomial { axis, coefficients } => {
+                if *axis >= dim || coefficients.is_empty() || coefficients.iter().any(|c| !c.is_finite()) {
+                    return Err(at.invalid(
+                        &field,
+                        "a polynomial needs a coordinate axis of the scene and finite coefficients".into(),
+                    ));
+                }
+                if !matches!(q.of, Quantity::Displacement { .. } | Quantity::Stress { .. }) {
+                    return Err(at.invalid(
+                        &field,
+                        "a polynomial is evaluated at a traced point: use it with Displacement or Stress"
+                            .into(),
+                    ));
+                }
+            }
+            Compare::Reference if !has_reference => {
+                return Err(at.invalid(
+                    &field,
+                    "compares with the reference run, but the study names none (`reference`)".into(),
+                ));
+            }
+            _ => {}
+        }
+        if spec.quantities[..k].iter().any(|p| p.name == q.name) {
+            return Err(at.invalid(&field, format!("the name `{}` is used twice", q.name)));
+        }
+    }
+    Ok(())
 }
 
 /// Every combination of the axes' values, the last axis varying fastest.
