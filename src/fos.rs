@@ -80,7 +80,7 @@ pub enum FosError {
     /// The bracket does not hold the factor of safety: the trials are in their folders.
     #[error("{0}")]
     NotBracketed(String),
-    /// Stopped by a signal ([`STOP`]) during the trial at this factor.
+    /// Stopped by a signal ([`crate::interrupt`]) during the trial at this factor.
     #[error("interrupted during the trial at F = {0}: the trials so far are in their folders")]
     Interrupted(f64),
     /// The output directory cannot be used (exit 2).
@@ -90,10 +90,6 @@ pub enum FosError {
     #[error("cannot write into {0}: {1}")]
     Output(PathBuf, std::io::Error),
 }
-
-/// Set (by a Ctrl-C or SIGTERM handler) to stop the analysis after the step under way of
-/// the trial under way.
-pub static STOP: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
 
 /// The scene with the strength of every material that has one divided by `factor`
 /// ([`crate::materials::SceneMaterial::reduce_strength`]), in the scene and in every stage
@@ -239,7 +235,7 @@ fn trial_run<D: Dim>(
     let recorder = Recorder::attach(sim, dir, output.history_every, output.snapshots, None)?;
     let (every, limit) = (spec.check_every, spec.failure_displacement);
     let result = sim.run_with(|s| {
-        if s.ctx.state.stop.is_none() && STOP.load(std::sync::atomic::Ordering::SeqCst) {
+        if s.ctx.state.stop.is_none() && crate::interrupt::requested() {
             s.ctx.state.stop = Some(StopReason::Interrupted);
         }
         let st = &s.ctx.state;

@@ -24,6 +24,7 @@ pub mod distributed;
 pub mod error;
 pub mod fos;
 pub mod grid;
+pub mod interrupt;
 pub mod lanes;
 pub mod materials;
 pub mod measure;

@@ -11,7 +11,6 @@ use kdmpm::{with_simulation, Dim, Simulation};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -483,9 +482,6 @@ struct Options {
     ranks: usize,
 }
 
-/// Set by Ctrl-C: the run checkpoints and stops after the step under way.
-static INTERRUPTED: AtomicBool = AtomicBool::new(false);
-
 /// Exit code of a run stopped by Ctrl-C (128 + SIGINT, as shells report it).
 const INTERRUPTED_EXIT: u8 = 130;
 
@@ -513,7 +509,7 @@ fn drive<D: Dim>(
     // file is written whole or not at all, so nothing torn is left.
     if options.ranks == 1 {
         let _ = ctrlc::set_handler(|| {
-            if INTERRUPTED.swap(true, Ordering::SeqCst) {
+            if kdmpm::interrupt::request() {
                 std::process::exit(INTERRUPTED_EXIT.into());
             }
         });
@@ -553,7 +549,7 @@ fn drive<D: Dim>(
     let result = sim.run_with(|s| {
         let st = &s.ctx.state;
         progress.update(st);
-        let interrupted = INTERRUPTED.load(Ordering::SeqCst);
+        let interrupted = kdmpm::interrupt::requested();
         let due = st.stop.is_none()
             && match every {
                 Some(CheckpointEvery::Steps(n)) => st.clock.step.is_multiple_of(n),
@@ -628,7 +624,9 @@ fn run_fos(path: &Path, out: Option<PathBuf>, overrides: &[String], quiet: bool)
     };
     let out = out.unwrap_or_else(|| default_out(path, "fos-", "scene"));
     // Ctrl-C or SIGTERM ends the trial under way at its next step, then the analysis.
-    let _ = ctrlc::set_handler(|| kdmpm::fos::STOP.store(true, Ordering::SeqCst));
+    let _ = ctrlc::set_handler(|| {
+        kdmpm::interrupt::request();
+    });
     let result = kdmpm::fos::strength_reduction(&loaded, &out, |t| {
         if !quiet {
             eprintln!(
@@ -738,7 +736,9 @@ fn run_study(
         r
     };
     // Ctrl-C or SIGTERM: the run under way gets the signal and is waited for.
-    let _ = ctrlc::set_handler(|| study::STOP.store(true, Ordering::SeqCst));
+    let _ = ctrlc::set_handler(|| {
+        kdmpm::interrupt::request();
+    });
     let failed = |e: study::StudyError| {
         progress.done();
         eprintln!("error: {e}");

@@ -51,10 +51,6 @@ pub enum StudyError {
     Interrupted(String),
 }
 
-/// Set (by a Ctrl-C or SIGTERM handler) to stop a study: the run under way is passed the
-/// signal and waited for, and no record is written for it.
-pub static STOP: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
-
 /// Refuses a reference run that did not converge: it ended at its step or time limit, or
 /// failed, so its figures are not the static answer the other runs are compared with.
 pub fn check_reference(reference: &Finished) -> Result<(), StudyError> {
@@ -167,7 +163,7 @@ pub fn run_one(
             Ok(None) => {}
             Err(e) => return Err(StudyError::Output(format!("cannot wait for run {}: {e}", run.id))),
         }
-        if STOP.load(std::sync::atomic::Ordering::SeqCst) {
+        if crate::interrupt::requested() {
             pass_signal(&child);
             let _ = child.wait();
             return Err(StudyError::Interrupted(run.id.clone()));
