@@ -2,7 +2,7 @@
 //! grid-to-particle, the Mohr-Coulomb stress update and the convergence monitor.
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use kdmpm::lanes::LANES;
+use kdmpm::infra::lanes::LANES;
 use kdmpm::materials::{Material, MohrCoulomb, PlasticStrain};
 use kdmpm::scene::{build, LoadedScene};
 use kdmpm::shape::QuadraticBSpline;
@@ -11,9 +11,9 @@ use kdmpm::tensor::{Sym3, Sym3x4};
 use kdmpm::{AnySimulation, Dim2, Simulation, System};
 use std::path::Path;
 
-/// As the `kdmpm` binary: large blocks coloured (see `kdmpm::alloc`).
+/// As the `kdmpm` binary: large blocks coloured (see `kdmpm::infra::alloc`).
 #[global_allocator]
-static ALLOCATOR: kdmpm::alloc::Coloured = kdmpm::alloc::Coloured;
+static ALLOCATOR: kdmpm::infra::alloc::Coloured = kdmpm::infra::alloc::Coloured;
 
 fn slope() -> Simulation<Dim2> {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/slope.ron");

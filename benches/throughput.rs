@@ -13,17 +13,17 @@
 //! And the 100k block with its points stored in random order (as after a flow has mixed
 //! them), left so (`sort_every = 0`) and after one spatial sort: what cell order is worth.
 
-use kdmpm::columns::{col_mut, points_with};
 use kdmpm::components::Position;
+use kdmpm::infra::columns::{col_mut, points_with};
 use kdmpm::scene::{build, LoadedScene};
 use kdmpm::systems::SpatialSort;
 use kdmpm::{with_simulation, Dim, Simulation, System};
 use std::path::Path;
 use std::time::Instant;
 
-/// As the `kdmpm` binary: large blocks coloured (see `kdmpm::alloc`).
+/// As the `kdmpm` binary: large blocks coloured (see `kdmpm::infra::alloc`).
 #[global_allocator]
-static ALLOCATOR: kdmpm::alloc::Coloured = kdmpm::alloc::Coloured;
+static ALLOCATOR: kdmpm::infra::alloc::Coloured = kdmpm::infra::alloc::Coloured;
 
 /// How the points are stored when the timing starts.
 #[derive(Clone, Copy, PartialEq)]

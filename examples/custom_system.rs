@@ -5,8 +5,8 @@
 //!
 //!     cargo run --release --example custom_system
 
-use kdmpm::columns::{col, points_with};
 use kdmpm::components::Velocity;
+use kdmpm::infra::columns::{col, points_with};
 use kdmpm::scene::{build, LoadedScene};
 use kdmpm::{AnySimulation, Context, Dim3, FnSystem, StepError};
 use std::path::Path;

@@ -1,45 +1,32 @@
 //! The files `kdmpm run` writes, from Rust: history.csv, the ParaView series
 //! (points.pvd and snapshots/), points.vtu and summary.json.
 //!
-//! Loads the paper's elastic bar, asks for a snapshot at every kinetic-damping reset,
-//! attaches a `Recorder`, runs to convergence and finishes the recorder.
+//! Loads the paper's elastic bar with a snapshot at every kinetic-damping reset and runs it
+//! to convergence into a directory with the library's runner, as `kdmpm run` does.
 //!
 //!     cargo run --release --example write_results [OUT_DIR]
 
-use kdmpm::output::{OutputDir, Recorder, SnapshotSpec};
-use kdmpm::scene::{build, LoadedScene};
-use kdmpm::with_simulation;
+use kdmpm::run::Run;
+use kdmpm::scene::LoadedScene;
 use std::path::{Path, PathBuf};
-use std::time::Instant;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let out: PathBuf = std::env::args()
         .nth(1)
         .map_or("out/write_results".into(), PathBuf::from);
     let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/bar.ron");
-    let loaded = LoadedScene::from_file(&scene, &[])?;
-    let (mut sim, _) = build(&loaded)?;
+    // The override goes into the scene's text, which a checkpoint keeps.
+    let loaded = LoadedScene::from_file(&scene, &["output.snapshots=(at_resets: true)".into()])?;
     // The output directory is locked for this process while it writes.
-    let dir = OutputDir::claim(&out)?;
-    let snapshots = SnapshotSpec {
-        at_resets: true,
-        ..SnapshotSpec::default()
-    };
-    let summary = with_simulation!(&mut sim, s => {
-        let recorder = Recorder::attach(s, &dir, 10, Some(snapshots), None)?;
-        let start = Instant::now();
-        let result = s.run(|_| {});
-        let error = result.as_ref().err().map(|e| e.to_string());
-        let (summary, _notes) =
-            recorder.finish(s, &dir, &scene.display().to_string(), start.elapsed().as_secs_f64(), error)?;
-        result?;
-        summary
-    });
+    let report = Run::scene(loaded).into_dir(&out).quiet(true).go()?;
+    if let Some(e) = report.error {
+        return Err(e.into());
+    }
     println!(
         "{:?} after {} steps; {} snapshots; files in {}",
-        summary.outcome,
-        summary.steps,
-        summary.snapshots.unwrap_or(0),
+        report.summary.outcome,
+        report.summary.steps,
+        report.summary.snapshots.unwrap_or(0),
         out.display()
     );
     Ok(())

@@ -15,12 +15,11 @@
 //! continues the `history.csv` beside it (a CRC-32 of the rows it had written), and holds
 //! only ids within range: a damaged or foreign checkpoint is never resumed.
 
-use crate::columns::points_with;
 use crate::components::*;
 use crate::dim::Dim;
 use crate::grid::NodeBox;
+use crate::infra::columns::points_with;
 use crate::parallel::SlabCache;
-use crate::point_components;
 use crate::simulation::Simulation;
 use crate::state::{
     Clock, Control, Convergence, CurvePoint, Drive, EnergyWindow, Peak, RankCounters, Resets, SolverState,
@@ -203,7 +202,7 @@ fn check_ids<D: Dim>(sim: &Simulation<D>, state: &SolverState) -> Result<(), Str
     let world = &sim.ctx.world;
     let materials = sim.ctx.materials.len();
     for arch in points_with::<MaterialId>(world) {
-        if let Some(m) = crate::columns::col::<MaterialId>(arch)
+        if let Some(m) = crate::infra::columns::col::<MaterialId>(arch)
             .iter()
             .find(|m| m.0 as usize >= materials)
         {
@@ -216,7 +215,7 @@ fn check_ids<D: Dim>(sim: &Simulation<D>, state: &SolverState) -> Result<(), Str
     let count = sim.point_count();
     let mut seen = vec![false; count];
     for arch in points_with::<PointId>(world) {
-        for id in crate::columns::col::<PointId>(arch).iter() {
+        for id in crate::infra::columns::col::<PointId>(arch).iter() {
             match seen.get_mut(id.0 as usize) {
                 None => {
                     return Err(format!(
@@ -650,7 +649,6 @@ impl<'a> Reader<'a> {
 mod tests {
     use crate::components::*;
     use crate::dim::{Dim, Dim2, Dim3};
-    use crate::point_components;
     use std::mem::size_of;
 
     /// Checkpoints copy point columns byte for byte: no component may hold padding, whose

@@ -2,7 +2,7 @@
 //!
 //! Material points and grid nodes are entities of one `hecs::World`. Each component below is
 //! one column; systems borrow whole columns of an archetype as plain slices
-//! ([`columns`](crate::columns)). A point carries only what its material and loads need: its
+//! (`infra::columns`). A point carries only what its material and loads need: its
 //! material's state column ([`crate::materials::Material::State`]) only where the model has
 //! state, a [`PointLoad`] only on points that carry a load. Grid nodes all share one archetype, spawned in id order, so a node
 //! column slice is indexed by node id.

@@ -1,9 +1,9 @@
 //! What every system reads and writes.
 
-use crate::comm::Comm;
-use crate::decomposition::Decomposition;
 use crate::dim::Dim;
 use crate::grid::Grid;
+use crate::infra::comm::Comm;
+use crate::infra::decomposition::Decomposition;
 use crate::materials::MaterialModel;
 use crate::parallel::SlabCache;
 use crate::state::{Settings, SolverState};

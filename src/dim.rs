@@ -5,7 +5,7 @@
 //! nodes per point with linear shape functions and never touches a third axis; the only
 //! 3D quantity it keeps is the out-of-plane normal stress, which plane strain requires.
 
-use crate::lanes::{madd, Lanes};
+use crate::infra::lanes::{madd, Lanes};
 use crate::tensor::{PlanarSym3, StoredSym, Sym, Sym3};
 use glam::{DMat2, DMat3, DVec2, DVec3};
 use std::fmt::Debug;
@@ -37,7 +37,7 @@ pub trait Vector:
     /// True when every component is finite.
     fn is_finite(self) -> bool;
     /// `self·k + acc`, each component rounded once where the CPU fuses a multiply and an add
-    /// (see [`crate::lanes::madd`]).
+    /// (see [`crate::infra::lanes::madd`]).
     fn madd(self, k: f64, acc: Self) -> Self;
 }
 

@@ -14,15 +14,11 @@
 //! `factor_of_safety` and its `bracket`. The failure mechanism is the displacement field of
 //! the trial at the smallest failing F (`mechanism`).
 
-use crate::dim::Dim;
 use crate::error::SceneError;
-use crate::measure::max_displacements;
 use crate::output::dir::write_atomic;
-use crate::output::{Outcome, OutputDir, Recorder};
-use crate::scene::{build, LoadedScene, StrengthReductionSpec};
-use crate::simulation::Simulation;
-use crate::state::StopReason;
-use crate::with_simulation;
+use crate::output::{Outcome, OutputDir};
+use crate::run::{DisplacementLimit, Run, RunError};
+use crate::scene::{LoadedScene, StrengthReductionSpec};
 use serde::Serialize;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -45,6 +41,21 @@ pub struct Trial {
     pub wall_seconds: f64,
     /// The trial's output directory, relative to the analysis's.
     pub dir: String,
+}
+
+impl Trial {
+    /// One line on how the trial ended, as `kdmpm fos` prints it.
+    pub fn describe(&self) -> String {
+        format!(
+            "F = {:.4}: {} ({}), largest displacement {:.3e} m, {} steps, {:.1} s",
+            self.factor,
+            if self.failed { "fails" } else { "stands" },
+            self.outcome.name(),
+            self.max_displacement,
+            self.steps,
+            self.wall_seconds
+        )
+    }
 }
 
 /// What the analysis found.
@@ -89,6 +100,31 @@ pub enum FosError {
     /// The output could not be written.
     #[error("cannot write into {0}: {1}")]
     Output(PathBuf, std::io::Error),
+}
+
+impl FosReport {
+    /// The analysis's result in one line, as `kdmpm fos` prints it.
+    pub fn describe(&self) -> String {
+        format!(
+            "factor of safety {:.3} (stands at {:.4}, fails at {:.4}), {} trials, {:.1} s",
+            self.factor_of_safety,
+            self.bracket[0],
+            self.bracket[1],
+            self.trials.len(),
+            self.wall_seconds
+        )
+    }
+}
+
+impl FosError {
+    /// True for input that cannot be used (the scene, the output directory), false for an
+    /// analysis that went wrong: the binary's exit codes 2 and 1.
+    pub fn is_bad_input(&self) -> bool {
+        matches!(
+            self,
+            FosError::Scene(_) | FosError::NotAnAnalysis(_) | FosError::OutputDir(_)
+        )
+    }
 }
 
 /// The scene with the strength of every material that has one divided by `factor`
@@ -201,60 +237,33 @@ fn run_trial(
     factor: f64,
     out: &Path,
 ) -> Result<Trial, FosError> {
-    let scene = reduced(loaded, factor);
-    let (mut sim, _) = build(&scene)?;
     let rel = trial_dir(factor);
     let path = out.join(&rel);
-    let dir = OutputDir::claim(&path)
-        .map_err(|e| FosError::Output(path.clone(), std::io::Error::other(e.to_string())))?;
     let start = Instant::now();
-    with_simulation!(&mut sim, s => {
-        let (steps, outcome, max_u) = trial_run(s, &scene, spec, &dir, start)
-            .map_err(|e| FosError::Output(path.clone(), e))?;
-        Ok(Trial {
-            factor,
-            failed: outcome != Outcome::Converged || max_u > spec.failure_displacement,
-            outcome,
-            max_displacement: max_u,
-            steps,
-            wall_seconds: start.elapsed().as_secs_f64(),
-            dir: rel,
+    let report = Run::scene(reduced(loaded, factor))
+        .into_dir(&path)
+        .quiet(true)
+        .without_checkpoints()
+        .displacement_limit(DisplacementLimit {
+            every: spec.check_every,
+            limit: spec.failure_displacement,
         })
+        .go()
+        .map_err(|e| match e {
+            RunError::Scene(e) => FosError::Scene(e),
+            e => FosError::Output(path.clone(), std::io::Error::other(e.to_string())),
+        })?;
+    let s = report.summary;
+    let max_u = s.max_displacement.unwrap_or(0.0);
+    Ok(Trial {
+        factor,
+        failed: s.outcome != Outcome::Converged || max_u > spec.failure_displacement,
+        outcome: s.outcome,
+        max_displacement: max_u,
+        steps: s.steps,
+        wall_seconds: start.elapsed().as_secs_f64(),
+        dir: rel,
     })
-}
-
-/// Steps one trial with its outputs; returns its steps, outcome and largest displacement.
-fn trial_run<D: Dim>(
-    sim: &mut Simulation<D>,
-    scene: &LoadedScene,
-    spec: &StrengthReductionSpec,
-    dir: &OutputDir,
-    start: Instant,
-) -> std::io::Result<(u64, Outcome, f64)> {
-    let output = &scene.scene.output;
-    let recorder = Recorder::attach(sim, dir, output.history_every, output.snapshots, None)?;
-    let (every, limit) = (spec.check_every, spec.failure_displacement);
-    let result = sim.run_with(|s| {
-        if s.ctx.state.stop.is_none() && crate::interrupt::requested() {
-            s.ctx.state.stop = Some(StopReason::Interrupted);
-        }
-        let st = &s.ctx.state;
-        if st.stop.is_none() && st.clock.step.is_multiple_of(every) {
-            let (u, _) = max_displacements(s).unwrap_or_default();
-            if u > limit {
-                s.ctx.state.stop = Some(StopReason::DisplacementLimit);
-            }
-        }
-        Ok(())
-    });
-    let error = result.err().map(|e| e.to_string());
-    let wall = start.elapsed().as_secs_f64();
-    let (summary, _) = recorder.finish(sim, dir, &scene.path.display().to_string(), wall, error)?;
-    Ok((
-        summary.steps,
-        summary.outcome,
-        summary.max_displacement.unwrap_or(0.0),
-    ))
 }
 
 /// `fos.csv`, `fos.svg` and `summary.json` of the analysis.

@@ -4,7 +4,7 @@
 //! `i·stride[0] + j·stride[1] + k·stride[2]`. x runs fastest (stride 1, the inner loop of
 //! every stencil); of y and z, the axis with more cells runs slowest: it is the axis that
 //! parallel scatters cut into slabs, each slab a contiguous range of node ids (see
-//! [`crate::parallel`]), so a long thin 3D slab between rollers still splits into many.
+//! `parallel`), so a long thin 3D slab between rollers still splits into many.
 //! In 2D the third count is zero, so a 2D grid has one layer of nodes.
 
 use crate::dim::{Dim, Vector};

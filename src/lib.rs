@@ -10,30 +10,46 @@
 //! [`Simulation`] with the schedule it needs.
 //!
 //! Units are SI throughout; stresses are tension positive.
+//!
+//! ## Where to start
+//!
+//! - Run a scene: [`LoadedScene::from_file`], then [`Run`] (into a directory, in memory,
+//!   resumed from a checkpoint); its [`RunReport`] holds the [`Summary`].
+//! - Step it yourself: [`scene::build`] gives an [`AnySimulation`]; [`Simulation::step`]
+//!   and [`Simulation::run`], the state in [`SolverState`].
+//! - Add a system to the schedule: [`System`], [`FnSystem`], [`Context`]; the columns a
+//!   system reads are [`components`], reached through [`infra::columns`]
+//!   (docs/writing-a-system.md).
+//! - Add a material: [`materials`] (docs/writing-a-material.md).
+//! - Analyses over runs: [`fos`] (factor of safety by strength reduction) and [`study`]
+//!   (speed against accuracy).
+//!
+//! The machinery beneath (allocation, SIMD lanes, threads and MPI ranks) is in [`infra`].
 #![warn(missing_docs)]
 
-pub mod alloc;
-pub mod checkpoint;
-pub mod columns;
-pub mod comm;
+// First, with `#[macro_use]`: their `macro_rules!` (`point_components!`, `with_simulation!`)
+// are in scope in every module declared after them, without a path back to the crate root.
+#[macro_use]
 pub mod components;
+#[macro_use]
+pub mod simulation;
+
+pub mod checkpoint;
 pub mod context;
-pub mod decomposition;
 pub mod dim;
-pub mod distributed;
 pub mod error;
 pub mod fos;
 pub mod grid;
+pub mod infra;
 pub mod interrupt;
-pub mod lanes;
 pub mod materials;
 pub mod measure;
 pub mod output;
-pub mod parallel;
+pub(crate) mod parallel;
+pub mod run;
 pub mod scene;
 pub mod schedule;
 pub mod shape;
-pub mod simulation;
 pub mod state;
 pub mod study;
 pub mod systems;
@@ -44,5 +60,13 @@ mod testing;
 pub use context::Context;
 pub use dim::{Dim, Dim2, Dim3};
 pub use error::{SceneError, StepError};
+pub use interrupt::StopSignal;
+pub use output::{Outcome, Summary};
+/// The scatters' grouping of points, kept in the [`Context`]: a system that moves or
+/// reorders points calls `ctx.slabs.invalidate()`.
+pub use parallel::SlabCache;
+pub use run::{Run, RunError, RunReport};
+pub use scene::LoadedScene;
 pub use schedule::{FnSystem, Schedule, System};
 pub use simulation::{AnySimulation, Simulation};
+pub use state::SolverState;

@@ -1,8 +1,8 @@
 //! Measurements of a state: free-surface angle, displacements, mass.
 
-use crate::columns::{col, points_with};
 use crate::components::{Displacement, Mass, PointId, Position};
 use crate::dim::{Dim, Vector};
+use crate::infra::columns::{col, points_with};
 use crate::simulation::Simulation;
 use serde::Serialize;
 

@@ -15,16 +15,6 @@ use std::ops::Range;
 /// Points per chunk in point-local loops.
 pub const CHUNK: usize = 2048;
 
-/// Sums `f(chunk_index, range)` over fixed chunks of `0..n` in parallel, adding the partial
-/// sums in chunk order.
-pub fn sum_chunks(n: usize, f: impl Fn(std::ops::Range<usize>) -> f64 + Sync) -> f64 {
-    let parts: Vec<f64> = (0..n.div_ceil(CHUNK))
-        .into_par_iter()
-        .map(|c| f(c * CHUNK..((c + 1) * CHUNK).min(n)))
-        .collect();
-    parts.iter().sum()
-}
-
 /// Points grouped into slabs of one cell row along the grid's slab axis (its slowest), so
 /// that each slab scatters into its own contiguous range of node ids.
 #[derive(Debug, Default)]

@@ -12,7 +12,7 @@ use std::time::{Duration, Instant};
 ///
 /// A system that moves a point into another cell, or adds, removes or reorders points, calls
 /// `ctx.slabs.invalidate()`, so that the next scatter groups them anew (see
-/// [`crate::parallel::SlabCache`]; [`crate::grid::Grid::landing`] tells a cell change).
+/// [`crate::SlabCache`]; [`crate::grid::Grid::landing`] tells a cell change).
 pub trait System<D: Dim>: Send {
     /// Stable name, used in schedules, profiles and error messages.
     fn name(&self) -> &str;

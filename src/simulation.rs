@@ -1,10 +1,11 @@
 //! A simulation: the ECS world, grid, materials and solver state, stepped by a schedule.
 
-use crate::columns::{col, first_non_finite_state, points_with};
 use crate::components::*;
 use crate::context::Context;
 use crate::dim::{Dim, Dim2, Dim3};
 use crate::error::StepError;
+use crate::infra::columns::{col, points_with};
+use crate::materials::first_non_finite_state;
 use crate::schedule::Schedule;
 use crate::state::SolverState;
 use crate::tensor::{StoredSym, Sym3};

@@ -3,7 +3,7 @@
 //!
 //! Sign convention: tension positive, as in continuum mechanics.
 
-use crate::lanes::{F64x4, Lanes, LANES};
+use crate::infra::lanes::{F64x4, Lanes, LANES};
 use glam::{DMat3, DVec3};
 use std::ops::{Add, AddAssign, Mul, Sub, SubAssign};
 
@@ -28,7 +28,7 @@ pub struct Sym<T> {
 /// A symmetric 3×3 tensor (stress in Pa, strain increment).
 pub type Sym3 = Sym<f64>;
 
-/// The symmetric tensors of four points, one per lane (see [`crate::lanes`]).
+/// The symmetric tensors of four points, one per lane (see [`crate::infra::lanes`]).
 pub type Sym3x4 = Sym<F64x4>;
 
 impl<T: Lanes> Sym<T> {
@@ -535,7 +535,7 @@ impl SubAssign for Sym3 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::lanes::gather;
+    use crate::infra::lanes::gather;
 
     fn sample() -> Sym3 {
         Sym3 {

@@ -6,8 +6,8 @@
 mod common;
 
 use kdmpm::checkpoint::{self, Header};
-use kdmpm::columns::{col_mut, points_with};
 use kdmpm::components::{MaterialId, PointId};
+use kdmpm::infra::columns::{col_mut, points_with};
 use kdmpm::scene::{build, LoadedScene};
 use kdmpm::{AnySimulation, Dim2, Simulation};
 use proptest::prelude::*;

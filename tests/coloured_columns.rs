@@ -1,11 +1,11 @@
 //! Under the binary's allocator, the large columns of a scene start at different offsets in
 //! a page: particle-to-grid's node momentum and force (same stride, same index) never share
-//! address bits 0–11, the layout that made it up to 4× slower in some runs (`kdmpm::alloc`).
+//! address bits 0–11, the layout that made it up to 4× slower in some runs (`kdmpm::infra::alloc`).
 
 use glam::DVec3;
-use kdmpm::alloc::{Coloured, LARGE, PAGE};
-use kdmpm::columns::{col, nodes, points_with};
 use kdmpm::components::{Mass, NodeForce, NodeMass, NodeMomentum, Position, Stress, Velocity, Volume};
+use kdmpm::infra::alloc::{Coloured, LARGE, PAGE};
+use kdmpm::infra::columns::{col, nodes, points_with};
 use kdmpm::scene::{build, LoadedScene};
 use kdmpm::tensor::Sym3;
 use kdmpm::AnySimulation;

@@ -2,8 +2,8 @@
 //! spatial sorts included (every 50 steps here, eight in the run), and the same bits whether
 //! the scatters share their grouping of points or group them anew.
 
-use kdmpm::columns::{col, points_with};
 use kdmpm::components::{Position, Stress, Velocity};
+use kdmpm::infra::columns::{col, points_with};
 use kdmpm::materials::PlasticStrain;
 use kdmpm::scene::{build, LoadedScene};
 use kdmpm::tensor::{PlanarSym3, StoredSym};

@@ -503,3 +503,21 @@ fn mass_scaling_changes_nothing_in_one_material_and_is_refused_above_courant_0_9
     let e = refused("soil_column.ron", &set).expect("Courant 1 with mass scaling is refused");
     assert!(e.to_string().contains("Courant(0.9)"), "{e}");
 }
+
+/// A point load's carrier has no material: mass scaling skips it (it panicked on the
+/// missing material column). The cohesionless bank on rock, loaded at its crest and scaled
+/// to the sand's step, flows for its 4000 steps as it does unscaled; the figures pin it.
+#[test]
+fn mass_scaling_runs_a_two_material_scene_with_a_point_load() {
+    let text = common::bank_on_layer_text(common::ROCK, 4000, 100, true).replace(
+        "time_step: Courant(0.3)",
+        "time_step: Courant(0.9), mass_scaling: true",
+    );
+    let s = common::run_text("bank.ron", &text);
+    assert_eq!(s.outcome, kdmpm::Outcome::MaxSteps, "{:?}", s.error);
+    let edge = traced(&s, "edge").displacement;
+    // To 1e-6: a legitimate change of summation order moves the last digits of a flow.
+    for (got, want) in [(edge[0], 0.4643461856013914), (edge[1], -0.4141554818648817)] {
+        assert!((got / want - 1.0).abs() < 1e-6, "edge displacement {edge:?}");
+    }
+}

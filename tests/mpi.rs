@@ -6,8 +6,8 @@
 
 mod common;
 
-use kdmpm::comm::Comm;
-use kdmpm::decomposition::Decomposition;
+use kdmpm::infra::comm::Comm;
+use kdmpm::infra::decomposition::Decomposition;
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::process::Command;

@@ -3,8 +3,8 @@
 //! loads, no sort system when sorting is off, no smaller time step for a material no body
 //! uses; 2D scenes store 2-vectors and the four stress components of plane strain.
 
-use kdmpm::columns::points_with;
 use kdmpm::components::{PointLoad, Position, Stress};
+use kdmpm::infra::columns::points_with;
 use kdmpm::materials::PlasticStrain;
 use kdmpm::scene::{build, LoadedScene};
 use kdmpm::tensor::{PlanarSym3, Sym3};

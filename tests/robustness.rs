@@ -327,8 +327,8 @@ fn a_non_finite_value_stops_the_run_with_the_last_finite_state() {
     {
         let poison = FnSystem::new("poison", |ctx: &mut kdmpm::Context<Dim2>| {
             if ctx.state.clock.step == 40 {
-                let n = kdmpm::columns::nodes(&ctx.world);
-                let mut a = kdmpm::columns::col_mut::<NodeAcceleration<glam::DVec2>>(n);
+                let n = kdmpm::infra::columns::nodes(&ctx.world);
+                let mut a = kdmpm::infra::columns::col_mut::<NodeAcceleration<glam::DVec2>>(n);
                 for x in a.iter_mut() {
                     x.0 *= f64::NAN;
                 }

@@ -5,8 +5,8 @@
 //! Expected angle here: Davis's effective friction angle for non-associated flow in plane
 //! strain, tan φ* = sin φ cos ψ / (1 − sin φ sin ψ) = sin 20° → φ* = 18.9°.
 
-use kdmpm::columns::{col, points_with};
 use kdmpm::components::Mass;
+use kdmpm::infra::columns::{col, points_with};
 use kdmpm::measure::{all_positions_finite, max_displacements, max_movement, positions, surface_angle};
 use kdmpm::scene::{build, LoadedScene};
 use kdmpm::state::StopReason;

@@ -25,54 +25,6 @@ fn read_pvd(path: &Path) -> Vec<(f64, String)> {
         .collect()
 }
 
-/// Every DataArray of a `.vtu` as f64, by name (`Points` for the positions), with its
-/// component count. The XML head is parsed as XML (closed where the raw section opens);
-/// each array's bytes are at `offset` after the `_` that opens the appended section, a
-/// UInt64 byte count first (header_type="UInt64"), little-endian values after it.
-fn read_vtu(path: &Path) -> BTreeMap<String, (usize, Vec<f64>)> {
-    let bytes = std::fs::read(path).expect("snapshot file");
-    let open = b"<AppendedData encoding=\"raw\">";
-    let at = bytes
-        .windows(open.len())
-        .position(|w| w == open)
-        .expect("raw appended data");
-    let head = format!("{}</VTKFile>", std::str::from_utf8(&bytes[..at]).unwrap());
-    let doc = roxmltree::Document::parse(&head).expect("the head is well-formed XML");
-    let root = doc.root_element();
-    assert_eq!(root.attribute("header_type"), Some("UInt64"));
-    assert_eq!(root.attribute("byte_order"), Some("LittleEndian"));
-    let underscore = at + open.len() + bytes[at + open.len()..].iter().position(|&b| b == b'_').unwrap();
-    let data = &bytes[underscore + 1..];
-    let mut out = BTreeMap::new();
-    for a in doc.descendants().filter(|n| n.has_tag_name("DataArray")) {
-        let name = a.attribute("Name").unwrap_or("Points").to_string();
-        let comps: usize = a
-            .attribute("NumberOfComponents")
-            .map_or(1, |c| c.parse().unwrap());
-        let offset: usize = a.attribute("offset").unwrap().parse().unwrap();
-        let len = u64::from_le_bytes(data[offset..offset + 8].try_into().unwrap()) as usize;
-        let raw = &data[offset + 8..offset + 8 + len];
-        let values: Vec<f64> = match a.attribute("type").unwrap() {
-            "Float64" => raw
-                .chunks(8)
-                .map(|c| f64::from_le_bytes(c.try_into().unwrap()))
-                .collect(),
-            "Int64" => raw
-                .chunks(8)
-                .map(|c| i64::from_le_bytes(c.try_into().unwrap()) as f64)
-                .collect(),
-            "UInt32" => raw
-                .chunks(4)
-                .map(|c| u32::from_le_bytes(c.try_into().unwrap()) as f64)
-                .collect(),
-            "UInt8" => raw.iter().map(|&b| b as f64).collect(),
-            t => panic!("unexpected type {t}"),
-        };
-        out.insert(name, (comps, values));
-    }
-    out
-}
-
 /// Step and time of every history row.
 fn history_times(dir: &Path) -> BTreeMap<u64, f64> {
     let text = std::fs::read_to_string(dir.join("history.csv")).unwrap();
@@ -140,7 +92,7 @@ fn the_series_reads_back_with_history_times_and_summary_values() {
     );
 
     // The final snapshot holds every point, and the traced points' values of summary.json.
-    let arrays = read_vtu(&out.join(last));
+    let arrays = common::read_vtu(&out.join(last));
     let (_, ids) = &arrays["id"];
     assert_eq!(ids.len() as u64, summary["particles"].as_u64().unwrap());
     let (_, x) = &arrays["Points"];

@@ -4,8 +4,8 @@
 //! the sums at the nodes changes).
 
 use glam::{DMat2, DVec2};
-use kdmpm::columns::{col, points_with};
 use kdmpm::components::*;
+use kdmpm::infra::columns::{col, points_with};
 use kdmpm::materials::PlasticStrain;
 use kdmpm::measure::{max_movement, positions};
 use kdmpm::systems::SpatialSort;

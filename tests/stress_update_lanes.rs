@@ -5,8 +5,8 @@
 //! short groups, with strain and spin increments large enough that the soils yield.
 
 use glam::DMat3;
-use kdmpm::columns::{col, col_mut, points_with};
 use kdmpm::components::{MaterialId, Stress, VelocityGradient};
+use kdmpm::infra::columns::{col, col_mut, points_with};
 use kdmpm::materials::PlasticStrain;
 
 use kdmpm::scene::{build, LoadedScene};

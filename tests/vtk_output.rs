@@ -2,8 +2,8 @@
 //! hold: read back, each number is the column's to the last bit.
 
 use glam::DVec2;
-use kdmpm::columns::{col, points_with};
 use kdmpm::components::*;
+use kdmpm::infra::columns::{col, points_with};
 use kdmpm::materials::PlasticStrain;
 use kdmpm::output::vtk::write_points;
 use kdmpm::tensor::{PlanarSym3, StoredSym};
@@ -22,58 +22,11 @@ fn simulation(displacements: bool) -> Simulation<Dim2> {
     sim
 }
 
-/// The numbers of every `DataArray` of a `.vtu` file, by name (`Points` for the positions),
-/// read from the raw appended section as VTK's XML format defines it: each array's `offset`
-/// counts bytes from the `_` that opens the section, where a UInt64 byte count precedes the
-/// little-endian values.
+/// The numbers of every `DataArray` of a `.vtu` file, by name (`Points` for the positions).
 fn read_arrays(path: &Path) -> BTreeMap<String, Vec<f64>> {
-    let bytes = std::fs::read(path).expect("points.vtu is written");
-    let marker = b"<AppendedData encoding=\"raw\">";
-    let section = bytes
-        .windows(marker.len())
-        .position(|w| w == marker)
-        .expect("an appended section");
-    let head = std::str::from_utf8(&bytes[..section]).expect("the XML head is text");
-    assert!(head.contains("header_type=\"UInt64\"") && head.contains("byte_order=\"LittleEndian\""));
-    let data = section
-        + marker.len()
-        + bytes[section + marker.len()..]
-            .iter()
-            .position(|&b| b == b'_')
-            .expect("the section opens with _")
-        + 1;
-    let attribute = |tag: &str, key: &str| {
-        tag.split_once(&format!(" {key}=\""))
-            .map(|(_, rest)| rest.split('"').next().unwrap().to_string())
-    };
-    head.split("<DataArray")
-        .skip(1)
-        .map(|array| {
-            let tag = array.split_once('>').expect("tag closes").0;
-            assert_eq!(attribute(tag, "format").as_deref(), Some("appended"));
-            let name = attribute(tag, "Name").unwrap_or_else(|| "Points".to_string());
-            let offset: usize = attribute(tag, "offset").expect("an offset").parse().unwrap();
-            let start = data + offset;
-            let len = u64::from_le_bytes(bytes[start..start + 8].try_into().unwrap()) as usize;
-            let block = &bytes[start + 8..start + 8 + len];
-            let values = match attribute(tag, "type").expect("a type").as_str() {
-                "Float64" => block
-                    .chunks_exact(8)
-                    .map(|b| f64::from_le_bytes(b.try_into().unwrap()))
-                    .collect(),
-                "Int64" => block
-                    .chunks_exact(8)
-                    .map(|b| i64::from_le_bytes(b.try_into().unwrap()) as f64)
-                    .collect(),
-                "UInt32" => block
-                    .chunks_exact(4)
-                    .map(|b| u32::from_le_bytes(b.try_into().unwrap()) as f64)
-                    .collect(),
-                "UInt8" => block.iter().map(|&b| b as f64).collect(),
-                other => panic!("unexpected type {other}"),
-            };
-            (name, values)
-        })
+    common::read_vtu(path)
+        .into_iter()
+        .map(|(name, (_, values))| (name, values))
         .collect()
 }
 

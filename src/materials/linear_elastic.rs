@@ -1,7 +1,7 @@
 //! Linear isotropic elasticity (Hooke's law in rate form).
 
 use super::{Elasticity, Material, SceneMaterial};
-use crate::lanes::LANES;
+use crate::infra::lanes::LANES;
 use crate::tensor::{Sym3, Sym3x4};
 use serde::{Deserialize, Serialize};
 

@@ -20,8 +20,9 @@ pub use linear_elastic::{LinearElastic, LinearElasticSpec};
 pub use mohr_coulomb::{MohrCoulomb, MohrCoulombSpec, PlasticStrain, Return};
 pub use mohr_coulomb_softening::{MohrCoulombSoftening, MohrCoulombSofteningSpec, SofteningStrain};
 
-use crate::lanes::{Lanes, LANES};
+use crate::infra::lanes::{Lanes, LANES};
 use crate::tensor::{Sym, Sym3, Sym3x4};
+use hecs::Archetype;
 use serde::{de::DeserializeOwned, Deserialize, Serialize};
 use std::any::TypeId;
 use std::fmt::Debug;
@@ -391,6 +392,40 @@ impl Elasticity {
             zx: g2 * de.zx,
         }
     }
+}
+
+/// Appends the accumulated plastic strain of each point of `arch` to `out`, in row order:
+/// from the column of its material's state, 0 where the points carry no state.
+pub fn extend_plastic_strain(arch: &Archetype, out: &mut Vec<f64>) {
+    struct Extend<'a>(&'a Archetype, &'a mut Vec<f64>, bool);
+    impl StateVisitor for Extend<'_> {
+        fn visit<S: MaterialState>(&mut self) {
+            if let (false, Some(c)) = (self.2, self.0.get::<&S>()) {
+                self.1.extend(c.iter().map(S::plastic_strain));
+                self.2 = true;
+            }
+        }
+    }
+    let mut e = Extend(arch, out, false);
+    visit_states(&mut e);
+    if !e.2 {
+        out.resize(out.len() + arch.len() as usize, 0.0);
+    }
+}
+
+/// The first row of `arch` whose material state holds a value that is not finite.
+pub fn first_non_finite_state(arch: &Archetype) -> Option<usize> {
+    struct Find<'a>(&'a Archetype, Option<usize>);
+    impl StateVisitor for Find<'_> {
+        fn visit<S: MaterialState>(&mut self) {
+            if let (None, Some(c)) = (self.1, self.0.get::<&S>()) {
+                self.1 = c.iter().position(|s| !s.is_finite());
+            }
+        }
+    }
+    let mut f = Find(arch, None);
+    visit_states(&mut f);
+    f.1
 }
 
 #[cfg(test)]

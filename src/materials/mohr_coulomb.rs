@@ -16,7 +16,7 @@
 //! σ1' = σ3' (1 + sin φ)/(1 − sin φ) + 2c cos φ/(1 − sin φ).
 
 use super::{update_lane_by_lane, Elasticity, Material, MaterialState, SceneMaterial};
-use crate::lanes::{gather, F64x4, Lanes, LANES};
+use crate::infra::lanes::{gather, F64x4, Lanes, LANES};
 use crate::tensor::{Sym, Sym3, Sym3x4};
 use glam::DVec3;
 use serde::{Deserialize, Serialize};

@@ -14,7 +14,7 @@ use super::mohr_coulomb::{check_strength, reduce_angle};
 use super::{
     update_lane_by_lane, Elasticity, Material, MaterialState, MohrCoulomb, PlasticStrain, SceneMaterial,
 };
-use crate::lanes::LANES;
+use crate::infra::lanes::LANES;
 use crate::tensor::{Sym3, Sym3x4};
 use serde::{Deserialize, Serialize};
 

@@ -186,6 +186,33 @@ fn ratio<S: serde::Serializer>(r: &f64, s: S) -> Result<S::Ok, S::Error> {
 }
 
 impl Summary {
+    /// The per-system timing table (`kdmpm run --profile`): calls, total and mean time and
+    /// share of each system, in schedule order.
+    pub fn profile_table(&self) -> String {
+        let total: f64 = self.systems.iter().map(|t| t.seconds).sum();
+        let mut text = format!(
+            "{:<18} {:>10} {:>12} {:>12} {:>7}\n",
+            "system", "calls", "total (s)", "mean (µs)", "share"
+        );
+        for t in &self.systems {
+            let mean = if t.calls > 0 {
+                1e6 * t.seconds / t.calls as f64
+            } else {
+                0.0
+            };
+            let share = if total > 0.0 {
+                100.0 * t.seconds / total
+            } else {
+                0.0
+            };
+            text += &format!(
+                "{:<18} {:>10} {:>12.4} {:>12.2} {:>6.1}%\n",
+                t.name, t.calls, t.seconds, mean, share
+            );
+        }
+        text
+    }
+
     /// Collects the summary of `sim` after a run that took `wall_seconds`.
     pub fn collect<D: Dim>(
         scene: &str,

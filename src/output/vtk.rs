@@ -1,9 +1,10 @@
 //! Material points as a VTK XML unstructured grid (`.vtu`) with raw binary arrays, readable
 //! by ParaView, VisIt, meshio and pyvista.
 
-use crate::columns::{col, extend_plastic_strain, points_with};
 use crate::components::*;
 use crate::dim::Dim;
+use crate::infra::columns::{col, points_with};
+use crate::materials::extend_plastic_strain;
 use crate::simulation::Simulation;
 use crate::tensor::StoredSym;
 use hecs::{Archetype, Component, World};

@@ -3,13 +3,13 @@
 
 use super::validate::{self, carried_state, Checked, Derived, StageModels};
 use super::{pad3, BoundarySpec, Condition, LoadedScene, Region, Scene};
-use crate::columns::{col, points_with};
 use crate::components::*;
 use crate::context::Context;
-use crate::decomposition::Decomposition;
 use crate::dim::{Dim, Dim2, Dim3, Vector};
 use crate::error::SceneError;
 use crate::grid::Grid;
+use crate::infra::columns::{col, points_with};
+use crate::infra::decomposition::Decomposition;
 use crate::materials::{MaterialModel, MaterialState, StateVisitor};
 use crate::parallel::SlabCache;
 use crate::shape::{for_each_node, Linear, QuadraticBSpline, ShapeKind, UniformGimp};

@@ -3,7 +3,7 @@
 use super::{fold_ghosts, for_each_row, from_lanes, in_lanes, GradientSum, Shape, Stencil1, StressColumns};
 use crate::dim::Dim;
 use crate::grid::{cell_index, index_to_f64, Axis, Grid};
-use crate::lanes::{F64x4, Lanes};
+use crate::infra::lanes::{F64x4, Lanes};
 use crate::tensor::Sym3;
 
 /// Quadratic B-spline centred on each node (support 3h, C¹ continuous).

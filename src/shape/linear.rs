@@ -3,7 +3,7 @@
 use super::{for_each_row, from_lanes, in_lanes, GradientSum, Shape, Stencil1, StressColumns};
 use crate::dim::Dim;
 use crate::grid::{cell_floor, cell_index, Axis, Grid};
-use crate::lanes::{F64x4, Lanes};
+use crate::infra::lanes::{F64x4, Lanes};
 use crate::tensor::Sym3;
 
 /// Linear hat function: w = 1 − |x − x_i|/h on the two nodes of the cell holding the point.

@@ -14,7 +14,7 @@ pub use linear::Linear;
 
 use crate::dim::{Dim, Vector};
 use crate::grid::{Axis, Grid};
-use crate::lanes::{F64x4, Lanes};
+use crate::infra::lanes::{F64x4, Lanes};
 use crate::tensor::Sym3;
 
 /// The 1D weights of one point along one axis: nodes `base .. base + SUPPORT`.
@@ -138,7 +138,7 @@ pub(crate) fn from_lanes<D: Dim>(v: F64x4) -> D::Vec {
 /// As glam vectors the twelve sums of a 3D gather did not all stay in registers, and every
 /// node's multiply-add waited on a store and a reload (the 3D kinematics' hottest
 /// instruction). Four registers hold them, and each lane rounds as the scalar
-/// [`crate::lanes::madd`], so the bits are those of the glam form.
+/// [`crate::infra::lanes::madd`], so the bits are those of the glam form.
 #[derive(Clone, Copy, Default)]
 pub(crate) struct GradientSum {
     /// Column j of the velocity gradient (1/s).
@@ -564,7 +564,7 @@ pub(crate) mod tests {
     /// `gather_node_by_node` and `scatter_node_by_node` against the same sums written one
     /// component at a time with `lanes::madd`, bit for bit, at `x` for an arbitrary nodal field.
     fn check_lanes_round_as_scalars<D: Dim, S: Shape>(grid: &Grid<D>, x: D::Vec) {
-        use crate::lanes::madd;
+        use crate::infra::lanes::madd;
         let v = |i: usize| D::vec_from(nodal_field(i));
         let (n, bits) = (D::N, |a: f64| a.to_bits());
         let (mut l, mut vel) = ([[0.0; 3]; 3], [0.0; 3]);

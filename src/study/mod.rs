@@ -8,6 +8,7 @@
 //! interrupted study started again continues where it stopped.
 
 mod plot;
+mod progress;
 mod report;
 mod spec;
 
@@ -227,6 +228,18 @@ pub struct Results {
     pub orders: Vec<Order>,
 }
 
+impl Results {
+    /// The Pareto front and, over a `Refine` axis, the observed orders, as `kdmpm study`
+    /// prints them.
+    pub fn describe(&self, study: &Study) -> String {
+        let mut text = front_table(study, &self.rows, &self.front);
+        if !self.orders.is_empty() {
+            text += &orders_table(&self.orders);
+        }
+        text
+    }
+}
+
 /// Everything a study writes: `study.csv`, `pareto.svg`, and `convergence.csv` over a
 /// `Refine` axis.
 pub fn write_results(
@@ -256,3 +269,32 @@ pub fn write_results(
 }
 
 pub use report::{front_table, orders_table};
+
+/// Runs a whole study into `dir`: the reference first (refused when it did not converge),
+/// then every planned run (skipping those an earlier invocation completed), and writes the
+/// study's table and picture. Progress goes to stderr unless `quiet`. A signal
+/// ([`crate::interrupt`]) stops the run under way and the study.
+pub fn conduct(study: &Study, dir: &OutputDir, launch: &Launch, quiet: bool) -> Result<Results, StudyError> {
+    let total = study.runs.len() + usize::from(study.reference.is_some());
+    let progress = progress::StudyProgress::new(total as u64, quiet);
+    let run = |planned: &Planned| {
+        progress.start(planned);
+        let r = run_one(study, planned, dir, launch);
+        if let Ok(f) = &r {
+            progress.finish(f);
+        }
+        r
+    };
+    let runs = || -> Result<(Option<Finished>, Vec<Finished>), StudyError> {
+        let reference = study.reference.as_ref().map(run).transpose()?;
+        if let Some(r) = &reference {
+            check_reference(r)?;
+        }
+        let finished = study.runs.iter().map(run).collect::<Result<Vec<_>, _>>()?;
+        Ok((reference, finished))
+    };
+    let ran = runs();
+    progress.done();
+    let (reference, finished) = ran?;
+    write_results(study, dir, reference.as_ref(), &finished)
+}

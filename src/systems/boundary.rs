@@ -1,11 +1,11 @@
 //! Essential boundary conditions on the grid (paper step 2): fixed components held at zero,
 //! driven ones at their prescribed motion's velocity.
 
-use crate::columns::{col, col_mut, nodes};
 use crate::components::*;
 use crate::context::Context;
 use crate::dim::{Dim, Vector};
 use crate::error::StepError;
+use crate::infra::columns::{col, col_mut, nodes};
 use crate::parallel::{grid_pass, Disjoint};
 use crate::schedule::System;
 use crate::state::Drive;

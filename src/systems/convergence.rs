@@ -1,11 +1,11 @@
 //! Convergence monitor: force ratio K_F (eq. 3), external work (eq. 6), energy ratio K_E
 //! (eq. 4), and the stopping rule (paper step 7).
 
-use crate::columns::{col, nodes};
 use crate::components::*;
 use crate::context::Context;
 use crate::dim::{Dim, Vector};
 use crate::error::StepError;
+use crate::infra::columns::{col, nodes};
 use crate::measure::{max_movement, positions};
 use crate::parallel::grid_pass;
 use crate::schedule::System;

@@ -1,18 +1,18 @@
 //! Sums of node columns over the ranks that share nodes (runs over MPI).
 //!
 //! Two neighbouring ranks both map into the band of node layers around the cell layer where
-//! their ranges meet ([`crate::decomposition`]); each holds a partial sum there. Each sends
+//! their ranges meet ([`crate::infra::decomposition`]); each holds a partial sum there. Each sends
 //! its band to the other, and both then hold lower rank's part + upper rank's part, added in
 //! that order: the same bits on both, so both update those nodes alike and their points read
 //! the same field. Sends go up the ranks, then down, so no rank waits on a chain.
 //!
 //! With one rank every function here returns at once.
 
-use crate::columns::{col, col_mut, nodes};
 use crate::components::*;
 use crate::context::Context;
 use crate::dim::Dim;
 use crate::grid::NodeBox;
+use crate::infra::columns::{col, col_mut, nodes};
 use std::ops::Range;
 
 /// Node mass.

@@ -1,10 +1,10 @@
 //! Grid-to-particle velocity update and the kinetic energy of eq. (5) (paper step 4).
 
-use crate::columns::{col, col_mut, nodes, points_with};
 use crate::components::*;
 use crate::context::Context;
 use crate::dim::{Dim, Vector};
 use crate::error::StepError;
+use crate::infra::columns::{col, col_mut, nodes, points_with};
 use crate::parallel::CHUNK;
 use crate::schedule::System;
 use crate::shape::{for_each_node, Shape};

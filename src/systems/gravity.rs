@@ -1,10 +1,10 @@
 //! Gravity: body force on the grid. Scheduled only when the scene has gravity.
 
-use crate::columns::{col, col_mut, nodes};
 use crate::components::*;
 use crate::context::Context;
 use crate::dim::Dim;
 use crate::error::StepError;
+use crate::infra::columns::{col, col_mut, nodes};
 use crate::parallel::{for_each_box_node, Disjoint};
 use crate::schedule::System;
 /// Adds m_i·g to every node, g from `Settings::gravity` (which a loading stage may change).

@@ -1,11 +1,11 @@
 //! Grid reset: every step starts from the undeformed, empty background grid (paper step 8).
 
-use crate::columns::{col_mut, nodes};
 use crate::components::*;
 use crate::context::Context;
 use crate::dim::{Dim, Vector};
 use crate::error::StepError;
 use crate::grid::NodeBox;
+use crate::infra::columns::{col_mut, nodes};
 use crate::parallel::fill_box;
 use crate::schedule::System;
 

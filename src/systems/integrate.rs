@@ -1,10 +1,10 @@
 //! Nodal integration of the equations of motion, eq. (2) (paper step 3).
 
-use crate::columns::{col, col_mut, nodes};
 use crate::components::*;
 use crate::context::Context;
 use crate::dim::{Dim, Vector};
 use crate::error::StepError;
+use crate::infra::columns::{col, col_mut, nodes};
 use crate::parallel::{for_each_box_node, Disjoint};
 use crate::schedule::System;
 use crate::state::Damping;

@@ -1,11 +1,11 @@
 //! Kinematics: velocity gradient and position update from one nodal velocity field
 //! (paper steps 5–6).
 
-use crate::columns::{col, col_mut, nodes, points_with};
 use crate::components::*;
 use crate::context::Context;
 use crate::dim::{Dim, Vector};
 use crate::error::StepError;
+use crate::infra::columns::{col, col_mut, nodes, points_with};
 use crate::parallel::CHUNK;
 use crate::schedule::System;
 use crate::shape::{for_each_node, Shape};
@@ -19,7 +19,7 @@ use std::marker::PhantomData;
 /// velocity) the displacement drifts from the strain at every kinetic-damping reset.
 /// After a reset the points neither move nor strain.
 ///
-/// The scatters' grouping of points ([`crate::parallel::SlabCache`]) depends on the cell of
+/// The scatters' grouping of points ([`crate::SlabCache`]) depends on the cell of
 /// each point alone, so it is dropped only when a point moved into another cell: in a body
 /// near rest most steps keep it, and particle-to-grid skips its counting sort (a sixth of
 /// its work a point; docs/performance.md).

@@ -1,11 +1,11 @@
 //! Load control: a load applied in equal increments, each relaxed by kinetic damping to its
 //! static state and recorded as a row of the load–displacement curve (`curve.csv`).
 
-use crate::columns::{col, points_with};
 use crate::components::*;
 use crate::context::Context;
 use crate::dim::Dim;
 use crate::error::StepError;
+use crate::infra::columns::{col, points_with};
 use crate::schedule::System;
 use crate::state::{CurvePoint, LoadSteps, StopReason};
 use crate::systems::point_loads::set_point_loads;

@@ -1,15 +1,15 @@
 //! Dynamic-relaxation mass scaling: fictitious nodal inertia so that every node takes the
 //! same stable step. Scheduled only with `solver.mass_scaling`.
 
-use crate::columns::{col, col_mut, nodes, points_with};
 use crate::components::*;
 use crate::context::Context;
 use crate::dim::Dim;
 use crate::error::StepError;
-use crate::grid::NodeBox;
-use crate::parallel::{fill_box, for_each_box_node, scatter, Disjoint};
+use crate::infra::columns::{col, col_mut, nodes, points_with};
+use crate::parallel::{for_each_box_node, Disjoint};
 use crate::schedule::System;
-use crate::shape::{for_each_node, Shape};
+use crate::shape::Shape;
+use crate::systems::node_pairs::NodePairs;
 use std::marker::PhantomData;
 
 /// The paper's eq. (2) mass only sets the path to a static answer, not the answer. With
@@ -24,16 +24,15 @@ use std::marker::PhantomData;
 /// reach is untouched; so is a one-material scene (every s_m = 1), which needs none of it.
 #[derive(Debug)]
 pub struct MassScaling<D: Dim, S> {
-    /// Per node: Σ_p w_ip m_p s_p (kg) and the largest s_p of the points that reach it;
-    /// zero outside the points' box between runs.
-    inertia: Vec<[f64; 2]>,
+    /// Per node: Σ_p w_ip m_p s_p (kg) and the largest s_p of the points that reach it.
+    inertia: NodePairs,
     _marker: PhantomData<fn() -> (D, S)>,
 }
 
 impl<D: Dim, S> Default for MassScaling<D, S> {
     fn default() -> Self {
         MassScaling {
-            inertia: Vec::new(),
+            inertia: NodePairs::default(),
             _marker: PhantomData,
         }
     }
@@ -47,34 +46,27 @@ impl<D: Dim, S: Shape> System<D> for MassScaling<D, S> {
         let grid = &ctx.grid;
         let factors = &ctx.settings.inertia_factors;
         let sums = &mut self.inertia;
-        sums.resize(grid.node_count(), [0.0; 2]);
-        let mut active = NodeBox::default();
-        for arch in points_with::<Mass>(&ctx.world) {
+        // Material points only: a point load's carrier has no material and no mass.
+        for arch in points_with::<MaterialId>(&ctx.world) {
             let (xg, mg, idg) = (
                 col::<Position<D::Vec>>(arch),
                 col::<Mass>(arch),
                 col::<MaterialId>(arch),
             );
-            let x: &[Position<D::Vec>] = &xg;
             let (m, id): (&[Mass], &[MaterialId]) = (&mg, &idg);
-            active = active.union(scatter(
-                ctx.slabs.slabs(grid, x),
+            sums.scatter::<D, S, _>(
+                &mut ctx.slabs,
                 grid,
-                S::SUPPORT,
-                &Disjoint::new(sums),
-                |points, sums, lo| {
-                    for &p in points {
-                        let p = p as usize;
-                        let s = factors.get(id[p].0 as usize).copied().unwrap_or(1.0);
-                        let scaled = m[p].0 * s;
-                        for_each_node::<D, S>(grid, x[p].0, |i, w, _| {
-                            let node = &mut sums[i - lo];
-                            node[0] += w * scaled;
-                            node[1] = node[1].max(s);
-                        });
-                    }
+                &xg,
+                |p| {
+                    let s = factors.get(id[p].0 as usize).copied().unwrap_or(1.0);
+                    (m[p].0 * s, s)
                 },
-            ));
+                |node, w, &(scaled, s)| {
+                    node[0] += w * scaled;
+                    node[1] = node[1].max(s);
+                },
+            );
         }
         let (dt, min_mass, floor) = (
             ctx.settings.dt,
@@ -84,7 +76,7 @@ impl<D: Dim, S: Shape> System<D> for MassScaling<D, S> {
         let n = nodes(&ctx.world);
         let nm = col::<NodeMass>(n);
         let nm = &*nm;
-        let scaled: &[[f64; 2]] = sums;
+        let scaled = sums.pairs();
         let mut na = col_mut::<NodeAcceleration<D::Vec>>(n);
         let mut nv = col_mut::<NodeVelocity<D::Vec>>(n);
         let target = (Disjoint::new(&mut na), Disjoint::new(&mut nv));
@@ -105,7 +97,7 @@ impl<D: Dim, S: Shape> System<D> for MassScaling<D, S> {
                 }
             }
         });
-        fill_box(grid, active, sums, [0.0; 2]);
+        sums.clear(grid);
         Ok(())
     }
 }

@@ -3,17 +3,16 @@
 //! [`Migrate`] ends every step of a run over several ranks (`distributed::decompose` adds
 //! it): a point moves less than a cell a step, so at the next mapping every point lies in
 //! its rank's layers and maps only into that rank's nodes and the bands it shares. A point goes
-//! with every column it has (the list of [`point_components!`](crate::point_components!),
+//! with every column it has (the list of `point_components!`,
 //! its material's state and its [`PointId`] included) and is spawned again on the other
 //! side, so a run's points are the same set whatever the rank count.
 
-use crate::columns::{col, points_with};
 use crate::components::*;
 use crate::context::Context;
-use crate::decomposition::Decomposition;
 use crate::dim::Dim;
 use crate::error::StepError;
-use crate::point_components;
+use crate::infra::columns::{col, points_with};
+use crate::infra::decomposition::Decomposition;
 use crate::schedule::System;
 use hecs::{Entity, EntityBuilder, World};
 
@@ -150,7 +149,7 @@ fn migrate_once<D: Dim>(ctx: &mut Context<D>) -> (usize, usize, bool) {
     (down.len() + up.len(), came, astray)
 }
 
-/// Bytes as whole f64 words (zero-padded), the unit [`crate::comm::Comm::exchange`] sends.
+/// Bytes as whole f64 words (zero-padded), the unit [`crate::infra::comm::Comm::exchange`] sends.
 fn words(mut bytes: Vec<u8>) -> Vec<f64> {
     bytes.resize(bytes.len().div_ceil(8) * 8, 0);
     bytes
@@ -160,7 +159,7 @@ fn words(mut bytes: Vec<u8>) -> Vec<f64> {
 }
 
 /// Appends point `e`: a mask of the components it has (bit k: the k-th of
-/// [`point_components!`](crate::point_components!)), then each one's bytes.
+/// `point_components!`), then each one's bytes.
 fn write_point<D: Dim>(world: &World, e: Entity, out: &mut Vec<u8>) {
     let point = world.entity(e).expect("a point found above");
     let at = out.len();

@@ -26,6 +26,7 @@ pub mod load_steps;
 pub mod mass_scaling;
 pub mod migrate;
 pub mod nodal_velocity;
+mod node_pairs;
 pub mod p2g;
 pub mod peak_watch;
 pub mod point_loads;

@@ -1,11 +1,11 @@
 //! Nodal velocity from mapped momentum, v_i = p_i/m_i, with the boundary conditions.
 
 use super::boundary::constrain;
-use crate::columns::{col, col_mut, nodes};
 use crate::components::*;
 use crate::context::Context;
 use crate::dim::{Dim, Vector};
 use crate::error::StepError;
+use crate::infra::columns::{col, col_mut, nodes};
 use crate::parallel::{for_each_box_node, Disjoint};
 use crate::schedule::System;
 

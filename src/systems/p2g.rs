@@ -1,11 +1,11 @@
 //! Particle-to-grid: mass, momentum and internal force mapped to the nodes (paper step 1).
 
-use crate::columns::{col, col_mut, nodes, points_with};
 use crate::components::*;
 use crate::context::Context;
 use crate::dim::Dim;
 use crate::error::StepError;
-use crate::lanes::F64x4;
+use crate::infra::columns::{col, col_mut, nodes, points_with};
+use crate::infra::lanes::F64x4;
 use crate::parallel::{scatter, Disjoint};
 use crate::schedule::System;
 use crate::shape::{for_each_node, from_lanes, Shape, StressColumns};
@@ -27,7 +27,7 @@ pub enum P2gPart {
 /// Maps point mass m_p, momentum m_p v_p and internal force −V_p σ_p·∇w_ip to the grid.
 ///
 /// Points are grouped in slabs of grid rows that scatter in parallel, slabs that share no
-/// node at a time (see [`scatter`]).
+/// node at a time (see `parallel::scatter`).
 #[derive(Debug)]
 pub struct P2g<D: Dim, S> {
     part: P2gPart,
@@ -151,8 +151,8 @@ impl<D: Dim, S: Shape> P2g<D, S> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::columns::col_mut;
     use crate::dim::Vector;
+    use crate::infra::columns::col_mut;
     use crate::scene::{build, LoadedScene};
     use crate::shape::{Linear, QuadraticBSpline};
     use crate::simulation::{AnySimulation, Simulation};

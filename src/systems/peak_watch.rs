@@ -1,11 +1,11 @@
 //! Kinetic damping: watch the kinetic energy and zero all velocities at a peak (paper §2.2,
 //! step 5). Scheduled only with kinetic damping.
 
-use crate::columns::{col_mut, points_with};
 use crate::components::*;
 use crate::context::Context;
 use crate::dim::{Dim, Vector};
 use crate::error::StepError;
+use crate::infra::columns::{col_mut, points_with};
 use crate::schedule::System;
 use crate::state::Peak;
 

@@ -1,10 +1,10 @@
 //! Point loads: concentrated forces carried by points. Scheduled only when a scene has them.
 
-use crate::columns::{col, col_mut, nodes, points_with};
 use crate::components::*;
 use crate::context::Context;
 use crate::dim::Dim;
 use crate::error::StepError;
+use crate::infra::columns::{col, col_mut, nodes, points_with};
 use crate::schedule::System;
 use crate::shape::{for_each_node, Shape};
 use std::marker::PhantomData;

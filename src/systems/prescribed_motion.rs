@@ -12,11 +12,11 @@
 //! The driven nodes take their velocity again at the next step; a reset step moves no
 //! point, and the motion travels nothing in it.
 
-use crate::columns::{col_mut, nodes};
 use crate::components::NodeFixity;
 use crate::context::Context;
 use crate::dim::Dim;
 use crate::error::StepError;
+use crate::infra::columns::{col_mut, nodes};
 use crate::schedule::System;
 use crate::state::{CurvePoint, MotionSpec, StopReason};
 

@@ -1,11 +1,11 @@
 //! MUSL remap: the updated point velocities mapped back to the grid (paper step 6).
 
 use super::nodal_velocity::velocity_from_momentum;
-use crate::columns::{col, col_mut, nodes, points_with};
 use crate::components::*;
 use crate::context::Context;
 use crate::dim::{Dim, Vector};
 use crate::error::StepError;
+use crate::infra::columns::{col, col_mut, nodes, points_with};
 use crate::parallel::{fill_box, scatter, Disjoint};
 use crate::schedule::System;
 use crate::shape::{for_each_node, Shape};

@@ -9,13 +9,12 @@
 //! cell start far apart in memory, and cell order is worth about a third of the block's
 //! throughput (`cargo bench --bench throughput`).
 
-use crate::columns::{col, points_with};
 use crate::components::*;
 use crate::context::Context;
 use crate::dim::Dim;
 use crate::error::StepError;
 use crate::grid::Grid;
-use crate::point_components;
+use crate::infra::columns::{col, points_with};
 use crate::schedule::System;
 use hecs::{Archetype, World};
 use rayon::prelude::*;

@@ -3,11 +3,11 @@
 //! Mohr-Coulomb strength), gravity, point loads and tractions when it begins, and may zero
 //! the displacements.
 
-use crate::columns::{col, col_mut, nodes, points_with};
 use crate::components::*;
 use crate::context::Context;
 use crate::dim::{Dim, Vector};
 use crate::error::StepError;
+use crate::infra::columns::{col, col_mut, nodes, points_with};
 use crate::schedule::System;
 use crate::state::{Gravity, LoadStage, StageResult, StopReason};
 use crate::systems::point_loads::set_point_loads;

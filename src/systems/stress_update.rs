@@ -1,11 +1,11 @@
 //! Constitutive update with the Jaumann stress rate, eqs. (7)–(10) (paper step 6).
 
-use crate::columns::{col, col_mut, points_with};
 use crate::components::*;
 use crate::context::Context;
 use crate::dim::Dim;
 use crate::error::StepError;
-use crate::lanes::{gather, F64x4, LANES};
+use crate::infra::columns::{col, col_mut, points_with};
+use crate::infra::lanes::{gather, F64x4, LANES};
 use crate::materials::{update_lane_by_lane, visit_states, MaterialModel, MaterialState, StateVisitor};
 use crate::parallel::CHUNK;
 use crate::schedule::System;
@@ -17,7 +17,7 @@ use std::marker::PhantomData;
 /// For each point: Δε = sym(L)Δt and ΔW = skew(L)Δt; the stress is first rotated by ΔW
 /// (objective Jaumann term) and then integrated by the point's material over Δε.
 ///
-/// Points go four at a time, one per SIMD lane ([`crate::lanes`]): the rotation always, and
+/// Points go four at a time, one per SIMD lane ([`crate::infra::lanes`]): the rotation always, and
 /// the material's update when the four share a material (each gets the bits it would get
 /// alone); the gain is in docs/performance.md ("Figures behind the code").
 #[derive(Debug, Default)]

@@ -1,10 +1,10 @@
 //! Volume (and so density ρ = m/V) update (paper step 6).
 
-use crate::columns::{col, col_mut, points_with};
 use crate::components::*;
 use crate::context::Context;
 use crate::dim::Dim;
 use crate::error::StepError;
+use crate::infra::columns::{col, col_mut, points_with};
 use crate::parallel::CHUNK;
 use crate::schedule::System;
 use rayon::prelude::*;

@@ -1,15 +1,15 @@
 //! Volumetric smoothing of the strain increment through the grid (against volumetric
 //! locking and the pressure checkerboard it causes).
 
-use crate::columns::{col, col_mut, points_with};
 use crate::components::*;
 use crate::context::Context;
 use crate::dim::Dim;
 use crate::error::StepError;
-use crate::grid::NodeBox;
-use crate::parallel::{fill_box, for_each_box_node, scatter, Disjoint, CHUNK};
+use crate::infra::columns::{col, col_mut, points_with};
+use crate::parallel::CHUNK;
 use crate::schedule::System;
 use crate::shape::{for_each_node, Shape};
+use crate::systems::node_pairs::NodePairs;
 use rayon::prelude::*;
 use std::marker::PhantomData;
 
@@ -25,16 +25,15 @@ use std::marker::PhantomData;
 /// volume see the same smoothed rate.
 #[derive(Debug)]
 pub struct VolumetricSmoothing<D: Dim, S> {
-    /// Per node: Σ w V tr(L), Σ w V; then θ_i in the first entry. Zero outside the points'
-    /// box between runs.
-    sums: Vec<[f64; 2]>,
+    /// Per node: Σ w V tr(L), Σ w V; then θ_i in the first entry.
+    sums: NodePairs,
     _marker: PhantomData<fn() -> (D, S)>,
 }
 
 impl<D: Dim, S> Default for VolumetricSmoothing<D, S> {
     fn default() -> Self {
         VolumetricSmoothing {
-            sums: Vec::new(),
+            sums: NodePairs::default(),
             _marker: PhantomData,
         }
     }
@@ -55,39 +54,27 @@ impl<D: Dim, S: Shape> System<D> for VolumetricSmoothing<D, S> {
             return Ok(());
         }
         let grid = &ctx.grid;
-        let mut active = NodeBox::default();
         let sums = &mut self.sums;
-        sums.resize(grid.node_count(), [0.0; 2]);
         for arch in points_with::<Volume>(&ctx.world) {
             let (xg, vg, lg) = (
                 col::<Position<D::Vec>>(arch),
                 col::<Volume>(arch),
                 col::<VelocityGradient<D::Mat>>(arch),
             );
-            let (x, vol): (&[Position<D::Vec>], &[Volume]) = (&xg, &vg);
-            let l: &[VelocityGradient<D::Mat>] = &lg;
-            active = active.union(scatter(
-                ctx.slabs.slabs(grid, x),
+            let (vol, l): (&[Volume], &[VelocityGradient<D::Mat>]) = (&vg, &lg);
+            sums.scatter::<D, S, _>(
+                &mut ctx.slabs,
                 grid,
-                S::SUPPORT,
-                &Disjoint::new(sums),
-                |points, sums, lo| {
-                    for &p in points {
-                        let p = p as usize;
-                        let (v, t) = (vol[p].0, trace::<D>(&l[p].0));
-                        for_each_node::<D, S>(grid, x[p].0, |i, w, _| {
-                            sums[i - lo][0] += w * v * t;
-                            sums[i - lo][1] += w * v;
-                        });
-                    }
+                &xg,
+                |p| (vol[p].0, trace::<D>(&l[p].0)),
+                |node, w, &(v, t)| {
+                    node[0] += w * v * t;
+                    node[1] += w * v;
                 },
-            ));
+            );
         }
-        for_each_box_node(grid, active, &Disjoint::new(sums), |_, k, sums| {
-            let s = sums[k];
-            sums[k] = [if s[1] > 0.0 { s[0] / s[1] } else { 0.0 }, 0.0];
-        });
-        let nodal: &[[f64; 2]] = sums;
+        sums.map(grid, |s| [if s[1] > 0.0 { s[0] / s[1] } else { 0.0 }, 0.0]);
+        let nodal = sums.pairs();
         let n = D::N as f64;
         for arch in points_with::<Volume>(&ctx.world) {
             let xg = col::<Position<D::Vec>>(arch);
@@ -102,7 +89,7 @@ impl<D: Dim, S: Shape> System<D> for VolumetricSmoothing<D, S> {
                 }
             });
         }
-        fill_box(grid, active, sums, [0.0; 2]);
+        sums.clear(grid);
         Ok(())
     }
 }

@@ -2,8 +2,10 @@
 #![allow(dead_code)]
 
 use kdmpm::output::Summary;
+use kdmpm::run::Run;
 use kdmpm::scene::{build, LoadedScene};
-use kdmpm::{with_simulation, AnySimulation, Dim2, Simulation};
+use kdmpm::{AnySimulation, Dim2, Simulation};
+use std::collections::BTreeMap;
 use std::path::Path;
 
 /// Path of a scene shipped in `scenes/`.
@@ -15,13 +17,13 @@ pub fn scene(name: &str) -> std::path::PathBuf {
 pub fn run(name: &str, overrides: &[&str]) -> Summary {
     let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
     let loaded = LoadedScene::from_file(&scene(name), &overrides).expect("scene loads");
-    run_loaded(name, &loaded)
+    run_loaded(loaded)
 }
 
 /// Runs the scene `text` (called `name` in messages) to its stop and returns the summary.
 pub fn run_text(name: &str, text: &str) -> Summary {
     let loaded = LoadedScene::from_text(Path::new(name), text, &[]).expect("scene loads");
-    run_loaded(name, &loaded)
+    run_loaded(loaded)
 }
 
 /// The error that building the scene `text` gives.
@@ -30,13 +32,10 @@ pub fn refusal(text: &str) -> String {
     build(&loaded).err().expect("refused").to_string()
 }
 
-fn run_loaded(name: &str, loaded: &LoadedScene) -> Summary {
-    let (mut sim, _) = build(loaded).expect("scene builds");
-    with_simulation!(&mut sim, s => {
-        let start = std::time::Instant::now();
-        let result = s.run(|_| {});
-        Summary::collect(name, s, start.elapsed().as_secs_f64(), result.err().map(|e| e.to_string()))
-    })
+/// Runs `loaded` in memory with the library's runner; a run that stops on an error gives
+/// its summary (outcome `Failed`, the error in `error`).
+fn run_loaded(loaded: LoadedScene) -> Summary {
+    Run::scene(loaded).quiet(true).go().expect("scene builds").summary
 }
 
 /// Runs the `kdmpm` binary with `args` and waits for it.
@@ -139,15 +138,70 @@ const BANK_ON_LAYER: &str = r#"Scene(
 /// run: `steps` steps, a sort every `sort_every` (0: none), per-point displacements kept or
 /// not.
 pub fn bank_on_layer(layer: &str, steps: u64, sort_every: u64, displacements: bool) -> Simulation<Dim2> {
-    let text = BANK_ON_LAYER
-        .replace("SAND", SAND)
-        .replace("LAYER", layer)
-        .replace("STEPS", &steps.to_string())
-        .replace("SORT", &sort_every.to_string())
-        .replace("KEEP", &displacements.to_string());
+    let text = bank_on_layer_text(layer, steps, sort_every, displacements);
     let loaded = LoadedScene::from_text(Path::new("bank.ron"), &text, &[]).expect("scene loads");
     let AnySimulation::Two(sim) = build(&loaded).expect("scene builds").0 else {
         unreachable!("2D scene")
     };
     sim
+}
+
+/// The scene text of [`bank_on_layer`].
+pub fn bank_on_layer_text(layer: &str, steps: u64, sort_every: u64, displacements: bool) -> String {
+    BANK_ON_LAYER
+        .replace("SAND", SAND)
+        .replace("LAYER", layer)
+        .replace("STEPS", &steps.to_string())
+        .replace("SORT", &sort_every.to_string())
+        .replace("KEEP", &displacements.to_string())
+}
+
+/// The test suite's own `.vtu` reader, independent of the library's (so that a fault in
+/// the writer cannot hide behind the same fault in a reader). Every DataArray as f64, by name (`Points` for the positions), with its
+/// component count. The XML head is parsed as XML (closed where the raw section opens);
+/// each array's bytes are at `offset` after the `_` that opens the appended section, a
+/// UInt64 byte count first (header_type="UInt64"), little-endian values after it.
+pub fn read_vtu(path: &Path) -> BTreeMap<String, (usize, Vec<f64>)> {
+    let bytes = std::fs::read(path).expect("the .vtu file is written");
+    let open = b"<AppendedData encoding=\"raw\">";
+    let at = bytes
+        .windows(open.len())
+        .position(|w| w == open)
+        .expect("raw appended data");
+    let head = format!("{}</VTKFile>", std::str::from_utf8(&bytes[..at]).unwrap());
+    let doc = roxmltree::Document::parse(&head).expect("the head is well-formed XML");
+    let root = doc.root_element();
+    assert_eq!(root.attribute("header_type"), Some("UInt64"));
+    assert_eq!(root.attribute("byte_order"), Some("LittleEndian"));
+    let underscore = at + open.len() + bytes[at + open.len()..].iter().position(|&b| b == b'_').unwrap();
+    let data = &bytes[underscore + 1..];
+    let mut out = BTreeMap::new();
+    for a in doc.descendants().filter(|n| n.has_tag_name("DataArray")) {
+        let name = a.attribute("Name").unwrap_or("Points").to_string();
+        let comps: usize = a
+            .attribute("NumberOfComponents")
+            .map_or(1, |c| c.parse().unwrap());
+        assert_eq!(a.attribute("format"), Some("appended"));
+        let offset: usize = a.attribute("offset").unwrap().parse().unwrap();
+        let len = u64::from_le_bytes(data[offset..offset + 8].try_into().unwrap()) as usize;
+        let raw = &data[offset + 8..offset + 8 + len];
+        let values: Vec<f64> = match a.attribute("type").unwrap() {
+            "Float64" => raw
+                .chunks(8)
+                .map(|c| f64::from_le_bytes(c.try_into().unwrap()))
+                .collect(),
+            "Int64" => raw
+                .chunks(8)
+                .map(|c| i64::from_le_bytes(c.try_into().unwrap()) as f64)
+                .collect(),
+            "UInt32" => raw
+                .chunks(4)
+                .map(|c| u32::from_le_bytes(c.try_into().unwrap()) as f64)
+                .collect(),
+            "UInt8" => raw.iter().map(|&b| b as f64).collect(),
+            t => panic!("unexpected type {t}"),
+        };
+        out.insert(name, (comps, values));
+    }
+    out
 }

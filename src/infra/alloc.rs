@@ -16,7 +16,7 @@
 //! order, and a block's offset in a page is its colour wherever the system put the block.
 //!
 //! Install it in a binary with
-//! `#[global_allocator] static ALLOCATOR: kdmpm::alloc::Coloured = kdmpm::alloc::Coloured;`.
+//! `#[global_allocator] static ALLOCATOR: kdmpm::infra::alloc::Coloured = kdmpm::infra::alloc::Coloured;`.
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicUsize, Ordering};

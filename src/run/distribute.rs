@@ -1,4 +1,4 @@
-//! Splitting a built simulation across MPI ranks ([`crate::decomposition`]).
+//! Splitting a built simulation across MPI ranks ([`crate::infra::decomposition`]).
 //!
 //! Every rank builds the whole scene (the same points with the same ids), counts the points
 //! of each cell layer along the slab axis, finds the same [`Decomposition`] and keeps the
@@ -6,10 +6,10 @@
 //! ([`crate::systems::exchange`]), reduces the global figures in rank order, and moves points
 //! that leave a rank to its neighbour ([`crate::systems::migrate`]).
 
-use crate::comm::Comm;
 use crate::components::Position;
-use crate::decomposition::Decomposition;
 use crate::dim::Dim;
+use crate::infra::comm::Comm;
+use crate::infra::decomposition::Decomposition;
 use crate::simulation::Simulation;
 use crate::systems::migrate::{layer_counts, Migrate};
 use hecs::Entity;

@@ -177,7 +177,7 @@ impl Comm {
     }
 
     /// Completes a list indexed by point id in which each rank filled its own points and
-    /// left the others NaN (see [`crate::measure::positions`]): every rank gets every
+    /// left the others NaN (see `measure::positions`): every rank gets every
     /// point's entry. The lists may differ in length (ids above a rank's last point).
     pub fn merge_by_id(&self, list: &mut Vec<[f64; 3]>) {
         if self.size == 1 {

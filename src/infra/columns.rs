@@ -4,7 +4,6 @@
 //! `&[T]` / `&mut [T]` through these helpers and index them together.
 
 use crate::components::NodeMass;
-use crate::materials::{visit_states, MaterialState, StateVisitor};
 use hecs::{Archetype, ArchetypeColumn, ArchetypeColumnMut, Component, World};
 
 /// Read access to column `T` of `arch`. Panics if the archetype lacks it: systems only ask
@@ -36,38 +35,4 @@ pub fn points_with<T: Component>(world: &World) -> impl Iterator<Item = &Archety
     world
         .archetypes()
         .filter(|a| a.has::<T>() && !a.is_empty() && !a.has::<NodeMass>())
-}
-
-/// Appends the accumulated plastic strain of each point of `arch` to `out`, in row order:
-/// from the column of its material's state, 0 where the points carry no state.
-pub fn extend_plastic_strain(arch: &Archetype, out: &mut Vec<f64>) {
-    struct Extend<'a>(&'a Archetype, &'a mut Vec<f64>, bool);
-    impl StateVisitor for Extend<'_> {
-        fn visit<S: MaterialState>(&mut self) {
-            if let (false, Some(c)) = (self.2, self.0.get::<&S>()) {
-                self.1.extend(c.iter().map(S::plastic_strain));
-                self.2 = true;
-            }
-        }
-    }
-    let mut e = Extend(arch, out, false);
-    visit_states(&mut e);
-    if !e.2 {
-        out.resize(out.len() + arch.len() as usize, 0.0);
-    }
-}
-
-/// The first row of `arch` whose material state holds a value that is not finite.
-pub fn first_non_finite_state(arch: &Archetype) -> Option<usize> {
-    struct Find<'a>(&'a Archetype, Option<usize>);
-    impl StateVisitor for Find<'_> {
-        fn visit<S: MaterialState>(&mut self) {
-            if let (None, Some(c)) = (self.1, self.0.get::<&S>()) {
-                self.1 = c.iter().position(|s| !s.is_finite());
-            }
-        }
-    }
-    let mut f = Find(arch, None);
-    visit_states(&mut f);
-    f.1
 }

@@ -1,0 +1,124 @@
+//! What the runner does between steps, one small hook each: the caller's observer, progress
+//! on stderr, the stop request, checkpoints, and the displacement limit of a
+//! strength-reduction trial. Each sees the whole simulation after every step and may end
+//! the run by setting `ctx.state.stop`.
+
+use crate::checkpoint;
+use crate::dim::Dim;
+use crate::error::StepError;
+use crate::interrupt::StopSignal;
+use crate::measure::max_displacements;
+use crate::output::{history, OutputDir, Progress, RowFile};
+use crate::scene::CheckpointEvery;
+use crate::simulation::Simulation;
+use crate::state::StopReason;
+use std::io::Write;
+use std::sync::{Arc, Mutex};
+use std::time::Instant;
+
+/// Called after every step, in the order the runner holds them.
+pub(crate) trait Hook<D: Dim> {
+    /// Looks at (and may stop) the simulation after a step.
+    fn after_step(&mut self, sim: &mut Simulation<D>) -> Result<(), StepError>;
+
+    /// The run has ended (by its stop or an error).
+    fn finish(&mut self) {}
+}
+
+/// The caller's observer ([`super::Run::observe`]).
+pub(crate) struct Observer<'a>(pub super::ObserveFn<'a>);
+
+impl<D: Dim> Hook<D> for Observer<'_> {
+    fn after_step(&mut self, sim: &mut Simulation<D>) -> Result<(), StepError> {
+        (self.0)(&sim.ctx.state);
+        Ok(())
+    }
+}
+
+/// Progress on stderr ([`Progress`]).
+pub(crate) struct ShowProgress(pub Progress);
+
+impl<D: Dim> Hook<D> for ShowProgress {
+    fn after_step(&mut self, sim: &mut Simulation<D>) -> Result<(), StepError> {
+        self.0.update(&sim.ctx.state);
+        Ok(())
+    }
+
+    fn finish(&mut self) {
+        self.0.finish();
+    }
+}
+
+/// Ends the run as `Interrupted` once its [`StopSignal`] is raised.
+pub(crate) struct StopOnRequest(pub StopSignal);
+
+impl<D: Dim> Hook<D> for StopOnRequest {
+    fn after_step(&mut self, sim: &mut Simulation<D>) -> Result<(), StepError> {
+        if sim.ctx.state.stop.is_none() && self.0.requested() {
+            sim.ctx.state.stop = Some(StopReason::Interrupted);
+        }
+        Ok(())
+    }
+}
+
+/// Writes `checkpoint.kdc` at the scene's cadence and when the run is interrupted (it runs
+/// after [`StopOnRequest`]). The history is flushed first, and its committed length and
+/// CRC-32 go into the header, so that a resumed run continues exactly that history.
+pub(crate) struct Checkpoints<'d> {
+    pub dir: &'d OutputDir,
+    pub every: Option<CheckpointEvery>,
+    pub header: checkpoint::Header,
+    pub rows: Arc<Mutex<RowFile>>,
+    /// Wall seconds of the run before this invocation (a resumed run's).
+    pub before: f64,
+    pub start: Instant,
+    pub last: Instant,
+}
+
+impl<D: Dim> Hook<D> for Checkpoints<'_> {
+    fn after_step(&mut self, sim: &mut Simulation<D>) -> Result<(), StepError> {
+        let st = &sim.ctx.state;
+        let interrupted = st.stop == Some(StopReason::Interrupted);
+        let due = st.stop.is_none()
+            && match self.every {
+                Some(CheckpointEvery::Steps(n)) => st.clock.step.is_multiple_of(n),
+                Some(CheckpointEvery::Seconds(t)) => self.last.elapsed().as_secs_f64() >= t,
+                None => false,
+            };
+        if interrupted || due {
+            self.last = Instant::now();
+            let mut rows = history::lock(&self.rows);
+            rows.flush()?;
+            self.header.history_bytes = rows.committed();
+            self.header.history_crc = rows.committed_crc();
+            self.header.wall_seconds = self.before + self.start.elapsed().as_secs_f64();
+            let bytes = checkpoint::encode(sim, &self.header);
+            self.dir
+                .write_atomic(checkpoint::FILE_NAME, |out| out.write_all(&bytes))?;
+        }
+        Ok(())
+    }
+}
+
+/// A strength-reduction trial's failure criterion: the run stops as soon as a point has
+/// moved farther than `limit` (m), looked at every `every` steps.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DisplacementLimit {
+    /// Steps between looks (the scan of every point costs about a step).
+    pub every: u64,
+    /// The largest displacement a standing trial may show (m).
+    pub limit: f64,
+}
+
+impl<D: Dim> Hook<D> for DisplacementLimit {
+    fn after_step(&mut self, sim: &mut Simulation<D>) -> Result<(), StepError> {
+        let st = &sim.ctx.state;
+        if st.stop.is_none() && st.clock.step.is_multiple_of(self.every) {
+            let (u, _) = max_displacements(sim).unwrap_or_default();
+            if u > self.limit {
+                sim.ctx.state.stop = Some(StopReason::DisplacementLimit);
+            }
+        }
+        Ok(())
+    }
+}

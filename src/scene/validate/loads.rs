@@ -1,0 +1,101 @@
+//! The loads: gravity, point loads, tractions (and their increments), traced points, and
+//! the rule that a scene loads something.
+
+use super::grid::check_faces;
+use super::materials::{check_mass_finite, check_smoothing};
+use super::*;
+use crate::error::SceneError;
+use crate::materials::MaterialModel;
+
+/// Face conditions, gravity, point loads, and what the materials make of them.
+pub(super) fn check_loads(r: &Rules, table: &[(String, MaterialModel)]) -> Result<(), SceneError> {
+    let (loaded, s, n) = (r.loaded, &r.loaded.scene, r.n);
+    check_faces(&s.boundaries, "boundaries", n).map_err(|(field, rule)| loaded.invalid(&field, rule))?;
+    if let Some(g) = &s.gravity {
+        r.len("gravity.acceleration", g.acceleration.len())?;
+        r.finite("gravity.acceleration", &g.acceleration, "m/s²")?;
+        if !non_negative(g.ramp_time) {
+            return r.bad(
+                "gravity.ramp_time",
+                format!("must be ≥ 0 s, found {}", g.ramp_time),
+            );
+        }
+    }
+    check_mass_finite(loaded, table, n)?;
+    if s.solver.volumetric_smoothing {
+        check_smoothing(loaded)?;
+    }
+    for (i, l) in s.point_loads.iter().enumerate() {
+        r.len(&format!("point_loads[{i}].position"), l.position.len())?;
+        r.len(&format!("point_loads[{i}].force"), l.force.len())?;
+        r.finite(&format!("point_loads[{i}].position"), &l.position, "m")?;
+        r.finite(&format!("point_loads[{i}].force"), &l.force, "N")?;
+    }
+    Ok(())
+}
+
+/// Tractions and traced points.
+pub(super) fn check_tractions_and_traced(r: &Rules) -> Result<(), SceneError> {
+    let (s, n) = (&r.loaded.scene, r.n);
+    for (i, t) in s.tractions.iter().enumerate() {
+        r.len(&format!("tractions[{i}].min"), t.min.len())?;
+        r.len(&format!("tractions[{i}].max"), t.max.len())?;
+        r.len(&format!("tractions[{i}].traction"), t.traction.len())?;
+        r.finite(&format!("tractions[{i}].min"), &t.min, "m")?;
+        r.finite(&format!("tractions[{i}].max"), &t.max, "m")?;
+        r.finite(&format!("tractions[{i}].traction"), &t.traction, "Pa")?;
+        if t.min.iter().zip(&t.max).any(|(lo, hi)| lo > hi) {
+            return r.bad(
+                &format!("tractions[{i}].max"),
+                "every entry must be at least min's".into(),
+            );
+        }
+        if t.increments == Some(0) {
+            return r.bad(&format!("tractions[{i}].increments"), "must be at least 1".into());
+        }
+        if t.increments.is_some() && !s.output.displacements {
+            return r.bad(
+                &format!("tractions[{i}].increments"),
+                "the curve follows the loaded points' displacement: keep them (output.displacements: true)"
+                    .into(),
+            );
+        }
+        if t.surface.axis_side().0 >= n {
+            return r.bad(
+                &format!("tractions[{i}].surface"),
+                format!("{:?} is not a face of a {n}D grid", t.surface),
+            );
+        }
+    }
+    for (i, t) in s.traced.iter().enumerate() {
+        r.len(&format!("traced[{i}].position"), t.position.len())?;
+        r.finite(&format!("traced[{i}].position"), &t.position, "m")?;
+    }
+    Ok(())
+}
+
+/// A scene without load is static as it stands.
+pub(super) fn check_has_load(r: &Rules) -> Result<(), SceneError> {
+    let s = &r.loaded.scene;
+    // A scene without load is static as it stands: K_F and K_E are 0/0 at every step and
+    // there is nothing to solve. Say so rather than run it.
+    let gravity = s
+        .gravity
+        .as_ref()
+        .is_some_and(|g| g.acceleration.iter().any(|&a| a != 0.0));
+    let loads = s.point_loads.iter().any(|l| l.force.iter().any(|&f| f != 0.0))
+        || s.tractions.iter().any(|t| t.traction.iter().any(|&f| f != 0.0));
+    if !gravity && !loads && s.motions.is_empty() {
+        return r.bad(
+            if s.gravity.is_some() {
+                "gravity.acceleration"
+            } else {
+                "gravity"
+            },
+            "the scene applies no load (no gravity, no non-zero point load, no motion): its \
+             static state is the state it starts in; add gravity, point_loads or motions"
+                .into(),
+        );
+    }
+    Ok(())
+}

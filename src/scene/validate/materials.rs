@@ -1,0 +1,91 @@
+//! The materials: each entry's own rules, the mass its density gives, and smoothing only
+//! where the flow rule allows it.
+
+use super::*;
+use crate::error::SceneError;
+use crate::materials::MaterialModel;
+use crate::scene::LoadedScene;
+
+/// Each body's mass (ρ times its bounding box's volume, an upper bound) and the scene's
+/// weight are finite numbers: a density of 1e308 kg/m³ gives points whose mass sums to
+/// infinity, and a gravity of 1e308 m/s² forces that do, and the first step turns them
+/// into NaN.
+pub(super) fn check_mass_finite(
+    loaded: &LoadedScene,
+    table: &[(String, MaterialModel)],
+    n: usize,
+) -> Result<(), SceneError> {
+    let s = &loaded.scene;
+    let mut total = 0.0f64;
+    for body in &s.bodies {
+        let Some((_, model)) = table.iter().find(|(name, _)| *name == body.material) else {
+            continue;
+        };
+        let (lo, hi) = crate::scene::region_bounds(&body.region, n);
+        let volume: f64 = (0..n).map(|a| (hi[a] - lo[a]).abs()).product();
+        let mass = model.density() * volume;
+        total += mass;
+        if !mass.is_finite() || !total.is_finite() {
+            return Err(loaded.invalid(
+                &format!("materials.{}.density", body.material),
+                format!(
+                    "{:e} kg/m³ over the bodies' {volume:e} m{} gives a mass that is not a finite number",
+                    model.density(),
+                    if n == 2 { "² (per metre)" } else { "³" }
+                ),
+            ));
+        }
+    }
+    if let Some(g) = &s.gravity {
+        let size = g.acceleration.iter().fold(0.0f64, |s, a| s.hypot(*a));
+        if !(total * size).is_finite() {
+            return Err(loaded.invalid(
+                "gravity.acceleration",
+                format!("|g| = {size:e} m/s² on {total:e} kg gives a weight that is not a finite number"),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Volumetric smoothing is for isochoric plastic flow (ψ = 0): it is refused on a material
+/// that dilates, in the scene or in a stage. The smoothed strain rate is not work-conjugate
+/// to the nodal forces, and on dilatant flow the mismatch feeds the kinetic energy: a
+/// smooth strip footing on c = 10 kPa, φ = ψ = 30° soil stops at K_E > 10 (docs/verification.md).
+/// Making the forces conjugate (the mean stress projected the same way) is stable there but
+/// spreads a shear band's dilation into the soil around it, which loses confinement: the
+/// limit pressure falls 12 % below Prandtl–Reissner and the footing then sinks without end.
+pub(super) fn check_smoothing(loaded: &LoadedScene) -> Result<(), SceneError> {
+    let s = &loaded.scene;
+    for (name, m) in s.every_material() {
+        let psi = m.dilatancy_angle();
+        if psi > 0.0 {
+            return Err(loaded.invalid(
+                "solver.volumetric_smoothing",
+                format!(
+                    "material \"{name}\" dilates (ψ = {psi}°): volumetric smoothing is for plastic \
+                     flow without volume change (ψ = 0) and makes a run with dilatant flow \
+                     unstable (docs/verification.md); set it false, or ψ = 0"
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Every material, checked by its own scene entry; the models in name order.
+pub(super) fn check_materials(r: &Rules) -> Result<Vec<(String, MaterialModel)>, SceneError> {
+    let (loaded, s) = (r.loaded, &r.loaded.scene);
+    if s.materials.is_empty() {
+        return r.bad("materials", "the scene defines no material".into());
+    }
+    let mut table = Vec::new();
+    for (name, m) in &s.materials {
+        let at = |f: &str| format!("materials.{name}.{f}");
+        let model = m
+            .model(&at)
+            .map_err(|(field, rule)| loaded.invalid(&field, rule))?;
+        table.push((name.clone(), model));
+    }
+    Ok(table)
+}

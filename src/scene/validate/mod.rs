@@ -1,0 +1,221 @@
+//! Rules a scene must satisfy before anything is built or written, and the figures derived
+//! from it. Each part of a scene has its file here and checks itself through [`Rules`],
+//! which names the field and the rule it breaks; [`check`] runs them in order and returns
+//! what set-up needs from them ([`Checked`]: the built materials, each stage's materials,
+//! the time step, the memory bound), so nothing is checked or built twice. A new part of a
+//! scene (a rigid body, a water table) is a new file with its check, one line in [`check`].
+
+mod bodies;
+mod grid;
+mod loads;
+mod materials;
+mod memory;
+mod motions;
+mod solver;
+mod stages;
+
+pub(crate) use memory::carried_state;
+pub use memory::Estimate;
+
+use bodies::check_bodies;
+use grid::check_grid;
+use loads::{check_has_load, check_loads, check_tractions_and_traced};
+use materials::check_materials;
+use memory::check_memory;
+use motions::check_motions_and_analyses;
+use solver::{check_solver, time_step};
+use stages::check_stages;
+
+use super::LoadedScene;
+use crate::error::SceneError;
+use crate::materials::MaterialModel;
+use serde::Serialize;
+
+/// Figures derived from a valid scene (printed by `kdmpm check`).
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct Derived {
+    /// Largest P-wave speed sqrt(M/ρ) over the materials the bodies use (m/s).
+    pub p_wave_speed: f64,
+    /// Critical time step h / c_p (s).
+    pub critical_time_step: f64,
+    /// Time step used (s).
+    pub time_step: f64,
+    /// Material points (load carriers included).
+    pub points: usize,
+    /// Nodes touched by the points at the start.
+    pub active_nodes: usize,
+    /// Grid nodes in all.
+    pub grid_nodes: usize,
+    /// Systems of one step, in order.
+    pub systems: Vec<String>,
+    /// Materials the scene defines but no body uses, in name order. They are validated
+    /// like the others but do not set the time step.
+    pub unused_materials: Vec<String>,
+    /// The memory bound checked before anything was allocated.
+    pub estimate: Estimate,
+}
+
+impl std::fmt::Display for Derived {
+    /// The figures as `kdmpm check` prints them, one a line.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        writeln!(f, "  points                {}", self.points)?;
+        writeln!(
+            f,
+            "  active nodes          {} of {}",
+            self.active_nodes, self.grid_nodes
+        )?;
+        writeln!(f, "  P-wave speed          {:.6} m/s", self.p_wave_speed)?;
+        writeln!(f, "  critical time step    {:.6e} s", self.critical_time_step)?;
+        writeln!(
+            f,
+            "  time step             {:.6e} s (Courant {:.3})",
+            self.time_step,
+            self.time_step / self.critical_time_step
+        )?;
+        writeln!(
+            f,
+            "  memory (bound)        {:.1} MB ({} points, {} nodes at most)",
+            self.estimate.bytes as f64 / 1e6,
+            self.estimate.points,
+            self.estimate.nodes
+        )?;
+        writeln!(f, "  systems               {}", self.systems.join(" → "))?;
+        if !self.unused_materials.is_empty() {
+            writeln!(
+                f,
+                "  unused materials      {} (no body uses them; they do not set the time step)",
+                self.unused_materials.join(", ")
+            )?;
+        }
+        Ok(())
+    }
+}
+
+/// Each stage's materials, built once: the index in the scene's table and the model.
+pub type StageModels = Vec<Vec<(u16, MaterialModel)>>;
+
+/// What [`check`] establishes.
+#[derive(Clone, Debug)]
+pub struct Checked {
+    /// Every material the scene defines, in name order.
+    pub materials: Vec<(String, MaterialModel)>,
+    /// The materials each stage sets (by index in `materials`), in stage order.
+    pub stage_materials: StageModels,
+    /// Largest P-wave speed sqrt(M/ρ) over the materials the bodies use (m/s).
+    pub p_wave_speed: f64,
+    /// Critical time step h / c_p (s).
+    pub critical_time_step: f64,
+    /// Time step to use (s).
+    pub time_step: f64,
+    /// Materials no body uses, in name order.
+    pub unused_materials: Vec<String>,
+    /// What the run will hold in memory, at most.
+    pub estimate: Estimate,
+}
+
+/// Names that label output (columns of `history.csv`, rows of `curve.csv` and
+/// `stages.csv`) are unique within their list: two traced points called "top" would give
+/// two columns of one name.
+fn unique_names(s: &super::Scene) -> Result<(), (String, String)> {
+    let lists: [(&str, Vec<&str>); 5] = [
+        ("traced", s.traced.iter().map(|t| t.name.as_str()).collect()),
+        (
+            "point_loads",
+            s.point_loads.iter().map(|t| t.name.as_str()).collect(),
+        ),
+        ("tractions", s.tractions.iter().map(|t| t.name.as_str()).collect()),
+        ("motions", s.motions.iter().map(|t| t.name.as_str()).collect()),
+        ("stages", s.stages.iter().map(|t| t.name.as_str()).collect()),
+    ];
+    for (field, names) in lists {
+        for (i, name) in names.iter().enumerate() {
+            if let Some(j) = names[..i].iter().position(|m| m == name) {
+                return Err((
+                    format!("{field}[{i}].name"),
+                    format!("\"{name}\" is also the name of {field}[{j}]: each needs its own name"),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// True for a finite number > 0 (NaN fails).
+fn positive(x: f64) -> bool {
+    x > 0.0 && x.is_finite()
+}
+
+/// True for a finite number ≥ 0 (NaN fails).
+fn non_negative(x: f64) -> bool {
+    x >= 0.0 && x.is_finite()
+}
+
+/// The scene and its dimension, for the checks of each part: each names a field and the
+/// rule it breaks through [`Rules::bad`].
+struct Rules<'a> {
+    loaded: &'a LoadedScene,
+    /// 2 or 3.
+    n: usize,
+}
+
+impl Rules<'_> {
+    /// The error for `field`, breaking `rule`.
+    fn bad<T>(&self, field: &str, rule: String) -> Result<T, SceneError> {
+        Err(self.loaded.invalid(field, rule))
+    }
+
+    /// A vector of one entry per axis.
+    fn len(&self, field: &str, v: usize) -> Result<(), SceneError> {
+        let n = self.n;
+        if v != n {
+            return Err(self
+                .loaded
+                .invalid(field, format!("needs {n} entries (dimension {n}), found {v}")));
+        }
+        Ok(())
+    }
+
+    /// Every coordinate, force and acceleration is a finite number: a NaN or infinity in
+    /// the input would reach the state and be written out.
+    fn finite(&self, field: &str, v: &[f64], unit: &str) -> Result<(), SceneError> {
+        match v.iter().position(|x| !x.is_finite()) {
+            Some(k) => Err(self.loaded.invalid(
+                field,
+                format!("entry {k} must be a finite number ({unit}), found {}", v[k]),
+            )),
+            None => Ok(()),
+        }
+    }
+}
+
+/// Checks every rule that does not need the points, part by part.
+pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
+    let s = &loaded.scene;
+    if s.dimension != 2 && s.dimension != 3 {
+        return Err(loaded.invalid("dimension", format!("must be 2 or 3, found {}", s.dimension)));
+    }
+    let r = Rules {
+        loaded,
+        n: s.dimension as usize,
+    };
+    check_grid(&r)?;
+    let table = check_materials(&r)?;
+    check_solver(&r)?;
+    check_bodies(&r)?;
+    check_loads(&r, &table)?;
+    check_motions_and_analyses(&r)?;
+    check_tractions_and_traced(&r)?;
+    check_has_load(&r)?;
+    let step = time_step(&r, &table)?;
+    let stage_materials = check_stages(&r, &table, step.p_wave_speed)?;
+    let estimate = check_memory(&r, &table)?;
+    Ok(Checked {
+        materials: table,
+        stage_materials,
+        p_wave_speed: step.p_wave_speed,
+        critical_time_step: step.critical,
+        time_step: step.dt,
+        unused_materials: step.unused_materials,
+        estimate,
+    })
+}

@@ -1,0 +1,116 @@
+//! Loading stages: each stage's changes, checked against the scene, and its materials
+//! built once.
+
+use super::grid::check_faces;
+use super::*;
+use crate::error::SceneError;
+use crate::materials::MaterialModel;
+
+/// The stages: each material, load, face condition and gravity they set.
+pub(super) fn check_stages(
+    r: &Rules,
+    table: &[(String, MaterialModel)],
+    c_p: f64,
+) -> Result<StageModels, SceneError> {
+    let (loaded, s, n) = (r.loaded, &r.loaded.scene, r.n);
+    let mut built = Vec::with_capacity(s.stages.len());
+    for (k, st) in s.stages.iter().enumerate() {
+        let mut models = Vec::with_capacity(st.materials.len());
+        for (name, spec) in &st.materials {
+            if !s.materials.contains_key(name) {
+                return r.bad(
+                    &format!("stages[{k}].materials"),
+                    format!("\"{name}\" is not a material of the scene: a stage replaces one"),
+                );
+            }
+            let at = |f: &str| format!("stages[{k}].materials.{name}.{f}");
+            let model = spec
+                .model(&at)
+                .map_err(|(field, rule)| loaded.invalid(&field, rule))?;
+            // A point carries one model's state for the whole run.
+            if let Some(carried) = carried_state(loaded, table, name) {
+                if let (Some(a), Some(b)) = (carried.state_name(), model.state_name()) {
+                    if a != b {
+                        return r.bad(
+                            &format!("stages[{k}].materials.{name}"),
+                            format!(
+                                "{} has another internal state than {}, which \"{name}\" takes \
+                                 in the scene or an earlier stage: a stage may change a material \
+                                 to a model with the same state, or with none",
+                                model.name(),
+                                carried.name()
+                            ),
+                        );
+                    }
+                }
+            }
+            let speed = (model.p_wave_modulus() / model.density()).sqrt();
+            if speed > c_p * (1.0 + 1e-12) {
+                return r.bad(
+                    &at("youngs_modulus"),
+                    format!(
+                        "a P-wave speed of {speed:.6} m/s, above the {c_p:.6} m/s that set the time \
+                         step: the explicit scheme would be unstable in this stage; give the \
+                         stiffest stage's material to the scene"
+                    ),
+                );
+            }
+            let id = table.iter().position(|(n, _)| n == name).expect("checked above");
+            models.push((id as u16, model));
+        }
+        built.push(models);
+        for (name, force) in &st.point_loads {
+            if !s.point_loads.iter().any(|l| l.name == *name) {
+                return r.bad(
+                    &format!("stages[{k}].point_loads"),
+                    format!("\"{name}\" is not a point load of the scene"),
+                );
+            }
+            r.len(&format!("stages[{k}].point_loads.{name}"), force.len())?;
+            r.finite(&format!("stages[{k}].point_loads.{name}"), force, "N")?;
+        }
+        for (name, traction) in &st.tractions {
+            let field = format!("stages[{k}].tractions.{name}");
+            match s.tractions.iter().find(|t| t.name == *name) {
+                None => return r.bad(&field, format!("\"{name}\" is not a traction of the scene")),
+                Some(t) if t.increments.is_some() => {
+                    return r.bad(
+                        &field,
+                        "this traction is applied in increments: a stage cannot set it too".into(),
+                    )
+                }
+                Some(_) => {}
+            }
+            r.len(&field, traction.len())?;
+            r.finite(&field, traction, "Pa")?;
+        }
+        if let Some(b) = &st.boundaries {
+            check_faces(b, &format!("stages[{k}].boundaries"), n)
+                .map_err(|(field, rule)| loaded.invalid(&field, rule))?;
+        }
+        if let Some(g) = &st.gravity {
+            if s.gravity.is_none() {
+                return r.bad(
+                    &format!("stages[{k}].gravity"),
+                    "the scene has no gravity: give it one (even [0, 0]) for a stage to change".into(),
+                );
+            }
+            r.len(&format!("stages[{k}].gravity.acceleration"), g.acceleration.len())?;
+            r.finite(
+                &format!("stages[{k}].gravity.acceleration"),
+                &g.acceleration,
+                "m/s²",
+            )?;
+            if !non_negative(g.ramp_time) {
+                return r.bad(&format!("stages[{k}].gravity.ramp_time"), "must be ≥ 0 s".into());
+            }
+        }
+        if st.reset_displacements && !s.output.displacements {
+            return r.bad(
+                &format!("stages[{k}].reset_displacements"),
+                "needs the displacements kept (output.displacements: true)".into(),
+            );
+        }
+    }
+    Ok(built)
+}

@@ -1,0 +1,66 @@
+//! Two sums a node, scattered from the points through the shape functions: the numerator
+//! and denominator of a weighted nodal average (volumetric smoothing), or a weighted sum
+//! and a maximum (mass scaling). Shared by the systems that need such a field for one step.
+
+use crate::components::Position;
+use crate::dim::Dim;
+use crate::grid::{Grid, NodeBox};
+use crate::parallel::{fill_box, for_each_box_node, scatter, Disjoint, SlabCache};
+use crate::shape::{for_each_node, Shape};
+
+/// Per node a pair `[f64; 2]`, zero outside the box the points reached since the last
+/// [`NodePairs::clear`], so a step pays only for the nodes in use.
+#[derive(Debug, Default)]
+pub(crate) struct NodePairs {
+    sums: Vec<[f64; 2]>,
+    active: NodeBox,
+}
+
+impl NodePairs {
+    /// Adds the points at `x` (a column of one archetype): for each point p its value
+    /// `value(p)`, computed once, goes into every node i it reaches with weight w_ip
+    /// through `add(pair_i, w_ip, &value)`. Deterministic: the scatter's slabs fix each
+    /// node's order of contributions.
+    pub(crate) fn scatter<D: Dim, S: Shape, V>(
+        &mut self,
+        slabs: &mut SlabCache,
+        grid: &Grid<D>,
+        x: &[Position<D::Vec>],
+        value: impl Fn(usize) -> V + Sync,
+        add: impl Fn(&mut [f64; 2], f64, &V) + Sync,
+    ) {
+        self.sums.resize(grid.node_count(), [0.0; 2]);
+        let reached = scatter(
+            slabs.slabs(grid, x),
+            grid,
+            S::SUPPORT,
+            &Disjoint::new(&mut self.sums),
+            |points, sums, lo| {
+                for &p in points {
+                    let p = p as usize;
+                    let v = value(p);
+                    for_each_node::<D, S>(grid, x[p].0, |i, w, _| add(&mut sums[i - lo], w, &v));
+                }
+            },
+        );
+        self.active = self.active.union(reached);
+    }
+
+    /// Replaces the pair of every node the points reached by `f(pair)`.
+    pub(crate) fn map<D: Dim>(&mut self, grid: &Grid<D>, f: impl Fn([f64; 2]) -> [f64; 2] + Sync) {
+        for_each_box_node(grid, self.active, &Disjoint::new(&mut self.sums), |_, k, sums| {
+            sums[k] = f(sums[k]);
+        });
+    }
+
+    /// The pairs, by node index.
+    pub(crate) fn pairs(&self) -> &[[f64; 2]] {
+        &self.sums
+    }
+
+    /// Zeroes the nodes the points reached, for the next step.
+    pub(crate) fn clear<D: Dim>(&mut self, grid: &Grid<D>) {
+        fill_box(grid, self.active, &mut self.sums, [0.0; 2]);
+        self.active = NodeBox::default();
+    }
+}
