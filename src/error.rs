@@ -3,6 +3,32 @@
 use std::path::PathBuf;
 use thiserror::Error;
 
+/// How a command ended, as a process reports it in its exit status.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Ending {
+    /// It did what was asked (0).
+    Done,
+    /// A run or an analysis went wrong while stepping or writing (1).
+    Failed,
+    /// The input cannot be used: a scene, a study, a checkpoint, an output directory (2).
+    BadInput,
+    /// Stopped by a signal, with everything written so far whole (130, as a shell reports
+    /// SIGINT).
+    Interrupted,
+}
+
+impl Ending {
+    /// The exit status: 0, 1, 2 or 130.
+    pub fn code(self) -> u8 {
+        match self {
+            Ending::Done => 0,
+            Ending::Failed => 1,
+            Ending::BadInput => 2,
+            Ending::Interrupted => crate::interrupt::INTERRUPTED_EXIT,
+        }
+    }
+}
+
 /// A scene that cannot be read, parsed or accepted.
 #[derive(Debug, Error)]
 pub enum SceneError {

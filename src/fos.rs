@@ -14,7 +14,7 @@
 //! `factor_of_safety` and its `bracket`. The failure mechanism is the displacement field of
 //! the trial at the smallest failing F (`mechanism`).
 
-use crate::error::SceneError;
+use crate::error::{Ending, SceneError};
 use crate::output::dir::write_atomic;
 use crate::output::{Outcome, OutputDir};
 use crate::run::{DisplacementLimit, Run, RunError};
@@ -97,6 +97,9 @@ pub enum FosError {
     /// The output directory cannot be used (exit 2).
     #[error("{0}")]
     OutputDir(String),
+    /// The trial at this factor could not be run (its directory, its results).
+    #[error("the trial at F = {0}: {1}")]
+    Trial(f64, RunError),
     /// The output could not be written.
     #[error("cannot write into {0}: {1}")]
     Output(PathBuf, std::io::Error),
@@ -117,13 +120,15 @@ impl FosReport {
 }
 
 impl FosError {
-    /// True for input that cannot be used (the scene, the output directory), false for an
-    /// analysis that went wrong: the binary's exit codes 2 and 1.
-    pub fn is_bad_input(&self) -> bool {
-        matches!(
-            self,
-            FosError::Scene(_) | FosError::NotAnAnalysis(_) | FosError::OutputDir(_)
-        )
+    /// Bad input (the scene, the output directory), an interrupted analysis, or one that
+    /// went wrong.
+    pub fn ending(&self) -> Ending {
+        match self {
+            FosError::Scene(_) | FosError::NotAnAnalysis(_) | FosError::OutputDir(_) => Ending::BadInput,
+            FosError::Trial(_, e) => e.ending(),
+            FosError::Interrupted(_) => Ending::Interrupted,
+            FosError::NotBracketed(_) | FosError::Output(..) => Ending::Failed,
+        }
     }
 }
 
@@ -251,7 +256,7 @@ fn run_trial(
         .go()
         .map_err(|e| match e {
             RunError::Scene(e) => FosError::Scene(e),
-            e => FosError::Output(path.clone(), std::io::Error::other(e.to_string())),
+            e => FosError::Trial(factor, e),
         })?;
     let s = report.summary;
     let max_u = s.max_displacement.unwrap_or(0.0);

@@ -5,8 +5,8 @@
 //! run that went wrong with 1, an interrupted one with 130.
 
 use clap::{Parser, Subcommand};
+use kdmpm::error::Ending;
 use kdmpm::infra::comm::Comm;
-use kdmpm::interrupt::INTERRUPTED_EXIT;
 use kdmpm::output::{Outcome, OutputDir};
 use kdmpm::run::{Run, RunError, RunReport};
 use kdmpm::scene::{build, LoadedScene};
@@ -123,68 +123,92 @@ enum Command {
     },
 }
 
-/// Exit code for a scene or output directory that cannot be used.
-const BAD_INPUT: u8 = 2;
-/// Exit code for a run stopped by an error while stepping.
-const RUN_FAILED: u8 = 1;
-
 fn main() -> ExitCode {
     let cli = Cli::parse();
     // MPI starts before any thread pool; without `mpirun` (or the `mpi` feature) this is
     // one rank.
     let comm = match Comm::world() {
         Ok(c) => Arc::new(c),
-        Err(e) => return fail(&e, BAD_INPUT),
+        Err(e) => return Fault::bad(e).report(),
     };
-    if comm.size() > 1 && !matches!(cli.command, Command::Run { .. }) {
-        let only = "only `kdmpm run` is split across ranks: start the other commands without mpirun";
-        return match comm.is_root() {
-            true => fail(
-                &format!("kdmpm was started on {} ranks; {only}", comm.size()),
-                BAD_INPUT,
-            ),
-            false => ExitCode::from(BAD_INPUT),
-        };
+    match command(cli.command, &comm) {
+        Ok(code) => code,
+        // Over several ranks, bad input is alike on every rank: rank 0 prints it.
+        Err(f) if f.1 == Ending::BadInput && !comm.is_root() => ExitCode::from(f.1.code()),
+        Err(f) => f.report(),
+    }
+}
+
+/// An error message and how the command ends with it.
+struct Fault(String, Ending);
+
+impl Fault {
+    /// Input that cannot be used.
+    fn bad(e: impl std::fmt::Display) -> Fault {
+        Fault(e.to_string(), Ending::BadInput)
+    }
+
+    /// Prints `error: {message}` and ends.
+    fn report(self) -> ExitCode {
+        eprintln!("error: {}", self.0);
+        ExitCode::from(self.1.code())
+    }
+}
+
+/// Sets up the process for the command (signals, trace, threads) and runs it.
+fn command(command: Command, comm: &Arc<Comm>) -> Result<ExitCode, Fault> {
+    if comm.size() > 1 && !matches!(command, Command::Run { .. }) {
+        return Err(Fault::bad(format!(
+            "kdmpm was started on {} ranks; only `kdmpm run` is split across ranks: start the \
+             other commands without mpirun",
+            comm.size()
+        )));
     }
     // Over several ranks a signal is mpirun's to pass on (a checkpoint would be rank 0's
     // alone).
     if comm.size() == 1 {
         kdmpm::interrupt::catch_signals();
     }
-    let (threads, trace) = match &cli.command {
+    let (threads, trace) = match &command {
         Command::Run { stepping, trace, .. } => (stepping.workers.threads, trace.clone()),
         Command::Resume { stepping, .. } => (stepping.workers.threads, None),
         Command::Fos { workers, .. } => (workers.threads, None),
         _ => (None, None),
     };
-    // The trace's guard flushes the file when main returns.
-    let _trace = match trace.map(kdmpm::infra::trace::start).transpose() {
-        Ok(guard) => guard,
-        Err(message) => return fail(&message, BAD_INPUT),
-    };
+    // The trace's guard flushes the file when the command returns.
+    let _trace = trace
+        .map(kdmpm::infra::trace::start)
+        .transpose()
+        .map_err(Fault::bad)?;
     if let Some(n) = threads {
-        if let Err(e) = rayon::ThreadPoolBuilder::new()
-            .num_threads(n.get())
-            .build_global()
-        {
-            return fail(&format!("cannot start {n} threads: {e}"), BAD_INPUT);
-        }
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(n.get());
+        pool.build_global()
+            .map_err(|e| Fault::bad(format!("cannot start {n} threads: {e}")))?;
     }
-    match cli.command {
-        Command::Check { scene, overrides } => check(&scene, &overrides),
-        Command::Plot { dir } => plot(&dir),
-        Command::Study { study, out, workers } => run_study(&study, out, workers),
+    match command {
+        Command::Check { scene, overrides } => {
+            let (_, derived) = LoadedScene::from_file(&scene, &overrides)
+                .and_then(|l| build(&l))
+                .map_err(Fault::bad)?;
+            print!("{}: valid\n{derived}", scene.display());
+        }
+        Command::Plot { dir } => {
+            let (written, skipped) = kdmpm::output::plots::draw(&dir)
+                .map_err(|e| Fault::bad(format!("cannot plot {}: {e}", dir.display())))?;
+            written.iter().for_each(|w| println!("{}", dir.join(w).display()));
+            skipped.iter().for_each(|s| eprintln!("  not drawn: {s}"));
+        }
+        Command::Study { study, out, workers } => run_study(&study, out, workers)?,
         Command::Fos {
             scene,
             out,
             overrides,
             workers,
-        } => run_fos(&scene, out, &overrides, workers.quiet),
-        Command::Resume { dir, stepping } => report(
-            Run::resume(dir).quiet(stepping.workers.quiet).go(),
-            stepping,
-            &comm,
-        ),
+        } => run_fos(&scene, out, &overrides, workers.quiet)?,
+        Command::Resume { dir, stepping } => {
+            let run = Run::resume(dir).quiet(stepping.workers.quiet).go();
+            return report(run, stepping, comm);
+        }
         Command::Run {
             scene,
             out,
@@ -193,24 +217,12 @@ fn main() -> ExitCode {
             ..
         } => {
             let out = out.unwrap_or_else(|| default_out(&scene, "", "scene"));
-            let run = LoadedScene::from_file(&scene, &overrides)
-                .map_err(RunError::from)
-                .and_then(|l| {
-                    Run::scene(l)
-                        .into_dir(out)
-                        .quiet(stepping.workers.quiet)
-                        .over(comm.clone())
-                        .go()
-                });
-            report(run, stepping, &comm)
+            let loaded = LoadedScene::from_file(&scene, &overrides).map_err(Fault::bad)?;
+            let run = Run::scene(loaded).into_dir(out).quiet(stepping.workers.quiet);
+            return report(run.over(comm.clone()).go(), stepping, comm);
         }
     }
-}
-
-/// Prints `error: {message}` and returns `code`.
-fn fail(message: &dyn std::fmt::Display, code: u8) -> ExitCode {
-    eprintln!("error: {message}");
-    ExitCode::from(code)
+    Ok(ExitCode::SUCCESS)
 }
 
 /// The output directory when none is given: `out/<prefix><file stem>` (`fallback` for a
@@ -222,47 +234,15 @@ fn default_out(path: &Path, prefix: &str, fallback: &str) -> PathBuf {
     Path::new("out").join(format!("{prefix}{stem}"))
 }
 
-/// `kdmpm check`: validates a scene and prints what it derives.
-fn check(path: &Path, overrides: &[String]) -> ExitCode {
-    match LoadedScene::from_file(path, overrides).and_then(|l| build(&l)) {
-        Ok((_, derived)) => {
-            print!("{}: valid\n{derived}", path.display());
-            ExitCode::SUCCESS
-        }
-        Err(e) => fail(&e, BAD_INPUT),
-    }
-}
-
-/// `kdmpm plot`: draws the plots of a run directory again.
-fn plot(dir: &Path) -> ExitCode {
-    match kdmpm::output::plots::draw(dir) {
-        Ok((written, skipped)) => {
-            written.iter().for_each(|w| println!("{}", dir.join(w).display()));
-            skipped.iter().for_each(|s| eprintln!("  not drawn: {s}"));
-            ExitCode::SUCCESS
-        }
-        Err(e) => fail(&format!("cannot plot {}: {e}", dir.display()), BAD_INPUT),
-    }
-}
-
 /// Reports a run (`run`, `resume`) as the user asked: the profile, the error with what the
-/// outputs left out, or the last line. Over several ranks, rank 0 reports bad input (every
-/// rank finds the same) and the run, each other rank its own failure.
-fn report(run: Result<RunReport, RunError>, stepping: Stepping, comm: &Comm) -> ExitCode {
+/// outputs left out, or the last line. Over several ranks rank 0 reports the run, each
+/// other rank its own failure.
+fn report(run: Result<RunReport, RunError>, stepping: Stepping, comm: &Comm) -> Result<ExitCode, Fault> {
     let rank = match comm.is_root() {
         true => String::new(),
         false => format!("rank {}: ", comm.rank()),
     };
-    let r = match run {
-        Err(e) if e.is_bad_input() && !comm.is_root() => return ExitCode::from(BAD_INPUT),
-        Err(e) => {
-            return fail(
-                &format_args!("{rank}{e}"),
-                if e.is_bad_input() { BAD_INPUT } else { RUN_FAILED },
-            )
-        }
-        Ok(r) => r,
-    };
+    let r = run.map_err(|e| Fault(format!("{rank}{e}"), e.ending()))?;
     if stepping.profile && comm.is_root() {
         print!("{}", r.summary.profile_table());
     }
@@ -271,67 +251,54 @@ fn report(run: Result<RunReport, RunError>, stepping: Stepping, comm: &Comm) -> 
         if comm.is_root() {
             r.notes.iter().for_each(|n| eprintln!("  {n}"));
         }
-        return ExitCode::from(RUN_FAILED);
+        return Ok(ExitCode::from(Ending::Failed.code()));
     }
     let interrupted = r.summary.outcome == Outcome::Interrupted;
     if comm.is_root() && (!stepping.workers.quiet || interrupted) {
         eprintln!("{}", r.describe());
     }
-    ExitCode::from(if interrupted { INTERRUPTED_EXIT } else { 0 })
+    Ok(ExitCode::from(
+        if interrupted {
+            Ending::Interrupted
+        } else {
+            Ending::Done
+        }
+        .code(),
+    ))
 }
 
 /// `kdmpm fos`: the strength-reduction analysis of a scene.
-fn run_fos(path: &Path, out: Option<PathBuf>, overrides: &[String], quiet: bool) -> ExitCode {
-    let loaded = match LoadedScene::from_file(path, overrides) {
-        Ok(l) => l,
-        Err(e) => return fail(&e, BAD_INPUT),
-    };
+fn run_fos(path: &Path, out: Option<PathBuf>, overrides: &[String], quiet: bool) -> Result<(), Fault> {
+    let loaded = LoadedScene::from_file(path, overrides).map_err(Fault::bad)?;
     let out = out.unwrap_or_else(|| default_out(path, "fos-", "scene"));
     let show = |t: &kdmpm::fos::Trial| {
         if !quiet {
             eprintln!("{}", t.describe());
         }
     };
-    match kdmpm::fos::strength_reduction(&loaded, &out, show) {
-        Ok(r) => {
-            println!("{} → {}", r.describe(), out.display());
-            ExitCode::SUCCESS
-        }
-        Err(e @ kdmpm::fos::FosError::Interrupted(_)) => fail(&e, INTERRUPTED_EXIT),
-        Err(e) => fail(&e, if e.is_bad_input() { BAD_INPUT } else { RUN_FAILED }),
-    }
+    let r =
+        kdmpm::fos::strength_reduction(&loaded, &out, show).map_err(|e| Fault(e.to_string(), e.ending()))?;
+    println!("{} → {}", r.describe(), out.display());
+    Ok(())
 }
 
 /// `kdmpm study`: plans and checks every run, then has the library conduct the study.
-fn run_study(path: &Path, out: Option<PathBuf>, workers: Workers) -> ExitCode {
-    use kdmpm::study::{self, Launch, Study, StudyError};
-    let study = match Study::from_file(path) {
-        Ok(s) => s,
-        Err(e) => return fail(&e, BAD_INPUT),
-    };
+fn run_study(path: &Path, out: Option<PathBuf>, workers: Workers) -> Result<(), Fault> {
+    use kdmpm::study::{conduct, Launch, Study};
+    let study = Study::from_file(path).map_err(Fault::bad)?;
     let out = out.unwrap_or_else(|| default_out(path, "study-", "study"));
-    let dir = match OutputDir::claim(&out) {
-        Ok(d) => d,
-        Err(e) => return fail(&e, BAD_INPUT),
-    };
-    let exe = match std::env::current_exe() {
-        Ok(exe) => exe,
-        Err(e) => {
-            return fail(
-                &format!("cannot find the kdmpm executable to launch runs: {e}"),
-                RUN_FAILED,
-            )
-        }
-    };
+    let dir = OutputDir::claim(&out).map_err(Fault::bad)?;
+    let exe = std::env::current_exe().map_err(|e| {
+        Fault(
+            format!("cannot find kdmpm to launch the runs: {e}"),
+            Ending::Failed,
+        )
+    })?;
     let threads = workers.threads.map(|n| n.get());
-    match study::conduct(&study, &dir, &Launch { exe, threads }, workers.quiet) {
-        Ok(results) => {
-            if !workers.quiet {
-                println!("{}→ {}", results.describe(&study), dir.path().display());
-            }
-            ExitCode::SUCCESS
-        }
-        Err(e @ StudyError::Interrupted(_)) => fail(&e, INTERRUPTED_EXIT),
-        Err(e) => fail(&e, RUN_FAILED),
+    let results = conduct(&study, &dir, &Launch { exe, threads }, workers.quiet)
+        .map_err(|e| Fault(e.to_string(), e.ending()))?;
+    if !workers.quiet {
+        println!("{}→ {}", results.describe(&study), dir.path().display());
     }
+    Ok(())
 }

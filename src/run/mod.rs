@@ -35,7 +35,7 @@ pub use hooks::DisplacementLimit;
 
 use crate::checkpoint::{self, CheckpointError};
 use crate::dim::Dim;
-use crate::error::{SceneError, StepError};
+use crate::error::{Ending, SceneError, StepError};
 use crate::infra::comm::Comm;
 use crate::interrupt::StopSignal;
 use crate::output::{Outcome, OutputDir, Progress, Recorder, Summary};
@@ -99,10 +99,13 @@ pub enum RunError {
 }
 
 impl RunError {
-    /// True for input that cannot be used (a scene, a checkpoint, an output directory),
-    /// false for a run that went wrong: the binary's exit codes 2 and 1.
-    pub fn is_bad_input(&self) -> bool {
-        !matches!(self, RunError::Results(_))
+    /// Bad input (a scene, a checkpoint, an output directory, a split over ranks) or a run
+    /// that went wrong (its results could not be written).
+    pub fn ending(&self) -> Ending {
+        match self {
+            RunError::Results(_) => Ending::Failed,
+            _ => Ending::BadInput,
+        }
     }
 }
 

@@ -53,11 +53,10 @@ pub(super) fn go<D: Dim>(
     let start = Instant::now();
     let result = sim.run(|_| {});
     // A state with a non-finite value comes with the run's error, reported with it.
-    let written = watch
+    let unwritten = watch
         .out
         .as_deref()
-        .map(|out| write_final_points(sim, out))
-        .transpose();
+        .and_then(|out| Some((out, write_final_points(sim, out).err()?)));
     // The summary's figures are collectives: this rank takes part, rank 0 writes them.
     let error = result.err();
     let summary = Summary::collect(
@@ -66,11 +65,11 @@ pub(super) fn go<D: Dim>(
         start.elapsed().as_secs_f64(),
         error.as_ref().map(|e| e.to_string()),
     );
-    if let (None, Err(e)) = (&error, written) {
+    if let (None, Some((out, e))) = (&error, unwritten) {
         return Err(RunError::Results(format!(
             "rank {}: cannot write its points into {}: {e}",
             comm.rank(),
-            watch.out.as_deref().unwrap_or_else(|| ".".as_ref()).display()
+            out.display()
         )));
     }
     Ok(RunReport {

@@ -1,8 +1,8 @@
 //! Building a simulation from a valid scene: grid nodes, material points, loads, tracing
 //! and the schedule. Only what the scene uses is created.
 
-use super::validate::{self, carried_state, Checked, Derived, StageModels};
-use super::{pad3, BoundarySpec, Condition, LoadedScene, Region, Scene};
+use super::validate::{self, carried_state, Checked, CheckedGrid, CheckedStage, Derived, FaceHold};
+use super::{pad3, LoadedScene, Region, Scene};
 use crate::components::*;
 use crate::context::Context;
 use crate::dim::{Dim, Dim2, Dim3, Vector};
@@ -183,94 +183,30 @@ impl<I: Iterator> Iterator for Counted<I> {
 impl<I: Iterator> ExactSizeIterator for Counted<I> {}
 
 /// The held axes of every node under the face conditions `boundaries`.
-fn face_fixity<D: Dim>(grid: &Grid<D>, boundaries: &[BoundarySpec]) -> Vec<NodeFixity> {
+fn face_fixity<D: Dim>(grid: &Grid<D>, faces: &[FaceHold]) -> Vec<NodeFixity> {
     let mut fixity = vec![NodeFixity(0); grid.node_count()];
-    for bc in boundaries {
-        let (axis, upper) = bc.face.axis_side();
-        let mask = match bc.condition {
-            Condition::Fixed => (1u8 << D::N) - 1,
-            Condition::Roller => 1u8 << axis,
-        };
-        let layer = if upper { grid.axes[axis].cells } else { 0 };
+    for face in faces {
+        let layer = if face.upper { grid.axes[face.axis].cells } else { 0 };
         for (id, f) in fixity.iter_mut().enumerate() {
-            if grid.node_ijk(id)[axis] == layer {
-                f.0 |= mask;
+            if grid.node_ijk(id)[face.axis] == layer {
+                f.0 |= face.mask;
             }
         }
     }
     fixity
 }
 
-/// Every motion's box holds grid nodes that the body touches at the start, and no node is
-/// in two boxes: a box of nodes the body never reaches pushes nothing (a curve of zero
-/// forces), and a node two motions claim is driven by the later one only.
-fn check_motion_boxes<D: Dim>(
-    loaded: &LoadedScene,
-    grid: &Grid<D>,
-    touched: &[bool],
-) -> Result<(), SceneError> {
-    let motions = &loaded.scene.motions;
-    if motions.is_empty() {
-        return Ok(());
-    }
-    let mut owner: Vec<Option<usize>> = vec![None; grid.node_count()];
-    for (k, m) in motions.iter().enumerate() {
-        let (mut inside, mut loaded_nodes) = (0usize, 0usize);
-        for (id, o) in owner.iter_mut().enumerate() {
-            let x = D::vec_to3(grid.node_position(grid.node_ijk(id)));
-            if !crate::systems::prescribed_motion::in_box(m, x, D::N, grid.cell_size) {
-                continue;
-            }
-            if let Some(j) = *o {
-                return Err(loaded.invalid(
-                    &format!("motions[{k}].min"),
-                    format!(
-                        "the box shares the node at {:?} with motions[{j}] (\"{}\"): a node has one \
-                         motion; give the motions boxes apart",
-                        &x[..D::N],
-                        motions[j].name
-                    ),
-                ));
-            }
-            *o = Some(k);
-            inside += 1;
-            loaded_nodes += usize::from(touched[id]);
-        }
-        if inside == 0 {
-            return Err(loaded.invalid(
-                &format!("motions[{k}].min"),
-                format!(
-                    "the box {:?}..{:?} holds no grid node (nodes lie every {} m from the grid's \
-                     origin): the motion would drive nothing",
-                    m.min, m.max, grid.cell_size
-                ),
-            ));
-        }
-        if loaded_nodes == 0 {
-            return Err(loaded.invalid(
-                &format!("motions[{k}].min"),
-                format!(
-                    "none of the box's {inside} nodes touches the body at the start: grid nodes \
-                     do not move, so the motion would push nothing and report zero force; put the \
-                     box on the body's surface"
-                ),
-            ));
-        }
-    }
-    Ok(())
-}
-
-/// The scene's stages with the materials the check built (`stage_materials`) and their
+/// The scene's stages with what the check built (`checked`: materials and faces) and their
 /// loads by carrier id (`load_ids`).
 fn stages<D: Dim>(
     grid: &Grid<D>,
     loaded: &LoadedScene,
-    stage_materials: StageModels,
+    checked: Vec<CheckedStage>,
     load_ids: &[(String, u32)],
     shares: &[(String, Vec<(u32, f64)>)],
 ) -> Vec<LoadStage> {
     let mut out = Vec::new();
-    for (st, materials) in loaded.scene.stages.iter().zip(stage_materials) {
+    for (st, CheckedStage { materials, faces }) in loaded.scene.stages.iter().zip(checked) {
         let mut loads: Vec<(u32, [f64; 3])> = st
             .point_loads
             .iter()
@@ -290,10 +226,7 @@ fn stages<D: Dim>(
             start: 0.0,
         });
         out.push(LoadStage {
-            fixity: st
-                .boundaries
-                .as_ref()
-                .map(|b| face_fixity(grid, b).into_iter().map(|f| f.0).collect()),
+            fixity: faces.map(|f| face_fixity(grid, &f).into_iter().map(|f| f.0).collect()),
             gravity,
             name: st.name.clone(),
             materials,
@@ -306,8 +239,9 @@ fn stages<D: Dim>(
 
 fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulation<D>, Derived), SceneError> {
     let Checked {
+        grid: checked_grid,
         materials: table,
-        stage_materials,
+        stages: checked_stages,
         p_wave_speed: c_p,
         critical_time_step: dt_crit,
         time_step: dt,
@@ -315,16 +249,16 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         estimate,
     } = checked;
     let s: &Scene = &loaded.scene;
-    let grid = new_grid::<D>(s);
+    let grid = new_grid::<D>(&checked_grid);
     let mut world = World::new();
-    spawn_nodes(&mut world, &grid, &s.boundaries);
+    spawn_nodes(&mut world, &grid, &checked_grid.faces);
     let Bodies {
         ids: body_ids,
         next_id,
         full_node_mass,
     } = spawn_bodies(loaded, &grid, &table, &mut world)?;
     let touched = touched_nodes(&world, &grid, s.shape);
-    check_motion_boxes(loaded, &grid, &touched)?;
+    validate::check_motion_boxes(loaded, &grid, &touched)?;
     let (load_ids, _) = spawn_point_loads(loaded, &grid, &mut world, &touched, next_id)?;
     let placed = super::tractions::place::<D>(&mut world, loaded, &body_ids)?;
 
@@ -361,7 +295,7 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         }),
         min_node_mass: s.solver.node_mass_cutoff * full_node_mass,
         motions: s.motions.clone(),
-        stages: stages(&grid, loaded, stage_materials, &load_ids, &placed.shares),
+        stages: stages(&grid, loaded, checked_stages, &load_ids, &placed.shares),
         load_steps: placed.steps,
         virtual_mass_floor: s.solver.virtual_mass_floor * full_node_mass,
     };
@@ -423,24 +357,18 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
     ))
 }
 
-/// The scene's grid; with uniform GIMP a point's box is its share of a cell, the same for
-/// every body (validation), 1/(2n) cell along an axis with n points a side.
-fn new_grid<D: Dim>(s: &Scene) -> Grid<D> {
-    let n = D::N;
-    let mut cells = [0usize; 3];
-    cells[..n].copy_from_slice(&s.grid.cells);
-    let mut grid = Grid::<D>::new(D::vec_from(pad3(&s.grid.origin)), s.grid.cell_size, cells);
-    if let Some(b) = s.bodies.first() {
-        for (axis, &per) in grid.axes.iter_mut().zip(&b.points_per_cell) {
-            axis.particle_half_width = 0.5 / per as f64;
-        }
+/// The checked grid, with each axis's point half-width (uniform GIMP).
+fn new_grid<D: Dim>(checked: &CheckedGrid) -> Grid<D> {
+    let mut grid = Grid::<D>::new(D::vec_from(checked.origin), checked.cell_size, checked.cells);
+    for (axis, &w) in grid.axes.iter_mut().zip(&checked.half_width) {
+        axis.particle_half_width = w;
     }
     grid
 }
 
 /// Spawns the grid's nodes, one archetype, in id order, held by the face conditions.
-fn spawn_nodes<D: Dim>(world: &mut World, grid: &Grid<D>, boundaries: &[BoundarySpec]) {
-    let fixity = face_fixity(grid, boundaries);
+fn spawn_nodes<D: Dim>(world: &mut World, grid: &Grid<D>, faces: &[FaceHold]) {
+    let fixity = face_fixity(grid, faces);
     let z = D::Vec::ZERO;
     world.spawn_batch(fixity.into_iter().map(|f| {
         (

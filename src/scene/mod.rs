@@ -11,7 +11,7 @@ mod validate;
 pub use crate::materials::MaterialSpec;
 pub use build::build;
 use build::{cell_span, region_bounds};
-pub use validate::{check, Checked, Derived, Estimate, StageModels};
+pub use validate::{check, Checked, CheckedGrid, CheckedStage, Derived, Estimate, FaceHold};
 
 use crate::error::SceneError;
 use crate::grid::Face;

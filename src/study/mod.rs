@@ -52,6 +52,17 @@ pub enum StudyError {
     Interrupted(String),
 }
 
+impl StudyError {
+    /// An interrupted study, or one that went wrong (its bad input is refused before it
+    /// starts, as a [`crate::error::SceneError`] from [`Study::from_file`]).
+    pub fn ending(&self) -> crate::error::Ending {
+        match self {
+            StudyError::Interrupted(_) => crate::error::Ending::Interrupted,
+            StudyError::Output(_) | StudyError::Reference(_) => crate::error::Ending::Failed,
+        }
+    }
+}
+
 /// Refuses a reference run that did not converge: it ended at its step or time limit, or
 /// failed, so its figures are not the static answer the other runs are compared with.
 pub fn check_reference(reference: &Finished) -> Result<(), StudyError> {

@@ -204,16 +204,36 @@ const INTEGRATED: &str = "points move with the integrated velocity";
 /// the order rules and the list in docs/writing-a-system.md all come from here: a new
 /// system is one entry. `S` is the scene's shape function.
 pub fn registry<D: Dim, S: Shape>() -> Vec<Entry<D>> {
-    use Stage as St;
-    use When::*;
-    let e = |name, stage, when, after, does, build| Entry {
+    let mut all = mapping::<D, S>();
+    all.extend(straining::<D, S>());
+    all.extend(loading::<D, S>());
+    all.extend(relaxing::<D, S>());
+    all
+}
+
+/// One registry entry.
+fn e<D: Dim>(
+    name: &'static str,
+    stage: Stage,
+    when: When,
+    after: &'static [(&'static str, &'static str)],
+    does: &'static str,
+    build: fn(&Settings) -> Box<dyn System<D>>,
+) -> Entry<D> {
+    Entry {
         name,
         stage,
         when,
         after,
         does,
         build,
-    };
+    }
+}
+
+/// From the points to the grid: reset, sort, map, nodal velocity.
+fn mapping<D: Dim, S: Shape>() -> Vec<Entry<D>> {
+    use Stage as St;
+    use When::*;
     vec![
         e(
             "grid_reset",
@@ -255,6 +275,14 @@ pub fn registry<D: Dim, S: Shape>() -> Vec<Entry<D>> {
             "USF: nodal velocity from momentum",
             |_| Box::new(NodalVelocity),
         ),
+    ]
+}
+
+/// The points' strain, stress and volume (and USF's internal force).
+fn straining<D: Dim, S: Shape>() -> Vec<Entry<D>> {
+    use Stage as St;
+    use When::*;
+    vec![
         e(
             "kinematics",
             St::Strain,
@@ -317,6 +345,14 @@ pub fn registry<D: Dim, S: Shape>() -> Vec<Entry<D>> {
             "USF: internal force of the updated stress",
             |_| Box::new(P2g::<D, S>::new(P2gPart::InternalForce)),
         ),
+    ]
+}
+
+/// External forces, the held components, integration and back to the points.
+fn loading<D: Dim, S: Shape>() -> Vec<Entry<D>> {
+    use Stage as St;
+    use When::*;
+    vec![
         e(
             "gravity",
             St::Forces,
@@ -382,6 +418,14 @@ pub fn registry<D: Dim, S: Shape>() -> Vec<Entry<D>> {
             "point velocities, kinetic energy",
             |_| Box::new(G2p::<D, S>::default()),
         ),
+    ]
+}
+
+/// Kinetic damping, the MUSL remap, USF's motion, the stopping rule and control.
+fn relaxing<D: Dim, S: Shape>() -> Vec<Entry<D>> {
+    use Stage as St;
+    use When::*;
+    vec![
         e(
             "peak_watch",
             St::Damp,

@@ -2,12 +2,46 @@
 
 use super::*;
 use crate::error::SceneError;
-use crate::scene::BoundarySpec;
+use crate::scene::{pad3, BoundarySpec, Condition};
 use crate::shape::ShapeKind;
 
+/// The grid as set-up builds it, checked.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CheckedGrid {
+    /// The grid's lower corner (m), padded to three axes with zeros.
+    pub origin: [f64; 3],
+    /// Cell size h (m).
+    pub cell_size: f64,
+    /// Cells per axis (0 on the axis a 2D grid does not have).
+    pub cells: [usize; 3],
+    /// Half the width of a point's box per axis, in cells (uniform GIMP): 1/(2n) with n
+    /// points a cell side in the first body (uniform GIMP requires the same in all); 1/4
+    /// (two a side) where the scene has no body.
+    pub half_width: [f64; 3],
+    /// The scene's face conditions.
+    pub faces: Vec<FaceHold>,
+}
+
+/// One face condition, as the nodes on that face carry it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct FaceHold {
+    /// The face's normal axis.
+    pub axis: usize,
+    /// The upper face (x = max) rather than the lower (x = origin).
+    pub upper: bool,
+    /// The held velocity components, one bit an axis (`NodeFixity`'s low bits): every axis
+    /// for `Fixed`, the normal one for `Roller`.
+    pub mask: u8,
+}
+
 /// Checks a list of face conditions (`field`: where it is in the scene): faces of the
-/// grid's dimension `n`, one condition a face.
-pub(super) fn check_faces(list: &[BoundarySpec], field: &str, n: usize) -> Result<(), (String, String)> {
+/// grid's dimension `n`, one condition a face. Returns them as the nodes hold them.
+pub(super) fn check_faces(
+    list: &[BoundarySpec],
+    field: &str,
+    n: usize,
+) -> Result<Vec<FaceHold>, (String, String)> {
+    let mut holds = Vec::with_capacity(list.len());
     for (i, bc) in list.iter().enumerate() {
         if bc.face.axis_side().0 >= n {
             return Err((
@@ -26,12 +60,18 @@ pub(super) fn check_faces(list: &[BoundarySpec], field: &str, n: usize) -> Resul
                 ),
             ));
         }
+        let (axis, upper) = bc.face.axis_side();
+        let mask = match bc.condition {
+            Condition::Fixed => (1u8 << n) - 1,
+            Condition::Roller => 1u8 << axis,
+        };
+        holds.push(FaceHold { axis, upper, mask });
     }
-    Ok(())
+    Ok(holds)
 }
 
-/// The grid: origin, cells and cell size.
-pub(super) fn check_grid(r: &Rules) -> Result<(), SceneError> {
+/// The grid: origin, cells and cell size, and its face conditions.
+pub(super) fn check_grid(r: &Rules) -> Result<CheckedGrid, SceneError> {
     let (s, n) = (&r.loaded.scene, r.n);
     r.len("grid.origin", s.grid.origin.len())?;
     r.finite("grid.origin", &s.grid.origin, "m")?;
@@ -84,5 +124,21 @@ pub(super) fn check_grid(r: &Rules) -> Result<(), SceneError> {
             ),
         );
     }
-    Ok(())
+    let faces = check_faces(&s.boundaries, "boundaries", n)
+        .map_err(|(field, rule)| r.loaded.invalid(&field, rule))?;
+    let mut cells = [0usize; 3];
+    cells[..n].copy_from_slice(&s.grid.cells);
+    let mut half_width = [0.25; 3];
+    if let Some(b) = s.bodies.first() {
+        for (w, &per) in half_width.iter_mut().zip(&b.points_per_cell) {
+            *w = 0.5 / per as f64;
+        }
+    }
+    Ok(CheckedGrid {
+        origin: pad3(&s.grid.origin),
+        cell_size: s.grid.cell_size,
+        cells,
+        half_width,
+        faces,
+    })
 }

@@ -1,16 +1,14 @@
 //! The loads: gravity, point loads, tractions (and their increments), traced points, and
 //! the rule that a scene loads something.
 
-use super::grid::check_faces;
 use super::materials::{check_mass_finite, check_smoothing};
 use super::*;
 use crate::error::SceneError;
 use crate::materials::MaterialModel;
 
-/// Face conditions, gravity, point loads, and what the materials make of them.
+/// Gravity, point loads, and what the materials make of them.
 pub(super) fn check_loads(r: &Rules, table: &[(String, MaterialModel)]) -> Result<(), SceneError> {
     let (loaded, s, n) = (r.loaded, &r.loaded.scene, r.n);
-    check_faces(&s.boundaries, "boundaries", n).map_err(|(field, rule)| loaded.invalid(&field, rule))?;
     if let Some(g) = &s.gravity {
         r.len("gravity.acceleration", g.acceleration.len())?;
         r.finite("gravity.acceleration", &g.acceleration, "m/s²")?;

@@ -1,8 +1,8 @@
 //! Rules a scene must satisfy before anything is built or written, and the figures derived
 //! from it. Each part of a scene has its file here and checks itself through [`Rules`],
 //! which names the field and the rule it breaks; [`check`] runs them in order and returns
-//! what set-up needs from them ([`Checked`]: the built materials, each stage's materials,
-//! the time step, the memory bound), so nothing is checked or built twice. A new part of a
+//! what set-up needs from them ([`Checked`]: the grid and its faces, the built materials,
+//! each stage's materials and faces, the time step, the memory bound), so nothing is checked or built twice. A new part of a
 //! scene (a rigid body, a water table) is a new file with its check, one line in [`check`].
 
 mod bodies;
@@ -14,8 +14,11 @@ mod motions;
 mod solver;
 mod stages;
 
+pub use grid::{CheckedGrid, FaceHold};
 pub(crate) use memory::carried_state;
 pub use memory::Estimate;
+pub(crate) use motions::check_motion_boxes;
+pub use stages::CheckedStage;
 
 use bodies::check_bodies;
 use grid::check_grid;
@@ -91,16 +94,15 @@ impl std::fmt::Display for Derived {
     }
 }
 
-/// Each stage's materials, built once: the index in the scene's table and the model.
-pub type StageModels = Vec<Vec<(u16, MaterialModel)>>;
-
 /// What [`check`] establishes.
 #[derive(Clone, Debug)]
 pub struct Checked {
+    /// The grid and its face conditions.
+    pub grid: CheckedGrid,
     /// Every material the scene defines, in name order.
     pub materials: Vec<(String, MaterialModel)>,
-    /// The materials each stage sets (by index in `materials`), in stage order.
-    pub stage_materials: StageModels,
+    /// Each stage's materials (by index in `materials`) and face conditions, in stage order.
+    pub stages: Vec<CheckedStage>,
     /// Largest P-wave speed sqrt(M/ρ) over the materials the bodies use (m/s).
     pub p_wave_speed: f64,
     /// Critical time step h / c_p (s).
@@ -198,7 +200,7 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
         loaded,
         n: s.dimension as usize,
     };
-    check_grid(&r)?;
+    let grid = check_grid(&r)?;
     let table = check_materials(&r)?;
     check_solver(&r)?;
     check_bodies(&r)?;
@@ -207,11 +209,12 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
     check_tractions_and_traced(&r)?;
     check_has_load(&r)?;
     let step = time_step(&r, &table)?;
-    let stage_materials = check_stages(&r, &table, step.p_wave_speed)?;
+    let stages = check_stages(&r, &table, step.p_wave_speed)?;
     let estimate = check_memory(&r, &table)?;
     Ok(Checked {
+        grid,
         materials: table,
-        stage_materials,
+        stages,
         p_wave_speed: step.p_wave_speed,
         critical_time_step: step.critical,
         time_step: step.dt,

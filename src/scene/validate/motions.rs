@@ -1,8 +1,12 @@
-//! Prescribed motions and the analyses over runs (strength reduction).
+//! Prescribed motions and the analyses over runs (strength reduction). The motions' boxes
+//! are checked against the grid nodes the bodies touch once set-up has placed the points
+//! ([`check_motion_boxes`]).
 
 use super::*;
 use crate::components::NodeFixity;
+use crate::dim::Dim;
 use crate::error::SceneError;
+use crate::grid::Grid;
 
 /// The finest bisection of `kdmpm fos`, relative to the bracket's high end: about 24
 /// halvings of a bracket [0.5, 2].
@@ -65,6 +69,65 @@ pub(super) fn check_motions_and_analyses(r: &Rules) -> Result<(), SceneError> {
                 "output.displacements",
                 "strength reduction judges trials by displacement: keep them (true)".into(),
             );
+        }
+    }
+    Ok(())
+}
+
+/// Every motion's box holds grid nodes that the body touches at the start, and no node is
+/// in two boxes: a box of nodes the body never reaches pushes nothing (a curve of zero
+/// forces), and a node two motions claim is driven by the later one only.
+pub(crate) fn check_motion_boxes<D: Dim>(
+    loaded: &LoadedScene,
+    grid: &Grid<D>,
+    touched: &[bool],
+) -> Result<(), SceneError> {
+    let motions = &loaded.scene.motions;
+    if motions.is_empty() {
+        return Ok(());
+    }
+    let mut owner: Vec<Option<usize>> = vec![None; grid.node_count()];
+    for (k, m) in motions.iter().enumerate() {
+        let (mut inside, mut loaded_nodes) = (0usize, 0usize);
+        for (id, o) in owner.iter_mut().enumerate() {
+            let x = D::vec_to3(grid.node_position(grid.node_ijk(id)));
+            if !crate::systems::prescribed_motion::in_box(m, x, D::N, grid.cell_size) {
+                continue;
+            }
+            if let Some(j) = *o {
+                return Err(loaded.invalid(
+                    &format!("motions[{k}].min"),
+                    format!(
+                        "the box shares the node at {:?} with motions[{j}] (\"{}\"): a node has one \
+                         motion; give the motions boxes apart",
+                        &x[..D::N],
+                        motions[j].name
+                    ),
+                ));
+            }
+            *o = Some(k);
+            inside += 1;
+            loaded_nodes += usize::from(touched[id]);
+        }
+        if inside == 0 {
+            return Err(loaded.invalid(
+                &format!("motions[{k}].min"),
+                format!(
+                    "the box {:?}..{:?} holds no grid node (nodes lie every {} m from the grid's \
+                     origin): the motion would drive nothing",
+                    m.min, m.max, grid.cell_size
+                ),
+            ));
+        }
+        if loaded_nodes == 0 {
+            return Err(loaded.invalid(
+                &format!("motions[{k}].min"),
+                format!(
+                    "none of the box's {inside} nodes touches the body at the start: grid nodes \
+                     do not move, so the motion would push nothing and report zero force; put the \
+                     box on the body's surface"
+                ),
+            ));
         }
     }
     Ok(())

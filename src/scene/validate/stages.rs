@@ -1,17 +1,26 @@
 //! Loading stages: each stage's changes, checked against the scene, and its materials
 //! built once.
 
-use super::grid::check_faces;
+use super::grid::{check_faces, FaceHold};
 use super::*;
 use crate::error::SceneError;
 use crate::materials::MaterialModel;
+
+/// A stage as set-up builds it: what the check built from its spec.
+#[derive(Clone, Debug)]
+pub struct CheckedStage {
+    /// The materials the stage sets: the index in the scene's table and the model.
+    pub materials: Vec<(u16, MaterialModel)>,
+    /// The face conditions the stage sets, replacing the scene's.
+    pub faces: Option<Vec<FaceHold>>,
+}
 
 /// The stages: each material, load, face condition and gravity they set.
 pub(super) fn check_stages(
     r: &Rules,
     table: &[(String, MaterialModel)],
     c_p: f64,
-) -> Result<StageModels, SceneError> {
+) -> Result<Vec<CheckedStage>, SceneError> {
     let (loaded, s, n) = (r.loaded, &r.loaded.scene, r.n);
     let mut built = Vec::with_capacity(s.stages.len());
     for (k, st) in s.stages.iter().enumerate() {
@@ -58,7 +67,6 @@ pub(super) fn check_stages(
             let id = table.iter().position(|(n, _)| n == name).expect("checked above");
             models.push((id as u16, model));
         }
-        built.push(models);
         for (name, force) in &st.point_loads {
             if !s.point_loads.iter().any(|l| l.name == *name) {
                 return r.bad(
@@ -84,10 +92,13 @@ pub(super) fn check_stages(
             r.len(&field, traction.len())?;
             r.finite(&field, traction, "Pa")?;
         }
-        if let Some(b) = &st.boundaries {
-            check_faces(b, &format!("stages[{k}].boundaries"), n)
-                .map_err(|(field, rule)| loaded.invalid(&field, rule))?;
-        }
+        let faces = match &st.boundaries {
+            Some(b) => Some(
+                check_faces(b, &format!("stages[{k}].boundaries"), n)
+                    .map_err(|(field, rule)| loaded.invalid(&field, rule))?,
+            ),
+            None => None,
+        };
         if let Some(g) = &st.gravity {
             if s.gravity.is_none() {
                 return r.bad(
@@ -111,6 +122,10 @@ pub(super) fn check_stages(
                 "needs the displacements kept (output.displacements: true)".into(),
             );
         }
+        built.push(CheckedStage {
+            materials: models,
+            faces,
+        });
     }
     Ok(built)
 }
