@@ -1,10 +1,11 @@
 //! The `kdmpm` command line: run or check a scene.
 //!
-//! The binary parses the command line and reports; the library runs: [`kdmpm::run::Run`]
+//! The binary parses the command line (`cli.rs`) and reports; the library runs: [`kdmpm::run::Run`]
 //! for `run` and `resume`, [`kdmpm::fos`] and [`kdmpm::study`]. Bad input exits with 2, a
 //! run that went wrong with 1, an interrupted one with 130.
 
-use clap::{Parser, Subcommand};
+use clap::Parser;
+use cli::{Cli, Command, Stepping, Workers};
 use kdmpm::error::Ending;
 use kdmpm::infra::comm::Comm;
 use kdmpm::output::{Outcome, OutputDir};
@@ -19,109 +20,7 @@ use std::sync::Arc;
 #[global_allocator]
 static ALLOCATOR: kdmpm::infra::alloc::Coloured = kdmpm::infra::alloc::Coloured;
 
-#[derive(Parser)]
-#[command(
-    name = "kdmpm",
-    version,
-    about = "Static large-deformation MPM with kinetic damping"
-)]
-struct Cli {
-    #[command(subcommand)]
-    command: Command,
-}
-
-/// Threads and terminal output, for every command that runs.
-#[derive(clap::Args, Clone, Copy)]
-struct Workers {
-    /// Print nothing but errors.
-    #[arg(long, short)]
-    quiet: bool,
-    /// Worker threads (default: all cores; a study gives each run this many). Results are
-    /// identical for any count.
-    #[arg(long)]
-    threads: Option<std::num::NonZeroUsize>,
-}
-
-/// How a run steps and what it prints, for `run` and `resume` alike.
-#[derive(clap::Args, Clone, Copy)]
-struct Stepping {
-    /// Print the per-system timing table at the end.
-    #[arg(long)]
-    profile: bool,
-    #[command(flatten)]
-    workers: Workers,
-}
-
-#[derive(Subcommand)]
-enum Command {
-    /// Run a scene to static equilibrium (or its step/time limit).
-    Run {
-        /// Scene file (RON).
-        scene: PathBuf,
-        /// Output directory (default: out/<scene file stem>).
-        #[arg(long)]
-        out: Option<PathBuf>,
-        /// Override a scene field, e.g. --set solver.tolerance=1e-4 (repeatable).
-        #[arg(long = "set", value_name = "PATH=VALUE")]
-        overrides: Vec<String>,
-        #[command(flatten)]
-        stepping: Stepping,
-        /// Write a Chrome trace (chrome://tracing, Perfetto) of every system call to FILE
-        /// (needs a build with `--features trace`).
-        #[arg(long, value_name = "FILE")]
-        trace: Option<PathBuf>,
-    },
-    /// Continue a run from the checkpoint in its output directory (`checkpoint.kdc`, written
-    /// by `solver.checkpoint_every` or Ctrl-C), bit for bit as if it had not stopped.
-    Resume {
-        /// The run's output directory.
-        dir: PathBuf,
-        #[command(flatten)]
-        stepping: Stepping,
-    },
-    /// Run a speed–accuracy study: a scene over axes of settings, each run compared with an
-    /// analytic value or a reference run; writes study.csv, pareto.svg (and convergence.csv
-    /// over a refinement axis) and prints the Pareto front.
-    Study {
-        /// Study file (RON; see docs/studies.md).
-        study: PathBuf,
-        /// Output directory (default: out/study-<study file stem>).
-        #[arg(long)]
-        out: Option<PathBuf>,
-        #[command(flatten)]
-        workers: Workers,
-    },
-    /// Factor of safety by strength reduction: solve the scene with c and tan φ divided by
-    /// trial factors, bisecting between the largest that stands and the smallest that fails
-    /// (the scene's `strength_reduction` field); writes summary.json, fos.csv, fos.svg and
-    /// each trial under trials/.
-    Fos {
-        /// Scene file (RON) with a `strength_reduction` field.
-        scene: PathBuf,
-        /// Output directory (default: out/fos-<scene file stem>).
-        #[arg(long)]
-        out: Option<PathBuf>,
-        /// Override a scene field (repeatable).
-        #[arg(long = "set", value_name = "PATH=VALUE")]
-        overrides: Vec<String>,
-        #[command(flatten)]
-        workers: Workers,
-    },
-    /// Draw (again) the plots of a run from its output directory, finished or running:
-    /// kinetic energy, K_F and K_E, traced displacements, displacement field (SVG).
-    Plot {
-        /// The run's output directory.
-        dir: PathBuf,
-    },
-    /// Parse and validate a scene without running it; print the derived figures.
-    Check {
-        /// Scene file (RON).
-        scene: PathBuf,
-        /// Override a scene field (repeatable).
-        #[arg(long = "set", value_name = "PATH=VALUE")]
-        overrides: Vec<String>,
-    },
-}
+mod cli;
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
