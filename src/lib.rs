@@ -46,6 +46,7 @@ pub mod materials;
 pub mod measure;
 pub mod output;
 pub(crate) mod parallel;
+pub mod refine;
 pub mod run;
 pub mod scene;
 pub mod schedule;

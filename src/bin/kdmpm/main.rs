@@ -1,7 +1,7 @@
 //! The `kdmpm` command line: run or check a scene.
 //!
 //! The binary parses the command line (`cli.rs`) and reports; the library runs: [`kdmpm::run::Run`]
-//! for `run` and `resume`, [`kdmpm::fos`] and [`kdmpm::study`]. Bad input exits with 2, a
+//! for `run` and `resume`, [`kdmpm::fos`], [`kdmpm::refine`] and [`kdmpm::study`]. Bad input exits with 2, a
 //! run that went wrong with 1, an interrupted one with 130.
 
 use clap::Parser;
@@ -102,8 +102,9 @@ fn command(command: Command, comm: &Arc<Comm>) -> Result<ExitCode, Fault> {
             scene,
             out,
             overrides,
+            refine,
             workers,
-        } => run_fos(&scene, out, &overrides, workers.quiet)?,
+        } => run_fos(&scene, out, &overrides, refine, workers.quiet)?,
         Command::Resume { dir, stepping } => {
             let run = Run::resume(dir).quiet(stepping.workers.quiet).go();
             return report(run, stepping, comm);
@@ -112,11 +113,15 @@ fn command(command: Command, comm: &Arc<Comm>) -> Result<ExitCode, Fault> {
             scene,
             out,
             overrides,
+            refine,
             stepping,
             ..
         } => {
             let out = out.unwrap_or_else(|| default_out(&scene, "", "scene"));
             let loaded = LoadedScene::from_file(&scene, &overrides).map_err(Fault::bad)?;
+            if let Some(levels) = refine {
+                return run_refined(&loaded, &out, levels, stepping.workers.quiet, comm);
+            }
             let run = Run::scene(loaded).into_dir(out).quiet(stepping.workers.quiet);
             return report(run.over(comm.clone()).go(), stepping, comm);
         }
@@ -166,10 +171,50 @@ fn report(run: Result<RunReport, RunError>, stepping: Stepping, comm: &Comm) -> 
     ))
 }
 
-/// `kdmpm fos`: the strength-reduction analysis of a scene.
-fn run_fos(path: &Path, out: Option<PathBuf>, overrides: &[String], quiet: bool) -> Result<(), Fault> {
+/// `kdmpm run --refine`: the scene's limit pressure at two or three cell sizes.
+fn run_refined(
+    loaded: &LoadedScene,
+    out: &Path,
+    levels: u32,
+    quiet: bool,
+    comm: &Comm,
+) -> Result<ExitCode, Fault> {
+    if comm.size() > 1 {
+        return Err(Fault::bad("--refine runs on one rank: start it without mpirun"));
+    }
+    let show = |l: &kdmpm::refine::Level| {
+        if !quiet {
+            eprintln!("h = {} m done ({:.1} s)", l.cell_size, l.wall_seconds);
+        }
+    };
+    let (r, refinement) = kdmpm::refine::limit_pressure(loaded, out, levels, quiet, show)
+        .map_err(|e| Fault(e.to_string(), e.ending()))?;
+    println!("{}\n{}", r.describe(), refinement.describe());
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `kdmpm fos`: the strength-reduction analysis of a scene (at two or three cell sizes with
+/// `--refine`).
+fn run_fos(
+    path: &Path,
+    out: Option<PathBuf>,
+    overrides: &[String],
+    refine: Option<u32>,
+    quiet: bool,
+) -> Result<(), Fault> {
     let loaded = LoadedScene::from_file(path, overrides).map_err(Fault::bad)?;
     let out = out.unwrap_or_else(|| default_out(path, "fos-", "scene"));
+    if let Some(levels) = refine {
+        let show = |h: f64, t: &kdmpm::fos::Trial| {
+            if !quiet {
+                eprintln!("h = {h} m, {}", t.describe());
+            }
+        };
+        let (r, refinement) = kdmpm::refine::factor_of_safety(&loaded, &out, levels, show)
+            .map_err(|e| Fault(e.to_string(), e.ending()))?;
+        println!("{} → {}\n{}", r.describe(), out.display(), refinement.describe());
+        return Ok(());
+    }
     let show = |t: &kdmpm::fos::Trial| {
         if !quiet {
             eprintln!("{}", t.describe());

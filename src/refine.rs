@@ -1,0 +1,444 @@
+//! The discretisation error of an answer, by refinement (`--refine` of `kdmpm run` and
+//! `kdmpm fos`).
+//!
+//! The analysis is repeated with the cell size halved, once or twice: h, h/2 (and h/4);
+//! everything the scene gives in metres and seconds stays as it is, and what it counts in
+//! steps grows with the steps (see [`finer`]). From the answers f₁ (h), f₂ (h/2), f₃ (h/4)
+//! Richardson's extrapolation (Richardson 1911; Roache 1998, *Verification and Validation
+//! in Computational Science and Engineering*, ch. 5) gives
+//!
+//! - the observed order p = ln((f₁ − f₂)/(f₂ − f₃)) / ln 2,
+//! - the extrapolated answer f* = f₃ + (f₃ − f₂)/(2^p − 1),
+//! - the discretisation error of the scene's own answer, f₁ − f*.
+//!
+//! The order is observed only when the answers converge cleanly: the differences have one
+//! sign, shrink, and stand above what each answer resolves (a factor of safety is known to
+//! half its bisection bracket, a limit load to the stopping tolerance K_F). Otherwise
+//! nothing is extrapolated and the report says why, with the spread of the answers. With
+//! two cell sizes the order cannot be observed: it is taken as 1, the order of limit loads
+//! in MPM, whose error comes from the edge of the loaded area, about h/B (said in the
+//! report).
+
+use crate::error::Ending;
+use crate::fos::{FosError, FosReport, Trial};
+use crate::output::dir::write_atomic;
+use crate::output::Outcome;
+use crate::run::{Run, RunError, RunReport};
+use crate::scene::LoadedScene;
+use serde::Serialize;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Cell sizes an estimate may use: the scene's and one or two halvings.
+pub const LEVELS: std::ops::RangeInclusive<u32> = 2..=3;
+
+/// The scene at cell size h/`ratio`: `grid.cell_size` divided, `grid.cells` multiplied;
+/// what counts steps (`max_steps`, `history_every`, snapshots and checkpoints every N
+/// steps, the strength reduction's `check_every`) multiplied, a fixed Δt divided, as the
+/// Courant number does by itself. Lengths, times, loads and points a cell side stay.
+pub fn finer(loaded: &LoadedScene, ratio: u32) -> LoadedScene {
+    let mut l = loaded.clone();
+    let (s, r) = (&mut l.scene, u64::from(ratio));
+    s.grid.cell_size /= f64::from(ratio);
+    s.grid.cells.iter_mut().for_each(|c| *c *= ratio as usize);
+    if let crate::scene::TimeStep::Fixed(dt) = &mut s.solver.time_step {
+        *dt /= f64::from(ratio);
+    }
+    if let Some(n) = &mut s.solver.max_steps {
+        *n = n.saturating_mul(r);
+    }
+    s.output.history_every = s.output.history_every.saturating_mul(r);
+    if let Some(n) = s.output.snapshots.as_mut().and_then(|sn| sn.every_steps.as_mut()) {
+        *n = n.saturating_mul(r);
+    }
+    if let Some(crate::scene::CheckpointEvery::Steps(n)) = &mut s.solver.checkpoint_every {
+        *n = n.saturating_mul(r);
+    }
+    if let Some(sr) = &mut s.strength_reduction {
+        sr.check_every = sr.check_every.saturating_mul(r);
+    }
+    l
+}
+
+/// One answer of a refinement.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Level {
+    /// The cell size h (m).
+    pub cell_size: f64,
+    /// The answer at that cell size.
+    pub value: f64,
+    /// How finely the answer is known by itself (half the bisection bracket of a factor of
+    /// safety; the stopping tolerance times a limit load).
+    pub resolution: f64,
+    /// Where its run wrote its files, relative to the analysis's directory ("." for the
+    /// scene's own cell size).
+    pub dir: String,
+    /// Wall-clock seconds.
+    pub wall_seconds: f64,
+}
+
+/// What refinement says about an answer.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Refinement {
+    /// What was refined (`limit_pressure`, `factor_of_safety`).
+    pub quantity: String,
+    /// Its unit ("kPa", "" for a factor).
+    pub unit: String,
+    /// The answers, scene's cell size first, each half the cell size of the one before.
+    pub levels: Vec<Level>,
+    /// The observed order p, when three answers converge cleanly.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub order: Option<f64>,
+    /// The order the extrapolation used: observed, or 1 assumed from two answers.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub order_used: Option<f64>,
+    /// The extrapolated answer f*.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub extrapolated: Option<f64>,
+    /// The discretisation error of the scene's own answer, f₁ − f* (positive: the scene's
+    /// answer is above the converged one).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub error: Option<f64>,
+    /// The spread of the answers, largest less smallest.
+    pub spread: f64,
+    /// How the estimate was made, or why there is none.
+    pub note: String,
+}
+
+/// Richardson's estimate from `levels` (h, h/2, h/4 ...; two or three), see the module.
+pub fn estimate(quantity: &str, unit: &str, levels: Vec<Level>) -> Refinement {
+    let f: Vec<f64> = levels.iter().map(|l| l.value).collect();
+    let res: Vec<f64> = levels.iter().map(|l| l.resolution).collect();
+    let noise = |a: usize, b: usize| res[a] + res[b];
+    let spread =
+        f.iter().copied().fold(f64::NEG_INFINITY, f64::max) - f.iter().copied().fold(f64::INFINITY, f64::min);
+    let mut out = Refinement {
+        quantity: quantity.into(),
+        unit: unit.into(),
+        levels,
+        order: None,
+        order_used: None,
+        extrapolated: None,
+        error: None,
+        spread,
+        note: String::new(),
+    };
+    let (order, finest, step) = match f[..] {
+        [f1, f2] => {
+            if (f1 - f2).abs() <= noise(0, 1) {
+                out.note = "the two answers differ by less than they resolve: no trend to extrapolate".into();
+                return out;
+            }
+            out.note = "two cell sizes: order 1 assumed (limit loads in MPM converge about as h/B)".into();
+            (None, f2, f2 - f1)
+        }
+        [f1, f2, f3] => {
+            let (d1, d2) = (f1 - f2, f2 - f3);
+            let why = if d1.abs() <= noise(0, 1) || d2.abs() <= noise(1, 2) {
+                Some("two answers differ by less than they resolve")
+            } else if d1.signum() != d2.signum() {
+                Some("the answers are not monotone in the cell size")
+            } else if d2.abs() >= d1.abs() {
+                Some("the differences do not shrink with the cell size")
+            } else {
+                None
+            };
+            if let Some(why) = why {
+                out.note = format!("no clean order: {why}; not extrapolated");
+                return out;
+            }
+            let p = (d1 / d2).ln() / 2f64.ln();
+            out.note = "three cell sizes: order observed".into();
+            (Some(p), f3, f3 - f2)
+        }
+        _ => unreachable!("a refinement has two or three cell sizes"),
+    };
+    let p = order.unwrap_or(1.0);
+    let extrapolated = finest + step / (2f64.powf(p) - 1.0);
+    out.order = order;
+    out.order_used = Some(p);
+    out.extrapolated = Some(extrapolated);
+    out.error = Some(f[0] - extrapolated);
+    out
+}
+
+impl Refinement {
+    /// The estimate in a few lines, as the terminal shows it.
+    pub fn describe(&self) -> String {
+        let unit = |v: f64| match self.unit.as_str() {
+            "" => format!("{v:.4}"),
+            "Pa" => format!("{:.2} kPa", v / 1e3),
+            u => format!("{v:.4e} {u}"),
+        };
+        let mut s = String::new();
+        for l in &self.levels {
+            s += &format!(
+                "  h = {} m: {} {} ({:.1} s)\n",
+                l.cell_size,
+                self.quantity.replace('_', " "),
+                unit(l.value),
+                l.wall_seconds
+            );
+        }
+        let f1 = self.levels[0].value;
+        match (self.extrapolated, self.error) {
+            (Some(x), Some(e)) => {
+                let order = match self.order {
+                    Some(p) => format!("observed order {p:.2}"),
+                    None => "order 1 assumed".into(),
+                };
+                s += &format!(
+                    "  extrapolated {} ({order}); the answer at h = {} m is {} ± {} ({:+.1} %)\n",
+                    unit(x),
+                    self.levels[0].cell_size,
+                    unit(f1),
+                    unit(e.abs()),
+                    100.0 * e / x
+                );
+            }
+            _ => {
+                s += &format!("  {}: the answers spread over {}\n", self.note, unit(self.spread));
+            }
+        }
+        s
+    }
+}
+
+/// Why a refinement could not give its estimate.
+#[derive(Debug, thiserror::Error)]
+pub enum RefineError {
+    /// The scene or the request cannot be refined (exit 2).
+    #[error("{0}")]
+    NotRefinable(String),
+    /// The run at this cell size could not be made.
+    #[error("at h = {0} m: {1}")]
+    Run(f64, Box<RunError>),
+    /// The strength-reduction analysis at this cell size could not be made.
+    #[error("at h = {0} m: {1}")]
+    Fos(f64, Box<FosError>),
+    /// The run at this cell size gave no answer (an error, or no limit pressure); the runs
+    /// before it are in their folders.
+    #[error("at h = {0} m: {1}")]
+    NoAnswer(f64, String),
+    /// Stopped by a signal during the run at this cell size.
+    #[error("interrupted during the run at h = {0} m: the cell sizes before it are in their folders")]
+    Interrupted(f64),
+    /// The summary could not be written.
+    #[error("cannot write {0}: {1}")]
+    Output(PathBuf, std::io::Error),
+}
+
+impl RefineError {
+    /// How a command ends with this error.
+    pub fn ending(&self) -> Ending {
+        match self {
+            RefineError::NotRefinable(_) => Ending::BadInput,
+            RefineError::Run(_, e) => e.ending(),
+            RefineError::Fos(_, e) => e.ending(),
+            RefineError::Interrupted(_) => Ending::Interrupted,
+            RefineError::NoAnswer(..) | RefineError::Output(..) => Ending::Failed,
+        }
+    }
+}
+
+/// Refuses a number of cell sizes outside [`LEVELS`].
+fn check_levels(count: u32) -> Result<(), RefineError> {
+    match LEVELS.contains(&count) {
+        true => Ok(()),
+        false => Err(RefineError::NotRefinable(format!(
+            "--refine takes {} or {} cell sizes (h, h/2 and h/4), found {count}",
+            LEVELS.start(),
+            LEVELS.end()
+        ))),
+    }
+}
+
+/// Where the analysis at `ratio` (1, 2, 4) writes: the scene's own cell size in `out`, the
+/// finer ones in `out/refine/h<cell size>/`.
+fn level_dir(out: &Path, ratio: u32, cell_size: f64) -> (PathBuf, String) {
+    match ratio {
+        1 => (out.to_path_buf(), ".".into()),
+        _ => {
+            let rel = format!("refine/h{cell_size}");
+            (out.join(&rel), rel)
+        }
+    }
+}
+
+/// Adds `refinement` to the `summary.json` in `out` (written whole, as every summary).
+fn add_to_summary(out: &Path, refinement: &Refinement) -> Result<(), RefineError> {
+    let path = out.join("summary.json");
+    let io = |e: std::io::Error| RefineError::Output(path.clone(), e);
+    let text = std::fs::read_to_string(&path).map_err(io)?;
+    let mut summary: serde_json::Value =
+        serde_json::from_str(&text).map_err(|e| io(std::io::Error::other(e)))?;
+    summary["refinement"] = serde_json::to_value(refinement).map_err(|e| io(std::io::Error::other(e)))?;
+    write_atomic(&path, |w| {
+        serde_json::to_writer_pretty(&mut *w, &summary).map_err(std::io::Error::other)?;
+        writeln!(w)
+    })
+    .map_err(io)
+}
+
+/// `kdmpm run --refine`: the scene's limit pressure (`limit_pressure` of its motions) at
+/// `count` cell sizes, with Richardson's estimate. Returns the report of the run at the
+/// scene's own cell size (in `out`) and the estimate, which is added to its `summary.json`.
+/// `show` hears of each cell size as it finishes.
+pub fn limit_pressure(
+    loaded: &LoadedScene,
+    out: &Path,
+    count: u32,
+    quiet: bool,
+    mut show: impl FnMut(&Level),
+) -> Result<(RunReport, Refinement), RefineError> {
+    check_levels(count)?;
+    if !loaded.scene.motions.iter().any(|m| m.area.is_some()) {
+        return Err(RefineError::NotRefinable(format!(
+            "{}: --refine estimates the error of a limit pressure, and the scene has no motion \
+             with a loaded `area`",
+            loaded.path.display()
+        )));
+    }
+    let tolerance = loaded.scene.solver.tolerance;
+    let mut first = None;
+    let mut levels = Vec::new();
+    for k in 0..count {
+        let ratio = 1u32 << k;
+        let scene = finer(loaded, ratio);
+        let h = scene.scene.grid.cell_size;
+        let (dir, rel) = level_dir(out, ratio, h);
+        let start = Instant::now();
+        let report = Run::scene(scene)
+            .into_dir(dir)
+            .quiet(quiet)
+            .go()
+            .map_err(|e| RefineError::Run(h, Box::new(e)))?;
+        if report.summary.outcome == Outcome::Interrupted {
+            return Err(RefineError::Interrupted(h));
+        }
+        if let Some(e) = &report.error {
+            return Err(RefineError::NoAnswer(h, e.to_string()));
+        }
+        let Some(value) = report.summary.limit_pressure else {
+            return Err(RefineError::NoAnswer(
+                h,
+                "the run reached no static state of its motions: no limit pressure".into(),
+            ));
+        };
+        let level = Level {
+            cell_size: h,
+            value,
+            resolution: tolerance * value.abs(),
+            dir: rel,
+            wall_seconds: start.elapsed().as_secs_f64(),
+        };
+        show(&level);
+        levels.push(level);
+        first.get_or_insert(report);
+    }
+    let refinement = estimate("limit_pressure", "Pa", levels);
+    add_to_summary(out, &refinement)?;
+    Ok((first.expect("at least two levels"), refinement))
+}
+
+/// `kdmpm fos --refine`: the factor of safety at `count` cell sizes, with Richardson's
+/// estimate. Returns the analysis at the scene's own cell size (in `out`) and the
+/// estimate, which is added to its `summary.json`. `show` hears of every trial.
+pub fn factor_of_safety(
+    loaded: &LoadedScene,
+    out: &Path,
+    count: u32,
+    mut show: impl FnMut(f64, &Trial),
+) -> Result<(FosReport, Refinement), RefineError> {
+    check_levels(count)?;
+    let mut first = None;
+    let mut levels = Vec::new();
+    for k in 0..count {
+        let ratio = 1u32 << k;
+        let scene = finer(loaded, ratio);
+        let h = scene.scene.grid.cell_size;
+        let (dir, rel) = level_dir(out, ratio, h);
+        let report = crate::fos::strength_reduction(&scene, &dir, |t| show(h, t)).map_err(|e| match e {
+            FosError::Interrupted(_) => RefineError::Interrupted(h),
+            e => RefineError::Fos(h, Box::new(e)),
+        })?;
+        levels.push(Level {
+            cell_size: h,
+            value: report.factor_of_safety,
+            resolution: 0.5 * (report.bracket[1] - report.bracket[0]),
+            dir: rel,
+            wall_seconds: report.wall_seconds,
+        });
+        first.get_or_insert(report);
+    }
+    let refinement = estimate("factor_of_safety", "", levels);
+    add_to_summary(out, &refinement)?;
+    Ok((first.expect("at least two levels"), refinement))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn levels(values: &[f64], resolution: f64) -> Vec<Level> {
+        values
+            .iter()
+            .enumerate()
+            .map(|(k, &value)| Level {
+                cell_size: 0.5f64.powi(k as i32),
+                value,
+                resolution,
+                dir: String::new(),
+                wall_seconds: 0.0,
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_first_order_sequence_extrapolates_to_its_limit() {
+        // f = 50 + 8 h: 58, 54, 52.
+        let r = estimate("limit_pressure", "kPa", levels(&[58.0, 54.0, 52.0], 0.1));
+        assert!((r.order.unwrap() - 1.0).abs() < 1e-12);
+        assert!((r.extrapolated.unwrap() - 50.0).abs() < 1e-12);
+        assert!((r.error.unwrap() - 8.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_second_order_sequence_shows_order_two() {
+        // f = 1.4 + 0.16 h²: 1.56, 1.44, 1.41.
+        let r = estimate("factor_of_safety", "", levels(&[1.56, 1.44, 1.41], 0.001));
+        assert!((r.order.unwrap() - 2.0).abs() < 1e-9);
+        assert!((r.extrapolated.unwrap() - 1.4).abs() < 1e-12);
+    }
+
+    #[test]
+    fn two_levels_assume_first_order() {
+        let r = estimate("limit_pressure", "kPa", levels(&[55.58, 52.92], 0.5));
+        assert_eq!(r.order, None);
+        assert_eq!(r.order_used, Some(1.0));
+        assert!((r.extrapolated.unwrap() - 50.26).abs() < 1e-9);
+    }
+
+    #[test]
+    fn a_non_monotone_sequence_is_not_extrapolated() {
+        let r = estimate("factor_of_safety", "", levels(&[1.414, 1.383, 1.39], 0.001));
+        assert_eq!(r.extrapolated, None);
+        assert!(r.note.contains("not monotone"), "{}", r.note);
+        assert!((r.spread - 0.031).abs() < 1e-12);
+    }
+
+    #[test]
+    fn differences_within_the_resolution_are_not_a_trend() {
+        let r = estimate("factor_of_safety", "", levels(&[1.414, 1.406, 1.40], 0.01));
+        assert_eq!(r.extrapolated, None);
+        assert!(r.note.contains("resolve"), "{}", r.note);
+    }
+
+    #[test]
+    fn growing_differences_are_not_extrapolated() {
+        let r = estimate("limit_pressure", "kPa", levels(&[55.0, 54.0, 52.0], 0.1));
+        assert_eq!(r.extrapolated, None);
+        assert!(r.note.contains("do not shrink"), "{}", r.note);
+    }
+}
