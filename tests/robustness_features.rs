@@ -477,6 +477,63 @@ fn a_study_refuses_a_reference_run_that_did_not_converge() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// `LimitPressure` reads a run's `limit_pressure` (the footing at h = 0.25 m: 55.58 kPa,
+/// +8.1 % on Prandtl's 51.42 kPa), and is refused on a scene without a loaded motion.
+#[test]
+fn a_study_measures_a_limit_pressure_and_refuses_one_without_a_loaded_motion() {
+    let dir = common::scratch("features", "study-limit-pressure");
+    let quantity = r#"quantities: [(name: "p", of: LimitPressure, compare: Analytic(51415.93))]"#;
+    let study = study_file(
+        &dir,
+        "footing.ron",
+        &format!(
+            r#"Study(scene: "SCENES/footing.ron", axes: [Set(path: "solver.tolerance", values: ["0.01"])], {quantity})"#
+        ),
+    );
+    let out = dir.join("out");
+    let args = [
+        "study",
+        study.to_str().unwrap(),
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    let o = kdmpm_within(&args, &[], Duration::from_secs(120));
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let table = std::fs::read_to_string(out.join("study.csv")).unwrap();
+    let row: Vec<&str> = table.lines().nth(1).unwrap().split(',').collect();
+    let header: Vec<&str> = table.lines().next().unwrap().split(',').collect();
+    let col = |name: &str| {
+        row[header.iter().position(|h| *h == name).unwrap()]
+            .parse::<f64>()
+            .unwrap()
+    };
+    // study.csv holds seven significant digits.
+    assert!(common::rel(col("p"), 55584.29) < 1e-6, "{table}");
+    assert!(
+        common::rel(col("error p"), 55584.285930086546 / 51415.93 - 1.0) < 1e-6,
+        "{table}"
+    );
+    let column = study_file(
+        &dir,
+        "column.ron",
+        &format!(
+            r#"Study(scene: "SCENES/soil_column.ron", axes: [Set(path: "solver.tolerance", values: ["1e-3"])], {quantity})"#
+        ),
+    );
+    let o = common::kdmpm(&[
+        "study",
+        column.to_str().unwrap(),
+        "--quiet",
+        "--out",
+        dir.join("out2").to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("no motion with a loaded `area`"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// SIGTERM to a study reaches the run under way, which is waited for: no run is left
 /// holding its directory, and the study exits 130.
 #[test]

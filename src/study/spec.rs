@@ -111,6 +111,8 @@ pub enum Quantity {
     MaxDisplacement,
     /// The simulated time at which the run stopped (s).
     StopTime,
+    /// The limit pressure of the scene's motions (Pa; needs a motion with a loaded `area`).
+    LimitPressure,
 }
 
 /// The value a quantity is compared with.
@@ -412,6 +414,12 @@ fn check_quantities(
                     "the scene does not measure the surface angle (output.surface_angle)".into(),
                 ));
             }
+            Quantity::LimitPressure if !base.scene.motions.iter().any(|m| m.area.is_some()) => {
+                return Err(at.invalid(
+                    &field,
+                    "the scene has no motion with a loaded `area`: no limit pressure".into(),
+                ));
+            }
             _ => {}
         }
         match &q.compare {
@@ -491,6 +499,7 @@ pub fn read(q: &Quantity, summary: &serde_json::Value) -> Option<(f64, Option<[f
         Quantity::SurfaceAngle => Some((summary["surface_angle"]["degrees"].as_f64()?, None)),
         Quantity::MaxDisplacement => Some((summary["max_displacement"].as_f64()?, None)),
         Quantity::StopTime => Some((summary["time"].as_f64()?, None)),
+        Quantity::LimitPressure => Some((summary["limit_pressure"].as_f64()?, None)),
     }
 }
 
