@@ -113,6 +113,11 @@ pub fn estimate(quantity: &str, unit: &str, levels: Vec<Level>) -> Refinement {
     let noise = |a: usize, b: usize| res[a] + res[b];
     let spread =
         f.iter().copied().fold(f64::NEG_INFINITY, f64::max) - f.iter().copied().fold(f64::INFINITY, f64::min);
+    // What narrows an answer's resolution, for the note.
+    let narrower = match quantity {
+        "factor_of_safety" => " (a smaller strength_reduction.tolerance narrows each answer)",
+        _ => " (a smaller solver.tolerance narrows each answer)",
+    };
     let mut out = Refinement {
         quantity: quantity.into(),
         unit: unit.into(),
@@ -127,7 +132,9 @@ pub fn estimate(quantity: &str, unit: &str, levels: Vec<Level>) -> Refinement {
     let (order, finest, step) = match f[..] {
         [f1, f2] => {
             if (f1 - f2).abs() <= noise(0, 1) {
-                out.note = "the two answers differ by less than they resolve: no trend to extrapolate".into();
+                out.note = format!(
+                    "the two answers differ by less than they resolve{narrower}: no trend to extrapolate"
+                );
                 return out;
             }
             out.note = "two cell sizes: order 1 assumed (limit loads in MPM converge about as h/B)".into();
@@ -136,11 +143,11 @@ pub fn estimate(quantity: &str, unit: &str, levels: Vec<Level>) -> Refinement {
         [f1, f2, f3] => {
             let (d1, d2) = (f1 - f2, f2 - f3);
             let why = if d1.abs() <= noise(0, 1) || d2.abs() <= noise(1, 2) {
-                Some("two answers differ by less than they resolve")
+                Some(format!("two answers differ by less than they resolve{narrower}"))
             } else if d1.signum() != d2.signum() {
-                Some("the answers are not monotone in the cell size")
+                Some("the answers are not monotone in the cell size".to_string())
             } else if d2.abs() >= d1.abs() {
-                Some("the differences do not shrink with the cell size")
+                Some("the differences do not shrink with the cell size".to_string())
             } else {
                 None
             };
