@@ -288,6 +288,45 @@ fn add_to_summary(out: &Path, refinement: &Refinement) -> Result<(), RefineError
     .map_err(io)
 }
 
+/// One answer of an analysis at one cell size: the analysis's own report, the answer, how
+/// finely it is known ([`Level::resolution`]) and the wall time.
+type Answer<T> = (T, f64, f64, f64);
+
+/// Makes the analysis `at` (the scene at a cell size, its folder, the cell size) at
+/// `count` cell sizes (checked by the caller), adds Richardson's estimate of `quantity` (in `unit`) to the
+/// `summary.json` in `out`, and returns the report at the scene's own cell size with it.
+fn refine<T>(
+    loaded: &LoadedScene,
+    out: &Path,
+    count: u32,
+    (quantity, unit): (&str, &str),
+    mut at: impl FnMut(LoadedScene, PathBuf, f64) -> Result<Answer<T>, RefineError>,
+    mut show: impl FnMut(&Level),
+) -> Result<(T, Refinement), RefineError> {
+    let mut first = None;
+    let mut levels = Vec::new();
+    for k in 0..count {
+        let ratio = 1u32 << k;
+        let scene = finer(loaded, ratio);
+        let h = scene.scene.grid.cell_size;
+        let (dir, rel) = level_dir(out, ratio, h);
+        let (report, value, resolution, wall_seconds) = at(scene, dir, h)?;
+        let level = Level {
+            cell_size: h,
+            value,
+            resolution,
+            dir: rel,
+            wall_seconds,
+        };
+        show(&level);
+        levels.push(level);
+        first.get_or_insert(report);
+    }
+    let refinement = estimate(quantity, unit, levels);
+    add_to_summary(out, &refinement)?;
+    Ok((first.expect("at least two levels"), refinement))
+}
+
 /// `kdmpm run --refine`: the scene's limit pressure (`limit_pressure` of its motions) at
 /// `count` cell sizes, with Richardson's estimate. Returns the report of the run at the
 /// scene's own cell size (in `out`) and the estimate, which is added to its `summary.json`.
@@ -297,10 +336,10 @@ pub fn limit_pressure(
     out: &Path,
     count: u32,
     quiet: bool,
-    mut show: impl FnMut(&Level),
+    show: impl FnMut(&Level),
 ) -> Result<(RunReport, Refinement), RefineError> {
     check_levels(count)?;
-    if !loaded.scene.motions.iter().any(|m| m.area.is_some()) {
+    if !loaded.scene.has_limit_pressure() {
         return Err(RefineError::NotRefinable(format!(
             "{}: --refine estimates the error of a limit pressure, and the scene has no motion \
              with a loaded `area`",
@@ -308,13 +347,7 @@ pub fn limit_pressure(
         )));
     }
     let tolerance = loaded.scene.solver.tolerance;
-    let mut first = None;
-    let mut levels = Vec::new();
-    for k in 0..count {
-        let ratio = 1u32 << k;
-        let scene = finer(loaded, ratio);
-        let h = scene.scene.grid.cell_size;
-        let (dir, rel) = level_dir(out, ratio, h);
+    let run = |scene: LoadedScene, dir: PathBuf, h: f64| {
         let start = Instant::now();
         let report = Run::scene(scene)
             .into_dir(dir)
@@ -333,20 +366,10 @@ pub fn limit_pressure(
                 "the run reached no static state of its motions: no limit pressure".into(),
             ));
         };
-        let level = Level {
-            cell_size: h,
-            value,
-            resolution: tolerance * value.abs(),
-            dir: rel,
-            wall_seconds: start.elapsed().as_secs_f64(),
-        };
-        show(&level);
-        levels.push(level);
-        first.get_or_insert(report);
-    }
-    let refinement = estimate("limit_pressure", "Pa", levels);
-    add_to_summary(out, &refinement)?;
-    Ok((first.expect("at least two levels"), refinement))
+        let wall = start.elapsed().as_secs_f64();
+        Ok((report, value, tolerance * value.abs(), wall))
+    };
+    refine(loaded, out, count, ("limit_pressure", "Pa"), run, show)
 }
 
 /// `kdmpm fos --refine`: the factor of safety at `count` cell sizes, with Richardson's
@@ -359,29 +382,16 @@ pub fn factor_of_safety(
     mut show: impl FnMut(f64, &Trial),
 ) -> Result<(FosReport, Refinement), RefineError> {
     check_levels(count)?;
-    let mut first = None;
-    let mut levels = Vec::new();
-    for k in 0..count {
-        let ratio = 1u32 << k;
-        let scene = finer(loaded, ratio);
-        let h = scene.scene.grid.cell_size;
-        let (dir, rel) = level_dir(out, ratio, h);
+    let analyse = |scene: LoadedScene, dir: PathBuf, h: f64| {
         let report = crate::fos::strength_reduction(&scene, &dir, |t| show(h, t)).map_err(|e| match e {
             FosError::Interrupted(_) => RefineError::Interrupted(h),
             e => RefineError::Fos(h, Box::new(e)),
         })?;
-        levels.push(Level {
-            cell_size: h,
-            value: report.factor_of_safety,
-            resolution: 0.5 * (report.bracket[1] - report.bracket[0]),
-            dir: rel,
-            wall_seconds: report.wall_seconds,
-        });
-        first.get_or_insert(report);
-    }
-    let refinement = estimate("factor_of_safety", "", levels);
-    add_to_summary(out, &refinement)?;
-    Ok((first.expect("at least two levels"), refinement))
+        let (value, wall) = (report.factor_of_safety, report.wall_seconds);
+        let resolution = 0.5 * (report.bracket[1] - report.bracket[0]);
+        Ok((report, value, resolution, wall))
+    };
+    refine(loaded, out, count, ("factor_of_safety", ""), analyse, |_| {})
 }
 
 #[cfg(test)]

@@ -462,6 +462,11 @@ impl Scene {
         let staged = self.stages.iter_mut().flat_map(|st| st.materials.iter_mut());
         self.materials.iter_mut().chain(staged)
     }
+
+    /// True when a motion has a loaded `area`: the run then has a `limit_pressure`.
+    pub fn has_limit_pressure(&self) -> bool {
+        self.motions.iter().any(|m| m.area.is_some())
+    }
 }
 
 impl LoadedScene {

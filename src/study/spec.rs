@@ -414,7 +414,7 @@ fn check_quantities(
                     "the scene does not measure the surface angle (output.surface_angle)".into(),
                 ));
             }
-            Quantity::LimitPressure if !base.scene.motions.iter().any(|m| m.area.is_some()) => {
+            Quantity::LimitPressure if !base.scene.has_limit_pressure() => {
                 return Err(at.invalid(
                     &field,
                     "the scene has no motion with a loaded `area`: no limit pressure".into(),

@@ -37,6 +37,16 @@ pub struct Stepping {
     pub workers: Workers,
 }
 
+/// The discretisation error of the answer, for `run` and `fos` alike.
+#[derive(clap::Args, Clone, Copy)]
+pub struct Refining {
+    /// Also run the analysis at h/2 and h/4 (`--refine 2`: h/2 only) and report the
+    /// extrapolated answer and the discretisation error of the answer at h (in
+    /// summary.json too); the finer runs go into <out>/refine/.
+    #[arg(long, value_name = "LEVELS", num_args = 0..=1, default_missing_value = "3")]
+    pub refine: Option<u32>,
+}
+
 #[derive(Subcommand)]
 pub enum Command {
     /// Run a scene to static equilibrium (or its step/time limit).
@@ -49,11 +59,8 @@ pub enum Command {
         /// Override a scene field, e.g. --set solver.tolerance=1e-4 (repeatable).
         #[arg(long = "set", value_name = "PATH=VALUE")]
         overrides: Vec<String>,
-        /// Also run the analysis at h/2 and h/4 (`--refine 2`: h/2 only) and report the
-        /// extrapolated answer and the discretisation error of the answer at h (in
-        /// summary.json too); the finer runs go into <out>/refine/.
-        #[arg(long, value_name = "LEVELS", num_args = 0..=1, default_missing_value = "3")]
-        refine: Option<u32>,
+        #[command(flatten)]
+        refining: Refining,
         #[command(flatten)]
         stepping: Stepping,
         /// Write a Chrome trace (chrome://tracing, Perfetto) of every system call to FILE
@@ -94,11 +101,8 @@ pub enum Command {
         /// Override a scene field (repeatable).
         #[arg(long = "set", value_name = "PATH=VALUE")]
         overrides: Vec<String>,
-        /// Also run the analysis at h/2 and h/4 (`--refine 2`: h/2 only) and report the
-        /// extrapolated answer and the discretisation error of the answer at h (in
-        /// summary.json too); the finer runs go into <out>/refine/.
-        #[arg(long, value_name = "LEVELS", num_args = 0..=1, default_missing_value = "3")]
-        refine: Option<u32>,
+        #[command(flatten)]
+        refining: Refining,
         #[command(flatten)]
         workers: Workers,
     },

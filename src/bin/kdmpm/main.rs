@@ -1,8 +1,9 @@
 //! The `kdmpm` command line: run or check a scene.
 //!
-//! The binary parses the command line (`cli.rs`) and reports; the library runs: [`kdmpm::run::Run`]
-//! for `run` and `resume`, [`kdmpm::fos`], [`kdmpm::refine`] and [`kdmpm::study`]. Bad input exits with 2, a
-//! run that went wrong with 1, an interrupted one with 130.
+//! The binary parses the command line (`cli.rs`) and reports; the library runs:
+//! [`kdmpm::run::Run`] for `run` and `resume`, [`kdmpm::fos`], [`kdmpm::refine`] and
+//! [`kdmpm::study`]. Bad input exits with 2, a run that went wrong with 1, an interrupted
+//! one with 130.
 
 use clap::Parser;
 use cli::{Cli, Command, Stepping, Workers};
@@ -102,9 +103,9 @@ fn command(command: Command, comm: &Arc<Comm>) -> Result<ExitCode, Fault> {
             scene,
             out,
             overrides,
-            refine,
+            refining,
             workers,
-        } => run_fos(&scene, out, &overrides, refine, workers.quiet)?,
+        } => run_fos(&scene, out, &overrides, refining.refine, workers.quiet)?,
         Command::Resume { dir, stepping } => {
             let run = Run::resume(dir).quiet(stepping.workers.quiet).go();
             return report(run, stepping, comm);
@@ -113,13 +114,13 @@ fn command(command: Command, comm: &Arc<Comm>) -> Result<ExitCode, Fault> {
             scene,
             out,
             overrides,
-            refine,
+            refining,
             stepping,
             ..
         } => {
             let out = out.unwrap_or_else(|| default_out(&scene, "", "scene"));
             let loaded = LoadedScene::from_file(&scene, &overrides).map_err(Fault::bad)?;
-            if let Some(levels) = refine {
+            if let Some(levels) = refining.refine {
                 return run_refined(&loaded, &out, levels, stepping.workers.quiet, comm);
             }
             let run = Run::scene(loaded).into_dir(out).quiet(stepping.workers.quiet);
