@@ -75,6 +75,8 @@ pub struct FosReport {
     pub mechanism: String,
     /// Every trial, in the order run.
     pub trials: Vec<Trial>,
+    /// Steps of every trial together.
+    pub steps: u64,
     /// Wall-clock seconds of the whole analysis.
     pub wall_seconds: f64,
 }
@@ -221,6 +223,7 @@ pub fn strength_reduction(
         tolerance: spec.tolerance,
         failure_displacement: spec.failure_displacement,
         mechanism,
+        steps: trials.iter().map(|t| t.steps).sum(),
         trials,
         wall_seconds: start.elapsed().as_secs_f64(),
     };

@@ -24,7 +24,7 @@ use crate::fos::{FosError, FosReport, Trial};
 use crate::output::dir::write_atomic;
 use crate::output::Outcome;
 use crate::run::{Run, RunError, RunReport};
-use crate::scene::LoadedScene;
+use crate::scene::{CheckpointEvery, LoadedScene, Scene, TimeStep};
 use serde::Serialize;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -37,28 +37,48 @@ pub const LEVELS: std::ops::RangeInclusive<u32> = 2..=3;
 /// what counts steps (`max_steps`, `history_every`, snapshots and checkpoints every N
 /// steps, the strength reduction's `check_every`) multiplied, a fixed Δt divided, as the
 /// Courant number does by itself. Lengths, times, loads and points a cell side stay.
-pub fn finer(loaded: &LoadedScene, ratio: u32) -> LoadedScene {
-    let mut l = loaded.clone();
-    let (s, r) = (&mut l.scene, u64::from(ratio));
-    s.grid.cell_size /= f64::from(ratio);
-    s.grid.cells.iter_mut().for_each(|c| *c *= ratio as usize);
-    if let crate::scene::TimeStep::Fixed(dt) = &mut s.solver.time_step {
-        *dt /= f64::from(ratio);
+///
+/// The changes are made to the scene's text ([`finer_overrides`]), so that a checkpoint of
+/// the finer run, which keeps the text, resumes at the finer cell size.
+pub fn finer(loaded: &LoadedScene, ratio: u32) -> Result<LoadedScene, crate::error::SceneError> {
+    loaded.with_overrides(&finer_overrides(&loaded.scene, ratio))
+}
+
+/// The `path=value` overrides that make [`finer`]'s scene: the one list of what a
+/// refinement changes, which `kdmpm study`'s `Refine` axis passes to its runs as well.
+pub fn finer_overrides(s: &Scene, ratio: u32) -> Vec<String> {
+    let r = u64::from(ratio);
+    let times = |n: u64| n.saturating_mul(r);
+    let cells: Vec<String> = s
+        .grid
+        .cells
+        .iter()
+        .map(|&c| (c * ratio as usize).to_string())
+        .collect();
+    let mut o = vec![
+        format!("grid.cell_size={:?}", s.grid.cell_size / f64::from(ratio)),
+        format!("grid.cells=[{}]", cells.join(", ")),
+        format!("output.history_every={}", times(s.output.history_every)),
+    ];
+    if let TimeStep::Fixed(dt) = s.solver.time_step {
+        o.push(format!("solver.time_step=Fixed({:?})", dt / f64::from(ratio)));
     }
-    if let Some(n) = &mut s.solver.max_steps {
-        *n = n.saturating_mul(r);
+    if let Some(n) = s.solver.max_steps {
+        o.push(format!("solver.max_steps={}", times(n)));
     }
-    s.output.history_every = s.output.history_every.saturating_mul(r);
-    if let Some(n) = s.output.snapshots.as_mut().and_then(|sn| sn.every_steps.as_mut()) {
-        *n = n.saturating_mul(r);
+    if let Some(n) = s.output.snapshots.as_ref().and_then(|sn| sn.every_steps) {
+        o.push(format!("output.snapshots.every_steps={}", times(n)));
     }
-    if let Some(crate::scene::CheckpointEvery::Steps(n)) = &mut s.solver.checkpoint_every {
-        *n = n.saturating_mul(r);
+    if let Some(CheckpointEvery::Steps(n)) = s.solver.checkpoint_every {
+        o.push(format!("solver.checkpoint_every=Steps({})", times(n)));
     }
-    if let Some(sr) = &mut s.strength_reduction {
-        sr.check_every = sr.check_every.saturating_mul(r);
+    if let Some(sr) = &s.strength_reduction {
+        o.push(format!(
+            "strength_reduction.check_every={}",
+            times(sr.check_every)
+        ));
     }
-    l
+    o
 }
 
 /// One answer of a refinement.
@@ -307,7 +327,7 @@ fn refine<T>(
     let mut levels = Vec::new();
     for k in 0..count {
         let ratio = 1u32 << k;
-        let scene = finer(loaded, ratio);
+        let scene = finer(loaded, ratio).map_err(|e| RefineError::NotRefinable(e.to_string()))?;
         let h = scene.scene.grid.cell_size;
         let (dir, rel) = level_dir(out, ratio, h);
         let (report, value, resolution, wall_seconds) = at(scene, dir, h)?;

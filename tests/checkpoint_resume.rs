@@ -258,7 +258,7 @@ fn a_staged_run_resumed_in_its_second_stage_writes_the_same_files() {
     resume_from_last_checkpoint("bar.ron", 2_000, &[stages]);
 }
 
-/// The footing, checkpointed in its sixth increment (step 5 000 of 8 743): the motion's
+/// The footing, checkpointed in its sixth increment (step 5 000 of 7 753): the motion's
 /// travel, its hold and the curve so far come back with the points.
 #[test]
 fn the_footing_resumed_in_the_middle_of_an_increment_writes_the_same_curve() {

@@ -30,19 +30,15 @@ fn strength_reduction_divides_cohesion_and_the_tangents_of_the_angles() {
 
 /// Griffiths & Lane (1999, Géotechnique 49(3), example 1): H = 10 m, 2:1 face, firm base
 /// at the toe, c′ = 10 kPa, φ′ = 20°, ψ = 0: FoS = 1.4 by finite elements (Bishop and
-/// Morgenstern's charts: 1.38): within ±0.07 of 1.4, and pinned to the bracket the
-/// deterministic trials give, 1.40625–1.421875 (README).
+/// Morgenstern's charts: 1.38; Bishop's simplified method 1.378). The scene, with its
+/// volumetric smoothing, is pinned to the bracket its deterministic trials give,
+/// 1.375–1.390625 (1.383, +0.3 % on Bishop; README).
 #[test]
-fn the_griffiths_lane_slope_has_a_factor_of_safety_of_1_4() {
+fn the_griffiths_lane_slope_has_bishops_factor_of_safety() {
     let out = common::scratch("fos", "griffiths-lane");
     let r = strength_reduction(&slope(), &out, |_| {}).expect("the bracket holds the factor");
-    assert!(
-        (r.factor_of_safety - 1.4).abs() <= 0.07,
-        "FoS {}",
-        r.factor_of_safety
-    );
     assert!(r.bracket[1] - r.bracket[0] <= 0.02, "{:?}", r.bracket);
-    assert_eq!(r.bracket, [1.40625, 1.421875]);
+    assert_eq!(r.bracket, [1.375, 1.390625]);
     // Every standing trial lies below every failing one.
     let stands = r
         .trials

@@ -39,7 +39,7 @@ fn a_softening_soil_whose_residual_is_its_peak_runs_as_mohr_coulomb_bit_for_bit(
 }
 
 /// Softening lowers the factor of safety of the Griffiths–Lane slope below the one of its
-/// peak strength (1.4, pinned in tests/fos.rs), and not as far as the one of its residual
+/// peak strength (1.383, pinned in tests/fos.rs), and not as far as the one of its residual
 /// strength alone: failure progresses from the points that yield first, while the others
 /// keep their peak.
 #[test]

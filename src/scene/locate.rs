@@ -238,7 +238,13 @@ pub fn override_edit(text: &str, assignment: &str) -> Result<(String, Edit), Sce
                     open = descend(text, v).ok_or_else(|| err(&format!("`{name}` holds no fields")))?
                 }
                 None if last => return Ok(edit(open + 1, 0, format!(" {name}: {value},"))),
-                None => return Err(err(&format!("no field `{name}` in the scene"))),
+                // A struct the file leaves to its defaults: written with the one field set
+                // (`output.history_every=8` on a scene without `output`).
+                None => {
+                    let nested = nest(&segs[k..], value)
+                        .ok_or_else(|| err(&format!("no field `{name}` in the scene")))?;
+                    return Ok(edit(open + 1, 0, format!(" {nested},")));
+                }
             },
             Seg::Index(i) => {
                 let e = element(text, open, i).ok_or_else(|| err(&format!("no element [{i}]")))?;
@@ -251,6 +257,16 @@ pub fn override_edit(text: &str, assignment: &str) -> Result<(String, Edit), Sce
         }
     }
     Err(err("empty path"))
+}
+
+/// `a: (b: (c: value))` for the fields `a.b.c`; `None` when a segment is an index.
+fn nest(segs: &[Seg], value: &str) -> Option<String> {
+    let (first, rest) = segs.split_first()?;
+    let Seg::Field(name) = first else { return None };
+    if rest.is_empty() {
+        return Some(format!("{name}: {value}"));
+    }
+    Some(format!("{name}: ({})", nest(rest, value)?))
 }
 
 enum Seg<'a> {
@@ -516,7 +532,11 @@ Scene(
         let t = apply_override(TEXT, "materials.soil.friction_angle=35").unwrap();
         assert!(t.contains("friction_angle: 35)"), "{t}");
         assert!(apply_override(TEXT, "solver").is_err());
-        assert!(apply_override(TEXT, "nope.field=1").is_err());
+        // A struct the text leaves out is written with the one field (the scene's own
+        // parse then refuses a name it does not know); a missing element cannot be.
+        let t = apply_override(TEXT, "nope.field=1").unwrap();
+        assert!(t.contains("nope: (field: 1),"), "{t}");
+        assert!(apply_override(TEXT, "nope[0].field=1").is_err());
     }
 
     #[test]

@@ -481,9 +481,31 @@ impl LoadedScene {
 
     /// Parses scene text; `path` is used in messages.
     pub fn from_text(path: &Path, text: &str, overrides: &[String]) -> Result<Self, SceneError> {
-        let original = text;
-        let mut text = text.to_string();
-        let mut edits = Vec::new();
+        Self::edited(path, text, text.to_string(), Vec::new(), overrides)
+    }
+
+    /// This scene with more overrides applied to its text, as if they had followed its own
+    /// on the command line: the text (which a checkpoint keeps) says what runs, and messages
+    /// still point into the file as written.
+    pub fn with_overrides(&self, overrides: &[String]) -> Result<Self, SceneError> {
+        Self::edited(
+            &self.path,
+            &self.source,
+            self.text.clone(),
+            self.edits.clone(),
+            overrides,
+        )
+    }
+
+    /// Parses `text`, `original` (the file as written) edited by `edits`, after applying
+    /// `overrides` to it.
+    fn edited(
+        path: &Path,
+        original: &str,
+        mut text: String,
+        mut edits: Vec<locate::Edit>,
+        overrides: &[String],
+    ) -> Result<Self, SceneError> {
         for o in overrides {
             let (t, e) = locate::override_edit(&text, o)?;
             text = t;

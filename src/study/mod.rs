@@ -66,7 +66,7 @@ impl StudyError {
 /// Refuses a reference run that did not converge: it ended at its step or time limit, or
 /// failed, so its figures are not the static answer the other runs are compared with.
 pub fn check_reference(reference: &Finished) -> Result<(), StudyError> {
-    if reference.outcome == "converged" {
+    if report::answered(&reference.outcome) {
         return Ok(());
     }
     Err(StudyError::Reference(format!(
@@ -147,7 +147,7 @@ pub fn run_one(
         }
     }
     let mut cmd = Command::new(&launch.exe);
-    cmd.arg("run")
+    cmd.arg(study.command())
         .arg(&study.scene)
         .arg("--out")
         .arg(&out)
@@ -192,6 +192,7 @@ pub fn run_one(
     let summary = read_summary(&out);
     let outcome = match (&status, &summary) {
         (None, _) => "timeout".to_string(),
+        (Some(_), Some(s)) if s.get("factor_of_safety").is_some() => report::BRACKETED.into(),
         (Some(_), Some(s)) => s["outcome"].as_str().unwrap_or("unknown").to_string(),
         (Some(st), None) => match st.code() {
             Some(2) => "bad input (exit 2)".into(),

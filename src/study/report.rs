@@ -5,6 +5,15 @@ use super::spec::{expected, read, relative_error, Axis, Compare, Study};
 use super::Finished;
 use std::fmt::Write;
 
+/// The outcome of a `kdmpm fos` run that bracketed its factor of safety.
+pub const BRACKETED: &str = "bracketed";
+
+/// True when a run gave its answer: a run that stopped at a static state (`converged`), or
+/// a strength reduction that bracketed its factor of safety.
+pub fn answered(outcome: &str) -> bool {
+    outcome == "converged" || outcome == BRACKETED
+}
+
 /// One run's figures.
 #[derive(Clone, Debug)]
 pub struct Row {
@@ -64,7 +73,7 @@ impl Row {
     /// The run's accuracy: the largest |relative error| over the quantities, when the run
     /// stopped at a static state and gave them all.
     pub fn worst_error(&self) -> Option<f64> {
-        if self.outcome != "converged" {
+        if !answered(&self.outcome) {
             return None;
         }
         self.errors
@@ -196,7 +205,7 @@ pub fn convergence_orders(study: &Study, rows: &[Row]) -> Vec<Order> {
             }
             for pair in members.windows(2) {
                 let ((r1, a), (r2, b)) = (pair[0], pair[1]);
-                if a.outcome != "converged" || b.outcome != "converged" || r1 == r2 {
+                if !answered(&a.outcome) || !answered(&b.outcome) || r1 == r2 {
                     continue;
                 }
                 let (Some(e1), Some(e2)) = (a.errors[q], b.errors[q]) else {

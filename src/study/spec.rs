@@ -113,6 +113,9 @@ pub enum Quantity {
     StopTime,
     /// The limit pressure of the scene's motions (Pa; needs a motion with a loaded `area`).
     LimitPressure,
+    /// The factor of safety by strength reduction (needs `strength_reduction`): each run
+    /// is a `kdmpm fos` analysis, so a study of it measures nothing else.
+    FactorOfSafety,
 }
 
 /// The value a quantity is compared with.
@@ -163,6 +166,15 @@ pub struct Study {
 }
 
 impl Study {
+    /// The `kdmpm` command each run is: `fos` for a study of the factor of safety, `run`
+    /// otherwise.
+    pub fn command(&self) -> &'static str {
+        match self.spec.quantities.first().map(|q| &q.of) {
+            Some(Quantity::FactorOfSafety) => "fos",
+            _ => "run",
+        }
+    }
+
     /// Reads, parses and checks a study file, and builds and validates every run's scene.
     pub fn from_file(path: &Path) -> Result<Self, SceneError> {
         let text = std::fs::read_to_string(path).map_err(|source| SceneError::Read {
@@ -181,7 +193,7 @@ impl Study {
             .map_err(|e| at.invalid("scene", format!("the base scene with the study's `set`: {e}")))?;
         check_axes(&spec, &at)?;
         let combos = combinations(&spec, &at)?;
-        let mut runs = plan_runs(&spec, &base, combos, &at)?;
+        let mut runs = plan_runs(&spec, &scene_path, combos, &at)?;
         let mut reference = spec.reference.as_ref().map(|r| Planned {
             id: "reference".into(),
             values: Vec::new(),
@@ -305,30 +317,33 @@ fn combinations(spec: &StudySpec, at: &Place) -> Result<Vec<Vec<String>>, SceneE
     Ok(combos)
 }
 
-/// One planned run a combination: the study's `set` and each axis's overrides.
+/// One planned run a combination: the study's `set` and each axis's overrides; a `Refine`
+/// factor last, as `--refine` makes its finer scenes ([`crate::refine::finer_overrides`])
+/// from the scene the other axes set.
 fn plan_runs(
     spec: &StudySpec,
-    base: &LoadedScene,
+    scene_path: &Path,
     combos: Vec<Vec<String>>,
     at: &Place,
 ) -> Result<Vec<Planned>, SceneError> {
     let mut runs = Vec::with_capacity(combos.len());
     for (k, values) in combos.into_iter().enumerate() {
         let mut overrides = spec.set.clone();
+        let mut ratio = 1;
         for (i, (axis, v)) in spec.axes.iter().zip(&values).enumerate() {
-            let field = || format!("axes[{i}]");
             match axis {
                 Axis::Set { path, .. } => overrides.push(format!("{path}={v}")),
                 Axis::Refine(_) => {
-                    let r: u32 = v
+                    ratio = v
                         .parse()
-                        .map_err(|_| at.invalid(&field(), format!("`{v}` is not a factor")))?;
-                    let g = &base.scene.grid;
-                    let cells: Vec<String> = g.cells.iter().map(|&n| (n * r as usize).to_string()).collect();
-                    overrides.push(format!("grid.cell_size={:e}", g.cell_size / r as f64));
-                    overrides.push(format!("grid.cells=[{}]", cells.join(", ")));
+                        .map_err(|_| at.invalid(&format!("axes[{i}]"), format!("`{v}` is not a factor")))?
                 }
             }
+        }
+        if ratio > 1 {
+            let with = LoadedScene::from_file(scene_path, &overrides)
+                .map_err(|e| at.invalid("axes", format!("run {} with {}: {e}", k + 1, values.join(", "))))?;
+            overrides.extend(crate::refine::finer_overrides(&with.scene, ratio));
         }
         runs.push(Planned {
             id: format!("run-{:03}", k + 1),
@@ -414,6 +429,12 @@ fn check_quantities(
                     "the scene does not measure the surface angle (output.surface_angle)".into(),
                 ));
             }
+            Quantity::FactorOfSafety if base.scene.strength_reduction.is_none() => {
+                return Err(at.invalid(
+                    &field,
+                    "the scene has no `strength_reduction`: no factor of safety".into(),
+                ));
+            }
             Quantity::LimitPressure if !base.scene.has_limit_pressure() => {
                 return Err(at.invalid(
                     &field,
@@ -451,6 +472,15 @@ fn check_quantities(
                 ));
             }
             _ => {}
+        }
+        let analysis = |q: &QuantitySpec| matches!(q.of, Quantity::FactorOfSafety);
+        if analysis(q) != analysis(&spec.quantities[0]) {
+            return Err(at.invalid(
+                &field,
+                "a factor of safety is the answer of a whole strength reduction (`kdmpm fos`), not \
+                 of one run: a study of it measures nothing else"
+                    .into(),
+            ));
         }
         if spec.quantities[..k].iter().any(|p| p.name == q.name) {
             return Err(at.invalid(&field, format!("the name `{}` is used twice", q.name)));
@@ -500,6 +530,7 @@ pub fn read(q: &Quantity, summary: &serde_json::Value) -> Option<(f64, Option<[f
         Quantity::MaxDisplacement => Some((summary["max_displacement"].as_f64()?, None)),
         Quantity::StopTime => Some((summary["time"].as_f64()?, None)),
         Quantity::LimitPressure => Some((summary["limit_pressure"].as_f64()?, None)),
+        Quantity::FactorOfSafety => Some((summary["factor_of_safety"].as_f64()?, None)),
     }
 }
 
