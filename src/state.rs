@@ -152,6 +152,8 @@ pub struct Settings {
     pub min_node_mass: f64,
     /// Prescribed motions (displacement control), in scene order.
     pub motions: Vec<MotionSpec>,
+    /// The scene's `Friction` faces: (normal axis, upper face, tan δ).
+    pub friction_faces: Vec<(usize, bool, f64)>,
     /// Loading stages, in order; the first is the scene as built.
     pub stages: Vec<LoadStage>,
     /// Loads applied in increments (load control), each increment to its static stop.

@@ -190,6 +190,9 @@ fn face_fixity<D: Dim>(grid: &Grid<D>, faces: &[FaceHold]) -> Vec<NodeFixity> {
         for (id, f) in fixity.iter_mut().enumerate() {
             if grid.node_ijk(id)[face.axis] == layer {
                 f.0 |= face.mask;
+                if face.friction.is_some() {
+                    f.0 |= NodeFixity::FRICTION;
+                }
             }
         }
     }
@@ -295,6 +298,11 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         }),
         min_node_mass: s.solver.node_mass_cutoff * full_node_mass,
         motions: s.motions.clone(),
+        friction_faces: checked_grid
+            .faces
+            .iter()
+            .filter_map(|f| f.friction.map(|mu| (f.axis, f.upper, mu)))
+            .collect(),
         stages: stages(&grid, loaded, checked_stages, &load_ids, &placed.shares),
         load_steps: placed.steps,
         virtual_mass_floor: s.solver.virtual_mass_floor * full_node_mass,

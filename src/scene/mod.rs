@@ -168,12 +168,17 @@ fn default_fos_check_every() -> u64 {
 }
 
 /// Condition on a grid face.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub enum Condition {
     /// All velocity components zero.
     Fixed,
     /// Normal velocity component zero (free sliding).
     Roller,
+    /// Normal velocity component zero, and Coulomb friction along the face: the soil slides
+    /// once its shear force reaches tan δ times the force it presses on the face with,
+    /// δ in degrees (0 ≤ δ < 90; 0 is a roller). A rough base under a slope, a block
+    /// pushed along a base.
+    Friction(f64),
 }
 
 /// A boundary condition on one face of the grid.

@@ -44,6 +44,14 @@ impl<D: Dim> System<D> for Boundary {
             Disjoint::new(&mut ne),
         );
         let grid = &ctx.grid;
+        let st = &ctx.settings;
+        let friction = Friction {
+            faces: &st.friction_faces,
+            drives,
+            dt: st.dt,
+            min_mass: st.min_node_mass,
+            floor: st.virtual_mass_floor,
+        };
         let parts = grid_pass(grid, ctx.state.active_nodes, &target, |b, (np, nf, ne), first| {
             let mut reactions = vec![[0.0; 3]; velocities.len()];
             for i in b.rows(grid).flatten() {
@@ -52,6 +60,9 @@ impl<D: Dim> System<D> for Boundary {
                     continue;
                 }
                 let k = i - first;
+                if f.0 & NodeFixity::FRICTION != 0 {
+                    friction.apply(grid, i, nm[i].0, &np[k].0, &mut nf[k].0, f);
+                }
                 for a in 0..D::N {
                     match hold(f, a, drives) {
                         Hold::Free => continue,
@@ -74,6 +85,63 @@ impl<D: Dim> System<D> for Boundary {
                 .fold([0.0; 3], |s, p| std::array::from_fn(|a| s[a] + p[d][a]));
         }
         Ok(())
+    }
+}
+
+/// Coulomb friction on the nodes of `Friction` faces, before their normal component is held.
+struct Friction<'a> {
+    faces: &'a [(usize, bool, f64)],
+    drives: &'a [Drive],
+    dt: f64,
+    min_mass: f64,
+    floor: f64,
+}
+
+impl Friction<'_> {
+    /// On each friction face through node `i` (mass `m`, momentum `p`, force `f`): the force
+    /// the face must supply to hold the normal component, R = p_n m̃/(m Δt) + f_n (outward
+    /// positive, m̃ the node's inertia as `integrate` takes it), and when the node presses
+    /// on the face (R > 0), a tangential force that stops the node's trial tangential
+    /// velocity v_t* = p_t/m + f_t Δt/m̃, at most tan δ · R (Coulomb; it slides beyond).
+    /// Axes another face holds fixed are left to it; on an axis a motion drives, the
+    /// friction enters the motion's reaction.
+    fn apply<D: Dim>(
+        &self,
+        grid: &crate::grid::Grid<D>,
+        i: usize,
+        m: f64,
+        p: &D::Vec,
+        f: &mut D::Vec,
+        fixity: NodeFixity,
+    ) {
+        if !grid.carries(i, m, self.min_mass) {
+            return;
+        }
+        let inertia = grid.inertia(i, m, self.floor);
+        let ijk = grid.node_ijk(i);
+        for &(axis, upper, mu) in self.faces {
+            let layer = if upper { grid.axes[axis].cells } else { 0 };
+            if ijk[axis] != layer {
+                continue;
+            }
+            let outward = if upper { 1.0 } else { -1.0 };
+            let push = outward * (p.get(axis) * inertia / (m * self.dt) + f.get(axis));
+            if push <= 0.0 {
+                continue;
+            }
+            let mut stop = [0.0; 3];
+            for (a, s) in stop.iter_mut().enumerate().take(D::N) {
+                // A driven axis feels the friction too: the motion's reaction includes it.
+                if a != axis && hold(fixity, a, self.drives) != Hold::Fixed {
+                    *s = -(p.get(a) / m + f.get(a) * self.dt / inertia) * inertia / self.dt;
+                }
+            }
+            let size = stop.iter().map(|s| s * s).sum::<f64>().sqrt();
+            let scale = if size > mu * push { mu * push / size } else { 1.0 };
+            for (a, s) in stop.iter().enumerate().take(D::N) {
+                f.set(a, f.get(a) + s * scale);
+            }
+        }
     }
 }
 

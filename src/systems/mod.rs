@@ -702,6 +702,7 @@ mod tests {
             flip: 1.0,
             min_node_mass: 0.0,
             motions: Vec::new(),
+            friction_faces: Vec::new(),
             stages: Vec::new(),
             load_steps: Vec::new(),
             virtual_mass_floor: 0.0,

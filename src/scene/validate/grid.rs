@@ -23,15 +23,17 @@ pub struct CheckedGrid {
 }
 
 /// One face condition, as the nodes on that face carry it.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FaceHold {
     /// The face's normal axis.
     pub axis: usize,
     /// The upper face (x = max) rather than the lower (x = origin).
     pub upper: bool,
     /// The held velocity components, one bit an axis (`NodeFixity`'s low bits): every axis
-    /// for `Fixed`, the normal one for `Roller`.
+    /// for `Fixed`, the normal one for `Roller` and `Friction`.
     pub mask: u8,
+    /// tan δ of a `Friction` face.
+    pub friction: Option<f64>,
 }
 
 /// Checks a list of face conditions (`field`: where it is in the scene): faces of the
@@ -55,17 +57,31 @@ pub(super) fn check_faces(
                 format!("{field}[{i}].face"),
                 format!(
                     "{:?} already has a condition ({field}[{j}]): give each face one condition \
-                     (Fixed holds every component, Roller the normal one)",
+                     (Fixed holds every component, Roller and Friction the normal one)",
                     bc.face
                 ),
             ));
         }
         let (axis, upper) = bc.face.axis_side();
-        let mask = match bc.condition {
-            Condition::Fixed => (1u8 << n) - 1,
-            Condition::Roller => 1u8 << axis,
+        let (mask, friction) = match bc.condition {
+            Condition::Fixed => ((1u8 << n) - 1, None),
+            Condition::Roller => (1u8 << axis, None),
+            Condition::Friction(angle) => {
+                if !(angle.is_finite() && (0.0..90.0).contains(&angle)) {
+                    return Err((
+                        format!("{field}[{i}].condition"),
+                        format!("the friction angle is 0 ≤ δ < 90°, found {angle}"),
+                    ));
+                }
+                (1u8 << axis, Some(angle.to_radians().tan()))
+            }
         };
-        holds.push(FaceHold { axis, upper, mask });
+        holds.push(FaceHold {
+            axis,
+            upper,
+            mask,
+            friction,
+        });
     }
     Ok(holds)
 }

@@ -99,6 +99,14 @@ pub(super) fn check_stages(
             ),
             None => None,
         };
+        if let Some(i) = faces.iter().flatten().position(|f| f.friction.is_some()) {
+            return r.bad(
+                &format!("stages[{k}].boundaries[{i}].condition"),
+                "a stage does not set Friction faces yet: give the friction face to the scene's \
+                 own `boundaries`, which the stages keep unless they replace them"
+                    .into(),
+            );
+        }
         if let Some(g) = &st.gravity {
             if s.gravity.is_none() {
                 return r.bad(
