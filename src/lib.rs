@@ -57,6 +57,7 @@ pub mod systems;
 pub mod tensor;
 #[cfg(test)]
 mod testing;
+pub mod water;
 
 pub use context::Context;
 pub use dim::{Dim, Dim2, Dim3};

@@ -150,6 +150,8 @@ pub struct Settings {
     /// Leaving a node out drops its share of Σ_i ∇w_ip = 0, which acts as a spurious force
     /// V_p σ_p ∇w_ip: keep this tiny and tame light nodes with `virtual_mass_floor`.
     pub min_node_mass: f64,
+    /// The water table, if any.
+    pub water: Option<crate::water::Water>,
     /// Prescribed motions (displacement control), in scene order.
     pub motions: Vec<MotionSpec>,
     /// The scene's `Friction` faces: (normal axis, upper face, tan δ).

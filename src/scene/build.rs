@@ -250,6 +250,7 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         time_step: dt,
         unused_materials,
         estimate,
+        water,
     } = checked;
     let s: &Scene = &loaded.scene;
     let grid = new_grid::<D>(&checked_grid);
@@ -259,9 +260,20 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         ids: body_ids,
         next_id,
         full_node_mass,
-    } = spawn_bodies(loaded, &grid, &table, &mut world)?;
+    } = spawn_bodies(loaded, &grid, &table, water.as_ref(), &mut world)?;
     let touched = touched_nodes(&world, &grid, s.shape);
     validate::check_motion_boxes(loaded, &grid, &touched)?;
+    if let Some(w) = &water {
+        let positions: Vec<[f64; 3]> = points_with::<Position<D::Vec>>(&world)
+            .flat_map(|a| {
+                col::<Position<D::Vec>>(a)
+                    .iter()
+                    .map(|x| D::vec_to3(x.0))
+                    .collect::<Vec<_>>()
+            })
+            .collect();
+        validate::check_ground(loaded, &grid, w, positions.into_iter())?;
+    }
     let (load_ids, _) = spawn_point_loads(loaded, &grid, &mut world, &touched, next_id)?;
     let placed = super::tractions::place::<D>(&mut world, loaded, &body_ids)?;
 
@@ -298,6 +310,7 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         }),
         min_node_mass: s.solver.node_mass_cutoff * full_node_mass,
         motions: s.motions.clone(),
+        water,
         friction_faces: checked_grid
             .faces
             .iter()
@@ -405,6 +418,7 @@ fn spawn_bodies<D: Dim>(
     loaded: &LoadedScene,
     grid: &Grid<D>,
     table: &[(String, MaterialModel)],
+    water: Option<&crate::water::Water>,
     world: &mut World,
 ) -> Result<Bodies, SceneError> {
     let s = &loaded.scene;
@@ -457,7 +471,7 @@ fn spawn_bodies<D: Dim>(
                 "the body holds no material point (is it smaller than a sub-cell?)",
             ));
         }
-        let spawned = spawn_body::<D>(loaded, b, table, world, xs, count, next_id)?;
+        let spawned = spawn_body::<D>(loaded, b, table, water, world, xs, next_id)?;
         full_node_mass = full_node_mass.min(spawned.full_node_mass);
         body_ids.push(next_id..spawned.next_id);
         next_id = spawned.next_id;
@@ -477,17 +491,18 @@ struct Spawned {
     full_node_mass: f64,
 }
 
-/// Spawns body `b`'s `count` points `xs` (positions and ids from `first`) as one column batch
-/// of its material's columns.
+/// Spawns body `b`'s points `xs` (positions and ids from `first`, as many as `xs.left`) as
+/// one column batch of its material's columns.
 fn spawn_body<D: Dim>(
     loaded: &LoadedScene,
     b: usize,
     table: &[(String, MaterialModel)],
+    water: Option<&crate::water::Water>,
     world: &mut World,
     xs: Counted<impl Iterator<Item = ([f64; 3], u32)> + Clone>,
-    count: usize,
     first: u32,
 ) -> Result<Spawned, SceneError> {
+    let count = xs.left;
     let s = &loaded.scene;
     let body = &s.bodies[b];
     let z = D::Vec::ZERO;
@@ -501,6 +516,15 @@ fn spawn_body<D: Dim>(
     let state = carried_state(loaded, table, &body.material).expect("validated");
     let volume = cell_volume / body.points_per_cell.iter().product::<usize>() as f64;
     let mass = model.density() * volume;
+    // Below the water table a point weighs its material's saturated density.
+    let saturated = water.zip(s.water.as_ref()).and_then(|(w, spec)| {
+        let rho = *spec.saturated_density.get(&body.material)?;
+        Some((w, rho * volume))
+    });
+    let mass_at = |x: [f64; 3]| match saturated {
+        Some((w, m)) if w.below(x) => m,
+        _ => mass,
+    };
     let next_id = u32::try_from(count)
         .ok()
         .and_then(|c| first.checked_add(c))
@@ -532,9 +556,9 @@ fn spawn_body<D: Dim>(
     }
     let batch = columns.into_batch(count as u32);
     fill(&batch, xs.clone().map(|(_, id)| PointId(id)));
-    fill(&batch, xs.map(|(x, _)| Position(D::vec_from(x))));
+    fill(&batch, xs.clone().map(|(x, _)| Position(D::vec_from(x))));
     fill(&batch, std::iter::repeat_n(Velocity(z), count));
-    fill(&batch, std::iter::repeat_n(Mass(mass), count));
+    fill(&batch, xs.map(|(x, _)| Mass(mass_at(x))));
     fill(&batch, std::iter::repeat_n(Volume(volume), count));
     fill(&batch, std::iter::repeat_n(Stress(D::Stress::default()), count));
     fill(&batch, std::iter::repeat_n(VelocityGradient(D::MAT_ZERO), count));

@@ -43,6 +43,9 @@ pub struct Scene {
     /// Gravity, if any.
     #[serde(default)]
     pub gravity: Option<GravitySpec>,
+    /// A hydrostatic water table (drained pore pressure, effective stress), if any.
+    #[serde(default)]
+    pub water: Option<crate::water::WaterSpec>,
     /// Concentrated loads, each carried by a massless point that moves with the body.
     #[serde(default)]
     pub point_loads: Vec<PointLoadSpec>,

@@ -30,6 +30,7 @@ mod node_pairs;
 pub mod p2g;
 pub mod peak_watch;
 pub mod point_loads;
+pub mod pore_pressure;
 pub mod prescribed_motion;
 pub mod remap;
 pub mod spatial_sort;
@@ -51,6 +52,7 @@ pub use nodal_velocity::NodalVelocity;
 pub use p2g::{P2g, P2gPart};
 pub use peak_watch::PeakWatch;
 pub use point_loads::PointLoads;
+pub use pore_pressure::PorePressure;
 pub use prescribed_motion::PrescribedMotion;
 pub use remap::Remap;
 pub use spatial_sort::SpatialSort;
@@ -379,6 +381,20 @@ fn loading<D: Dim, S: Shape>() -> Vec<Entry<D>> {
             |_| Box::new(PointLoads::<D, S>::default()),
         ),
         e(
+            "pore_pressure",
+            St::Forces,
+            Needed(|s, _| s.water.is_some(), "the scene has water"),
+            &[
+                ("p2g", "the pore pressure adds to the internal force p2g maps"),
+                (
+                    "p2g_force",
+                    "the pore pressure adds to the internal force p2g_force maps",
+                ),
+            ],
+            "pore water: +Σ V u ∇w (total = effective − u I)",
+            |_| Box::new(PorePressure::<D, S>::default()),
+        ),
+        e(
             "boundary",
             St::Constrain,
             Always,
@@ -387,6 +403,7 @@ fn loading<D: Dim, S: Shape>() -> Vec<Entry<D>> {
                 ("p2g_force", COMPLETE),
                 ("gravity", COMPLETE),
                 ("point_loads", COMPLETE),
+                ("pore_pressure", COMPLETE),
             ],
             "held components: fixed at zero, or at a motion's velocity",
             |_| Box::new(Boundary),
@@ -702,6 +719,7 @@ mod tests {
             flip: 1.0,
             min_node_mass: 0.0,
             motions: Vec::new(),
+            water: None,
             friction_faces: Vec::new(),
             stages: Vec::new(),
             load_steps: Vec::new(),

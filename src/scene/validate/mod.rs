@@ -13,6 +13,7 @@ mod memory;
 mod motions;
 mod solver;
 mod stages;
+mod water;
 
 pub use grid::{CheckedGrid, FaceHold};
 pub(crate) use memory::carried_state;
@@ -28,6 +29,8 @@ use memory::check_memory;
 use motions::check_motions_and_analyses;
 use solver::{check_solver, time_step};
 use stages::check_stages;
+pub(crate) use water::check_ground;
+use water::check_water;
 
 use super::LoadedScene;
 use crate::error::SceneError;
@@ -113,6 +116,8 @@ pub struct Checked {
     pub unused_materials: Vec<String>,
     /// What the run will hold in memory, at most.
     pub estimate: Estimate,
+    /// The water table, if any.
+    pub water: Option<crate::water::Water>,
 }
 
 /// Names that label output (columns of `history.csv`, rows of `curve.csv` and
@@ -211,6 +216,7 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
     let step = time_step(&r, &table)?;
     let stages = check_stages(&r, &table, step.p_wave_speed)?;
     let estimate = check_memory(&r, &table)?;
+    let water = check_water(&r, &table)?;
     Ok(Checked {
         grid,
         materials: table,
@@ -220,5 +226,6 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
         time_step: step.dt,
         unused_materials: step.unused_materials,
         estimate,
+        water,
     })
 }
