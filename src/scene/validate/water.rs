@@ -35,7 +35,7 @@ pub(super) fn check_water(r: &Rules, table: &[(String, MaterialModel)]) -> Resul
         }
     }
     for (b, body) in s.bodies.iter().enumerate() {
-        let (lo, _) = super::super::build::region_bounds(&body.region, r.n);
+        let (lo, _) = crate::scene::region_bounds(&body.region, r.n);
         if lo[water.axis] < water.table && !spec.saturated_density.contains_key(&body.material) {
             return r.bad(
                 "water.saturated_density",
