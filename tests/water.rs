@@ -71,3 +71,49 @@ fn water_that_cannot_be_modelled_is_refused() {
         "{e}"
     );
 }
+
+/// With water, `points.vtu` and every snapshot hold the pore pressure and the total stress
+/// beside the (effective) `stress`: u = γ_w (table − y) at each point, σ = σ′ − u I.
+#[test]
+fn the_pore_pressure_and_the_total_stress_are_written_for_paraview() {
+    let dir = common::scratch("water", "vtu");
+    let o = common::run_into(
+        &common::scene("soil_column.ron"),
+        &dir,
+        &[WATER, "output.snapshots=(every_steps: 100)"],
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let snapshot = std::fs::read_dir(dir.join("snapshots"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|p| p.extension().is_some_and(|e| e == "vtu"))
+        .expect("a snapshot");
+    for file in [dir.join("points.vtu"), snapshot] {
+        let vtu = common::read_vtu(&file);
+        let (x, s, u, t) = (
+            &vtu["Points"].1,
+            &vtu["stress"].1,
+            &vtu["pore_pressure"].1,
+            &vtu["total_stress"].1,
+        );
+        assert_eq!(u.len() * 3, x.len());
+        let mut below = 0;
+        for p in 0..u.len() {
+            let want = 9810.0 * (8.0 - x[3 * p + 1]).max(0.0);
+            assert!((u[p] - want).abs() <= 1e-9 * want.max(1.0), "{file:?} point {p}");
+            below += usize::from(want > 0.0);
+            for k in 0..6 {
+                let shift = if k < 3 { u[p] } else { 0.0 };
+                assert_eq!(t[6 * p + k], s[6 * p + k] - shift, "{file:?} point {p}");
+            }
+        }
+        assert!(below > 0, "{file:?}: points below the table");
+    }
+    // A dry run writes neither.
+    let dry = common::scratch("water", "dry");
+    assert!(common::run_into(&common::scene("soil_column.ron"), &dry, &[])
+        .status
+        .success());
+    let vtu = common::read_vtu(&dry.join("points.vtu"));
+    assert!(!vtu.contains_key("pore_pressure") && !vtu.contains_key("total_stress"));
+}

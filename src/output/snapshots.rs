@@ -161,7 +161,12 @@ impl<D: Dim> System<D> for Snapshots<D> {
         let mut sender = lock(&self.sender);
         let Some(tx) = sender.as_ref() else { return Ok(()) };
         let mut frame = self.written.try_recv().unwrap_or_default();
-        frame.refill::<D>(&ctx.world, ctx.state.clock.step, ctx.state.clock.time);
+        frame.refill::<D>(
+            &ctx.world,
+            ctx.state.clock.step,
+            ctx.state.clock.time,
+            ctx.settings.water,
+        );
         let start = Instant::now();
         if tx.send(frame).is_err() {
             // The writer stopped on an error; finish() reports it. Stepping goes on.

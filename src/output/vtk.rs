@@ -7,6 +7,7 @@ use crate::infra::columns::{col, points_with};
 use crate::materials::extend_plastic_strain;
 use crate::simulation::Simulation;
 use crate::tensor::StoredSym;
+use crate::water::Water;
 use hecs::{Archetype, Component, World};
 use std::fs::File;
 use std::io::{BufWriter, Write};
@@ -25,6 +26,16 @@ enum Field {
     DeviatoricStress,
     Volume,
     PlasticStrain,
+    /// u = γ_w · depth below the water table (Pa, compression positive).
+    PorePressure,
+    /// σ = σ′ − u I (Pa, tension positive: xx yy zz xy yz zx).
+    TotalStress,
+}
+
+/// Pore pressure `u` at `x` and the total stress of the effective stress `s` there.
+fn total(water: &Water, x: [f64; 3], s: &[f64; 6]) -> [f64; 6] {
+    let u = water.pore_pressure(x);
+    [s[0] - u, s[1] - u, s[2] - u, s[3], s[4], s[5]]
 }
 
 /// Where a file's values come from: the live columns ([`write_points`]) or a copy taken
@@ -34,6 +45,8 @@ trait Source {
     fn len(&self) -> usize;
     /// True when displacements are kept (`output.displacements`).
     fn has_displacement(&self) -> bool;
+    /// The water table, when the scene has one (the stress is then effective).
+    fn water(&self) -> Option<Water>;
     /// Writes `field` of every point, in id order.
     fn write(&self, field: Field, out: &mut BufWriter<File>) -> std::io::Result<()>;
 }
@@ -115,6 +128,23 @@ fn arrays<S: Source>(src: &S) -> Vec<Array<'_>> {
             field(f),
         ));
     }
+    // With water the points' stress is effective: the pore pressure and the total stress
+    // beside it.
+    if src.water().is_some() {
+        for (name, components, f) in [
+            ("pore_pressure", 1, Field::PorePressure),
+            ("total_stress", 6, Field::TotalStress),
+        ] {
+            arrays.push(Array::new(
+                Part::PointData,
+                name,
+                Kind::Float64,
+                components,
+                n,
+                field(f),
+            ));
+        }
+    }
     let mut offset = 0;
     for array in &mut arrays {
         array.offset = offset;
@@ -128,7 +158,8 @@ fn arrays<S: Source>(src: &S) -> Vec<Array<'_>> {
 /// left them in, with its id, material (index in the scene's name order), displacement (m,
 /// when kept), velocity (m/s), stress (Pa, tension positive: xx yy zz xy yz zx), mean
 /// stress p and deviatoric stress q = √(3J₂) (Pa), volume (m³) and accumulated plastic
-/// strain (0 for bodies without plastic state).
+/// strain (0 for bodies without plastic state). With water the stress is effective, and the
+/// pore pressure (Pa, compression positive) and the total stress σ′ − u I follow.
 ///
 /// The arrays are raw little-endian binary in the file's appended section (VTK XML's
 /// `format="appended"`, `encoding="raw"`, 64-bit block headers), the form ParaView itself
@@ -140,7 +171,7 @@ fn arrays<S: Source>(src: &S) -> Vec<Array<'_>> {
 /// raise the run's peak memory. Snapshots during a run copy the points into a [`Frame`]
 /// instead, for the writer thread.
 pub fn write_points<D: Dim>(sim: &Simulation<D>, path: &Path) -> std::io::Result<()> {
-    let columns = Columns::<D>::of(&sim.ctx.world);
+    let columns = Columns::<D>::of(&sim.ctx.world, sim.ctx.settings.water);
     let arrays = arrays(&columns);
     crate::output::dir::write_atomic(path, |out| write_arrays(out, columns.len(), &arrays))
 }
@@ -153,7 +184,7 @@ pub fn write_parallel_points<D: Dim>(
     path: &Path,
     parts: &[String],
 ) -> std::io::Result<()> {
-    let columns = Columns::<D>::of(&sim.ctx.world);
+    let columns = Columns::<D>::of(&sim.ctx.world, sim.ctx.settings.water);
     let arrays = arrays(&columns);
     crate::output::dir::write_atomic(path, |out| {
         out.write_all(b"<?xml version=\"1.0\"?>\n<VTKFile type=\"PUnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n<PUnstructuredGrid GhostLevel=\"0\">\n")?;
@@ -190,11 +221,12 @@ struct Columns<'a, D: Dim> {
     order: Order,
     n: usize,
     displacements: bool,
+    water: Option<Water>,
     _marker: std::marker::PhantomData<fn() -> D>,
 }
 
 impl<'a, D: Dim> Columns<'a, D> {
-    fn of(world: &'a World) -> Self {
+    fn of(world: &'a World, water: Option<Water>) -> Self {
         let archs: Vec<&Archetype> = points_with::<Stress<D::Stress>>(world).collect();
         // Where the point of each id is: archetype in the high half, row in the low half (the
         // load carriers' ids are gaps).
@@ -212,6 +244,7 @@ impl<'a, D: Dim> Columns<'a, D> {
             order: Order(at),
             n,
             displacements,
+            water,
             _marker: std::marker::PhantomData,
         }
     }
@@ -223,6 +256,9 @@ impl<D: Dim> Source for Columns<'_, D> {
     }
     fn has_displacement(&self) -> bool {
         self.displacements
+    }
+    fn water(&self) -> Option<Water> {
+        self.water
     }
     fn write(&self, field: Field, out: &mut BufWriter<File>) -> std::io::Result<()> {
         let (archs, order) = (&self.archs[..], &self.order);
@@ -250,6 +286,27 @@ impl<D: Dim> Source for Columns<'_, D> {
                 f64s(out, &[invariants(&voigt::<D>(s)).1])
             }),
             Field::Volume => each::<Volume>(archs, order, out, |out, v| f64s(out, &[v.0])),
+            Field::PorePressure | Field::TotalStress => {
+                let w = self.water.expect("written only with water");
+                // Per archetype: each point's position and effective stress.
+                let points: Vec<Vec<([f64; 3], [f64; 6])>> = archs
+                    .iter()
+                    .map(|a| {
+                        let (x, s) = (col::<Position<D::Vec>>(a), col::<Stress<D::Stress>>(a));
+                        x.iter()
+                            .zip(s.iter())
+                            .map(|(x, s)| (D::vec_to3(x.0), voigt::<D>(s)))
+                            .collect()
+                    })
+                    .collect();
+                order.points().try_for_each(|(_, a, r)| {
+                    let (x, s) = points[a][r];
+                    match field {
+                        Field::PorePressure => f64s(out, &[w.pore_pressure(x)]),
+                        _ => f64s(out, &total(&w, x, &s)),
+                    }
+                })
+            }
             Field::PlasticStrain => {
                 let plastic: Vec<Vec<f64>> = archs
                     .iter()
@@ -290,21 +347,24 @@ pub struct Frame {
     pub volume: Vec<f64>,
     /// Accumulated plastic strain (0 without plastic state).
     pub plastic_strain: Vec<f64>,
+    /// The water table, when the scene has one (the stress is then effective).
+    pub water: Option<Water>,
 }
 
 impl Frame {
     /// Copies the points of `world` at `step` and `time` (about 140 bytes a point) in
     /// storage order: column by column, so the stepping thread only streams memory.
     /// [`Frame::in_id_order`] puts them in id order on the thread that writes them.
-    pub fn capture<D: Dim>(world: &World, step: u64, time: f64) -> Frame {
+    pub fn capture<D: Dim>(world: &World, step: u64, time: f64, water: Option<Water>) -> Frame {
         let mut f = Frame::default();
-        f.refill::<D>(world, step, time);
+        f.refill::<D>(world, step, time, water);
         f
     }
 
     /// [`Frame::capture`] into this frame's buffers, which keep their capacity: a frame
     /// handed back by the writer is filled again without touching fresh memory.
-    pub fn refill<D: Dim>(&mut self, world: &World, step: u64, time: f64) {
+    pub fn refill<D: Dim>(&mut self, world: &World, step: u64, time: f64, water: Option<Water>) {
+        self.water = water;
         let archs: Vec<&Archetype> = points_with::<Stress<D::Stress>>(world).collect();
         let n = archs.iter().map(|a| a.len() as usize).sum::<usize>();
         let displacements = n > 0 && archs.iter().all(|a| a.has::<Displacement<D::Vec>>());
@@ -351,7 +411,7 @@ impl Frame {
             PointId(id).place(&mut order, row as u32, u32::MAX);
         }
         order.retain(|&r| r != u32::MAX);
-        (sorted.step, sorted.time) = (self.step, self.time);
+        (sorted.step, sorted.time, sorted.water) = (self.step, self.time, self.water);
         permute(&self.material, &order, &mut sorted.material);
         permute(&self.position, &order, &mut sorted.position);
         match &self.displacement {
@@ -387,6 +447,9 @@ impl Source for Frame {
     fn has_displacement(&self) -> bool {
         self.displacement.is_some()
     }
+    fn water(&self) -> Option<Water> {
+        self.water
+    }
     fn write(&self, field: Field, out: &mut BufWriter<File>) -> std::io::Result<()> {
         // Whole columns at a time: a frame is written on the writer thread, which shares
         // the cores with stepping, so it costs what a copy costs.
@@ -417,6 +480,27 @@ impl Source for Frame {
             ),
             Field::Volume => f64_block(out, &self.volume),
             Field::PlasticStrain => f64_block(out, &self.plastic_strain),
+            Field::PorePressure => {
+                let w = self.water.expect("written only with water");
+                f64_block(
+                    out,
+                    &self
+                        .position
+                        .iter()
+                        .map(|&x| w.pore_pressure(x))
+                        .collect::<Vec<_>>(),
+                )
+            }
+            Field::TotalStress => {
+                let w = self.water.expect("written only with water");
+                let t: Vec<[f64; 6]> = self
+                    .position
+                    .iter()
+                    .zip(&self.stress)
+                    .map(|(&x, s)| total(&w, x, s))
+                    .collect();
+                f64_block(out, bytemuck::cast_slice(&t))
+            }
         }
     }
 }
