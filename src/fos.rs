@@ -77,6 +77,9 @@ pub struct FosReport {
     pub trials: Vec<Trial>,
     /// Steps of every trial together.
     pub steps: u64,
+    /// The water the trials held (pore pressures are not reduced), when the scene has some.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub water: Option<crate::water::WaterSpec>,
     /// Wall-clock seconds of the whole analysis.
     pub wall_seconds: f64,
 }
@@ -224,6 +227,7 @@ pub fn strength_reduction(
         failure_displacement: spec.failure_displacement,
         mechanism,
         steps: trials.iter().map(|t| t.steps).sum(),
+        water: loaded.scene.water.clone(),
         trials,
         wall_seconds: start.elapsed().as_secs_f64(),
     };

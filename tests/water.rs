@@ -117,3 +117,40 @@ fn the_pore_pressure_and_the_total_stress_are_written_for_paraview() {
     let vtu = common::read_vtu(&dry.join("points.vtu"));
     assert!(!vtu.contains_key("pore_pressure") && !vtu.contains_key("total_stress"));
 }
+
+/// `kdmpm fos` holds the pore pressures (they are not reduced with the strength) and says
+/// which water it used: Griffiths & Lane's slope at h = 1 m with a table 0.5 m above its
+/// base (the highest a level table may stand without open water at the toe) gives 1.398
+/// (1.3906–1.4062) against the dry 1.414 (1.4062–1.4219); the dry summary has no `water`.
+#[test]
+fn strength_reduction_holds_the_pore_pressures_and_names_the_water() {
+    let coarse = ["grid.cell_size=1.0", "grid.cells=[55, 12]"];
+    let fos = |name: &str, water: Option<&str>| {
+        let dir = common::scratch("water", name);
+        let scene = common::scene("slope_fos.ron");
+        let mut args = vec![
+            "fos",
+            scene.to_str().unwrap(),
+            "--quiet",
+            "--out",
+            dir.to_str().unwrap(),
+        ];
+        for s in coarse.iter().copied().chain(water) {
+            args.extend(["--set", s]);
+        }
+        let o = common::kdmpm(&args);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let text = std::fs::read_to_string(dir.join("summary.json")).unwrap();
+        serde_json::from_str::<serde_json::Value>(&text).unwrap()
+    };
+    let dry = fos("fos-dry", None);
+    let wet = fos(
+        "fos-wet",
+        Some(r#"water=(table: 0.5, saturated_density: {"soil": 2100.0})"#),
+    );
+    assert_eq!(dry["bracket"], serde_json::json!([1.40625, 1.421875]));
+    assert_eq!(wet["bracket"], serde_json::json!([1.390625, 1.40625]));
+    assert!(dry.get("water").is_none());
+    assert_eq!(wet["water"]["table"], 0.5);
+    assert_eq!(wet["water"]["saturated_density"]["soil"], 2100.0);
+}
