@@ -110,15 +110,24 @@ fn arrays<S: Source>(src: &S) -> Vec<Array<'_>> {
             field(Field::Displacement),
         ));
     }
-    // Bodies without plastic state (elastic) write a plastic strain of zero.
-    for (name, components, f) in [
+    // Bodies without plastic state (elastic) write a plastic strain of zero. With water the
+    // points' stress is effective: the pore pressure and the total stress follow it.
+    let water: &[(&str, usize, Field)] = match src.water() {
+        Some(_) => &[
+            ("pore_pressure", 1, Field::PorePressure),
+            ("total_stress", 6, Field::TotalStress),
+        ],
+        None => &[],
+    };
+    let fields = [
         ("velocity", 3, Field::Velocity),
         ("stress", 6, Field::Stress),
         ("mean_stress", 1, Field::MeanStress),
         ("deviatoric_stress", 1, Field::DeviatoricStress),
         ("volume", 1, Field::Volume),
         ("plastic_strain", 1, Field::PlasticStrain),
-    ] {
+    ];
+    for &(name, components, f) in fields.iter().chain(water) {
         arrays.push(Array::new(
             Part::PointData,
             name,
@@ -127,23 +136,6 @@ fn arrays<S: Source>(src: &S) -> Vec<Array<'_>> {
             n,
             field(f),
         ));
-    }
-    // With water the points' stress is effective: the pore pressure and the total stress
-    // beside it.
-    if src.water().is_some() {
-        for (name, components, f) in [
-            ("pore_pressure", 1, Field::PorePressure),
-            ("total_stress", 6, Field::TotalStress),
-        ] {
-            arrays.push(Array::new(
-                Part::PointData,
-                name,
-                Kind::Float64,
-                components,
-                n,
-                field(f),
-            ));
-        }
     }
     let mut offset = 0;
     for array in &mut arrays {
@@ -288,22 +280,14 @@ impl<D: Dim> Source for Columns<'_, D> {
             Field::Volume => each::<Volume>(archs, order, out, |out, v| f64s(out, &[v.0])),
             Field::PorePressure | Field::TotalStress => {
                 let w = self.water.expect("written only with water");
-                // Per archetype: each point's position and effective stress.
-                let points: Vec<Vec<([f64; 3], [f64; 6])>> = archs
-                    .iter()
-                    .map(|a| {
-                        let (x, s) = (col::<Position<D::Vec>>(a), col::<Stress<D::Stress>>(a));
-                        x.iter()
-                            .zip(s.iter())
-                            .map(|(x, s)| (D::vec_to3(x.0), voigt::<D>(s)))
-                            .collect()
-                    })
-                    .collect();
+                // Read straight from the columns, in id order: no copy of the points.
+                let xs: Vec<_> = archs.iter().map(|a| col::<Position<D::Vec>>(a)).collect();
+                let ss: Vec<_> = archs.iter().map(|a| col::<Stress<D::Stress>>(a)).collect();
                 order.points().try_for_each(|(_, a, r)| {
-                    let (x, s) = points[a][r];
+                    let x = D::vec_to3(xs[a][r].0);
                     match field {
                         Field::PorePressure => f64s(out, &[w.pore_pressure(x)]),
-                        _ => f64s(out, &total(&w, x, &s)),
+                        _ => f64s(out, &total(&w, x, &voigt::<D>(&ss[a][r]))),
                     }
                 })
             }

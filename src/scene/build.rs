@@ -264,15 +264,7 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
     let touched = touched_nodes(&world, &grid, s.shape);
     validate::check_motion_boxes(loaded, &grid, &touched)?;
     if let Some(w) = &water {
-        let positions: Vec<[f64; 3]> = points_with::<Position<D::Vec>>(&world)
-            .flat_map(|a| {
-                col::<Position<D::Vec>>(a)
-                    .iter()
-                    .map(|x| D::vec_to3(x.0))
-                    .collect::<Vec<_>>()
-            })
-            .collect();
-        validate::check_ground(loaded, &grid, w, positions.into_iter())?;
+        validate::check_ground(loaded, &grid, w, &world)?;
     }
     let (load_ids, _) = spawn_point_loads(loaded, &grid, &mut world, &touched, next_id)?;
     let placed = super::tractions::place::<D>(&mut world, loaded, &body_ids)?;

@@ -3,9 +3,11 @@
 //! everywhere is checked once the points are placed ([`check_ground`]).
 
 use super::*;
+use crate::components::Position;
 use crate::dim::{Dim, Vector};
 use crate::error::SceneError;
 use crate::grid::Grid;
+use crate::infra::columns::{col, points_with};
 use crate::materials::MaterialModel;
 use crate::water::Water;
 
@@ -57,21 +59,24 @@ pub(crate) fn check_ground<D: Dim>(
     loaded: &LoadedScene,
     grid: &Grid<D>,
     water: &Water,
-    positions: impl Iterator<Item = [f64; 3]>,
+    world: &hecs::World,
 ) -> Result<(), SceneError> {
     // The highest point of each column of cells across gravity's axis.
     let across: Vec<usize> = (0..D::N).filter(|&a| a != water.axis).collect();
     let cells: Vec<usize> = across.iter().map(|&a| grid.axes[a].cells).collect();
     let mut top = vec![f64::NEG_INFINITY; cells.iter().product()];
-    for x in positions {
-        let mut k = 0;
-        for (j, &a) in across.iter().enumerate() {
-            let c = ((x[a] - grid.origin.get(a)) * grid.inv_h)
-                .floor()
-                .clamp(0.0, (cells[j] - 1) as f64);
-            k = k * cells[j] + c as usize;
+    for arch in points_with::<Position<D::Vec>>(world) {
+        for x in col::<Position<D::Vec>>(arch).iter() {
+            let x = D::vec_to3(x.0);
+            let mut k = 0;
+            for (j, &a) in across.iter().enumerate() {
+                let c = ((x[a] - grid.origin.get(a)) * grid.inv_h)
+                    .floor()
+                    .clamp(0.0, (cells[j] - 1) as f64);
+                k = k * cells[j] + c as usize;
+            }
+            top[k] = top[k].max(x[water.axis]);
         }
-        top[k] = top[k].max(x[water.axis]);
     }
     let half = 0.5 * grid.cell_size;
     if let Some(k) = top
