@@ -191,6 +191,8 @@ pub struct LoadStage {
     pub fixity: Option<Vec<u8>>,
     /// Gravity it sets (its ramp starts with the stage).
     pub gravity: Option<Gravity>,
+    /// The water it sets (its surfaces), if it moves it.
+    pub water: Option<crate::water::Water>,
     /// Zero every point's accumulated displacement when it begins (after a geostatic stage).
     pub reset_displacements: bool,
 }

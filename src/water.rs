@@ -1,19 +1,60 @@
-//! Pore water (`water` in a scene): a hydrostatic water table, drained and static.
+//! Pore water (`water` in a scene): piezometric surfaces, drained and static.
 //!
-//! Below the table a point carries pore pressure u = γ_w (z_w − z) (Pa, compression
-//! positive), where z is its current height along gravity's axis; above it, u = 0 (no
-//! suction). The points' `Stress` is the effective stress σ′, on which the materials act;
-//! the total stress is σ = σ′ − u I (tension positive). So the pore water enters the
-//! balance only through the internal force: the system `pore_pressure` adds
-//! Σ_p V_p u_p ∇w_ip to the nodal forces, the −V (−u I)·∇w part of −V σ·∇w. Points below the
-//! table at set-up weigh their material's saturated density.
+//! Below its material's piezometric surface a point carries the pore pressure
+//! u = γ_w (h(x) − z) (Pa, compression positive), where z is its current height along
+//! gravity's axis and h(x) the surface's height above the point's place across it (the
+//! convention of limit-equilibrium programs); above it, u = 0 (no suction). The points'
+//! `Stress` is the effective stress σ′, on which the materials act; the total stress is
+//! σ = σ′ − u I (tension positive).
 //!
-//! What this does not do yet: open water above the ground (a table above the soil surface
-//! is refused at set-up, since the water's pressure on the surface would be missing), a
-//! sloping table, and stages that move the table.
+//! Balance. With σ = σ′ − u I, the weak form's −∫ σ:∇w dV splits into −∫ σ′:∇w dV (what
+//! `p2g` maps) and +∫ u ∇·w dV = ∮ u w·n dS − ∫ w·∇u dV. The surface term is the pressure of
+//! open water on the ground wherever the surface stands above it; with it applied as load,
+//! what is left is the body force −∇u = γ_w (e_z − ∇h) below the surface: buoyancy, plus a
+//! seepage force where the surface slopes. The system `pore_pressure` maps that body force
+//! (Σ_p V_p w_ip (−∇u_p)) as applied load. So a submerged slope face carries γ_w · depth
+//! normal to itself without the engine having to find the face, exactly as
+//! Archimedes has it, and a table below the ground leaves its surface load-free. On the
+//! grid's held faces the same term is part of the reaction.
+//!
+//! A point astride its surface counts as submerged by the share of its height below it,
+//! for its buoyancy and its weight alike. Points below their surface at set-up weigh their
+//! material's saturated density; a stage that moves a surface weighs again the points it
+//! crosses ([`Water::density_ratio`]). A point that moves keeps its mass: soil that settles
+//! below a table is buoyed up, but not wetted.
 
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
+use std::sync::Arc;
+
+/// A piezometric surface: the height (m, up gravity's axis) the water stands at above each
+/// place across that axis.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub enum Surface {
+    /// Level at this height.
+    Level(f64),
+    /// In 2D: the heights at increasing x, [x, height] each, straight between them. It must
+    /// span the grid across.
+    Polyline(Vec<Vec<f64>>),
+    /// In 3D: heights on a regular grid over the two axes across gravity's (in axis order:
+    /// for gravity along z, x then y), bilinear between its nodes. It must span the grid
+    /// across.
+    Heights {
+        /// The first node's place (m), two entries.
+        origin: Vec<f64>,
+        /// Node spacing along each axis (m), two entries.
+        spacing: Vec<f64>,
+        /// Heights (m): one row per node along the second axis, each row along the first.
+        heights: Vec<Vec<f64>>,
+    },
+}
+
+/// A height grid's fields, borrowed.
+struct HeightGrid<'a> {
+    origin: &'a [f64],
+    spacing: &'a [f64],
+    heights: &'a [Vec<f64>],
+}
 
 /// The water as the scene gives it.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -22,78 +63,402 @@ pub struct WaterSpec {
     /// Unit weight of water γ_w (N/m³).
     #[serde(default = "default_unit_weight")]
     pub unit_weight: f64,
-    /// Height of the water table, measured up the axis gravity points down (m).
-    pub table: f64,
-    /// Saturated density of each material that has points below the table (kg/m³, at
+    /// The piezometric surface of every material `material_tables` leaves out.
+    pub table: Surface,
+    /// Materials with their own piezometric surface (a perched table in a clay layer), by
+    /// material name.
+    #[serde(default)]
+    pub material_tables: BTreeMap<String, Surface>,
+    /// Saturated density of each material that has points below its surface (kg/m³, at
     /// least its dry density).
+    #[serde(default)]
     pub saturated_density: BTreeMap<String, f64>,
+}
+
+/// What a stage changes of the water: every surface (the unit weight and the saturated
+/// densities stay the scene's).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StageWaterSpec {
+    /// The piezometric surface of every material `material_tables` leaves out.
+    pub table: Surface,
+    /// Materials with their own piezometric surface, by material name.
+    #[serde(default)]
+    pub material_tables: BTreeMap<String, Surface>,
 }
 
 fn default_unit_weight() -> f64 {
     9810.0
 }
 
-/// The water table as the run uses it.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// A checked surface, ready to evaluate.
+#[derive(Clone, Debug, PartialEq)]
+enum Head {
+    Level(f64),
+    /// Knots at strictly increasing places (place, height).
+    Polyline(Vec<[f64; 2]>),
+    /// Origin, spacing, node counts, heights row-major (second axis outer).
+    Heights {
+        origin: [f64; 2],
+        spacing: [f64; 2],
+        nodes: [usize; 2],
+        h: Vec<f64>,
+    },
+}
+
+impl Head {
+    /// The height h and its slope ∂h/∂s along each axis across, at the place `s`.
+    #[inline]
+    fn at(&self, s: [f64; 2]) -> (f64, [f64; 2]) {
+        match self {
+            Head::Level(h) => (*h, [0.0; 2]),
+            Head::Polyline(k) => {
+                // The segment holding s (checked: the knots span the grid).
+                let j = k.partition_point(|p| p[0] <= s[0]).clamp(1, k.len() - 1);
+                let ([x0, h0], [x1, h1]) = (k[j - 1], k[j]);
+                let slope = (h1 - h0) / (x1 - x0);
+                (h0 + slope * (s[0] - x0), [slope, 0.0])
+            }
+            Head::Heights {
+                origin,
+                spacing,
+                nodes,
+                h,
+            } => {
+                let mut cell = [0usize; 2];
+                let mut t = [0.0; 2];
+                for a in 0..2 {
+                    let u = ((s[a] - origin[a]) / spacing[a]).clamp(0.0, (nodes[a] - 1) as f64);
+                    cell[a] = (u.floor() as usize).min(nodes[a] - 2);
+                    t[a] = u - cell[a] as f64;
+                }
+                let at = |i: usize, j: usize| h[(cell[1] + j) * nodes[0] + cell[0] + i];
+                let (h00, h10, h01, h11) = (at(0, 0), at(1, 0), at(0, 1), at(1, 1));
+                let value = h00 * (1.0 - t[0]) * (1.0 - t[1])
+                    + h10 * t[0] * (1.0 - t[1])
+                    + h01 * (1.0 - t[0]) * t[1]
+                    + h11 * t[0] * t[1];
+                let d0 = ((h10 - h00) * (1.0 - t[1]) + (h11 - h01) * t[1]) / spacing[0];
+                let d1 = ((h01 - h00) * (1.0 - t[0]) + (h11 - h10) * t[0]) / spacing[1];
+                (value, [d0, d1])
+            }
+        }
+    }
+}
+
+/// The water as the run uses it.
+#[derive(Clone, Debug, PartialEq)]
 pub struct Water {
     /// γ_w (N/m³).
     pub unit_weight: f64,
-    /// Height of the table along `axis` (m).
-    pub table: f64,
     /// Gravity's axis (gravity points along −axis).
     pub axis: usize,
+    /// The axes across gravity's, in order (the third is unused in 2D).
+    across: [usize; 2],
+    /// The surfaces, and each material's (by `MaterialId`).
+    heads: Arc<[Head]>,
+    of_material: Arc<[u16]>,
+    /// Density ratio ρ_sat/ρ_dry of each material (1 without a saturated density).
+    wet_ratio: Arc<[f64]>,
 }
 
 impl Water {
-    /// Pore pressure at `x` (Pa, compression positive): γ_w times the depth below the table.
+    /// The surface's height above `x` and its slopes, for a point of `material`.
     #[inline(always)]
-    pub fn pore_pressure(&self, x: [f64; 3]) -> f64 {
-        self.unit_weight * (self.table - x[self.axis]).max(0.0)
+    fn head(&self, material: u16, x: [f64; 3]) -> (f64, [f64; 2]) {
+        let s = [x[self.across[0]], x[self.across[1]]];
+        self.heads[self.of_material[material as usize] as usize].at(s)
     }
 
-    /// True when `x` lies below the table.
-    pub fn below(&self, x: [f64; 3]) -> bool {
-        self.pore_pressure(x) > 0.0
+    /// Pore pressure at `x` in `material` (Pa, compression positive): γ_w times the depth
+    /// below its piezometric surface, 0 above it.
+    #[inline(always)]
+    pub fn pore_pressure(&self, material: u16, x: [f64; 3]) -> f64 {
+        self.unit_weight * (self.head(material, x).0 - x[self.axis]).max(0.0)
+    }
+
+    /// The share of a point at `x` of height `side` (m, along gravity's axis) that lies
+    /// below its surface, the surface taken level across the point: 0 to 1, linear in
+    /// between, so that a point crossing the surface gains its buoyancy gradually rather
+    /// than all at once.
+    #[inline(always)]
+    fn submerged(&self, h: f64, x: [f64; 3], side: f64) -> f64 {
+        ((h - x[self.axis]) / side + 0.5).clamp(0.0, 1.0)
+    }
+
+    /// The body force −∇u (N/m³) on a point at `x` in `material` of height `side` (m):
+    /// γ_w (e_axis − ∇h) times its submerged share (buoyancy and seepage), zero above the
+    /// surface.
+    #[inline(always)]
+    pub fn body_force(&self, material: u16, x: [f64; 3], side: f64) -> [f64; 3] {
+        let (h, slope) = self.head(material, x);
+        let mut f = [0.0; 3];
+        let share = self.submerged(h, x, side);
+        if share > 0.0 {
+            let g = self.unit_weight * share;
+            f[self.axis] = g;
+            f[self.across[0]] = -g * slope[0];
+            if self.across[1] != self.axis {
+                f[self.across[1]] = -g * slope[1];
+            }
+        }
+        f
+    }
+
+    /// True when some of a point at `x` of height `side` (m) lies below its surface.
+    pub fn wets(&self, material: u16, x: [f64; 3], side: f64) -> bool {
+        self.submerged(self.head(material, x).0, x, side) > 0.0
+    }
+
+    /// A point's density over its material's dry density: 1 + s (ρ_sat/ρ_dry − 1) for its
+    /// submerged share s at `x` (height `side`, m).
+    pub fn density_factor(&self, material: u16, x: [f64; 3], side: f64) -> f64 {
+        let share = self.submerged(self.head(material, x).0, x, side);
+        1.0 + share * (self.wet_ratio[material as usize] - 1.0)
+    }
+
+    /// The factor a point's mass changes by when the water goes from `self` to `next`, judged
+    /// at the point's current place `x` (height `side`, m).
+    pub fn density_ratio(&self, next: &Water, material: u16, x: [f64; 3], side: f64) -> f64 {
+        next.density_factor(material, x, side) / self.density_factor(material, x, side)
+    }
+
+    /// The same water with the surfaces of `stage`.
+    pub fn with_surfaces(&self, stage: &Water) -> Water {
+        Water {
+            heads: stage.heads.clone(),
+            of_material: stage.of_material.clone(),
+            ..self.clone()
+        }
+    }
+}
+
+/// Why a surface cannot be used: (field under the surface, rule).
+type Refusal = (String, String);
+
+/// Checks `surface` for a grid spanning `lo..hi` across gravity (`across` axes, `n` of them)
+/// and turns it into a [`Head`].
+fn head(surface: &Surface, n: usize, lo: [f64; 2], hi: [f64; 2]) -> Result<Head, Refusal> {
+    let bad = |f: &str, r: String| Err((f.to_string(), r));
+    match surface {
+        Surface::Level(h) if h.is_finite() => Ok(Head::Level(*h)),
+        Surface::Level(h) => bad("", format!("must be a finite height (m), found {h}")),
+        Surface::Polyline(_) if n != 1 => bad(
+            "",
+            "a Polyline is a 2D surface: in 3D give Heights (a height grid) or a Level".into(),
+        ),
+        Surface::Polyline(k) => {
+            if k.len() < 2 || k.iter().any(|p| p.len() != 2) || k.iter().flatten().any(|v| !v.is_finite()) {
+                return bad("", "needs at least two points [x, height], finite numbers".into());
+            }
+            let k: Vec<[f64; 2]> = k.iter().map(|p| [p[0], p[1]]).collect();
+            if let Some(j) = (1..k.len()).find(|&j| k[j][0] <= k[j - 1][0]) {
+                return bad(
+                    "",
+                    format!(
+                        "is not a function of x: point {j} (x = {}) does not lie to the right of \
+                         point {} (x = {}); give the points at strictly increasing x",
+                        k[j][0],
+                        j - 1,
+                        k[j - 1][0]
+                    ),
+                );
+            }
+            let (first, last) = (k[0][0], k[k.len() - 1][0]);
+            if first > lo[0] || last < hi[0] {
+                return bad(
+                    "",
+                    format!(
+                        "spans x = {first} to {last} m but the grid spans {} to {} m: the \
+                         surface must reach across the whole grid",
+                        lo[0], hi[0]
+                    ),
+                );
+            }
+            Ok(Head::Polyline(k))
+        }
+        Surface::Heights { .. } if n != 2 => bad(
+            "",
+            "a height grid is a 3D surface: in 2D give a Polyline or a Level".into(),
+        ),
+        Surface::Heights {
+            origin,
+            spacing,
+            heights,
+        } => {
+            let g = HeightGrid {
+                origin,
+                spacing,
+                heights,
+            };
+            let rows = g.heights.len();
+            let cols = g.heights.first().map_or(0, Vec::len);
+            if rows < 2 || cols < 2 || g.heights.iter().any(|r| r.len() != cols) {
+                return bad(
+                    "heights",
+                    "needs at least two rows of at least two heights, every row as long".into(),
+                );
+            }
+            if g.origin.len() != 2 || g.spacing.len() != 2 {
+                return bad("origin", "origin and spacing need two entries each".into());
+            }
+            if g.heights.iter().flatten().any(|h| !h.is_finite()) || !g.origin.iter().all(|o| o.is_finite()) {
+                return bad("heights", "heights and origin must be finite".into());
+            }
+            if !g.spacing.iter().all(|s| s.is_finite() && *s > 0.0) {
+                return bad("spacing", format!("must be above 0 m, found {:?}", g.spacing));
+            }
+            let nodes = [cols, rows];
+            for a in 0..2 {
+                let end = g.origin[a] + g.spacing[a] * (nodes[a] - 1) as f64;
+                if g.origin[a] > lo[a] || end < hi[a] {
+                    return bad(
+                        "",
+                        format!(
+                            "spans {} to {end} m along its axis {a} but the grid spans {} to {} \
+                             m: the surface must reach across the whole grid",
+                            g.origin[a], lo[a], hi[a]
+                        ),
+                    );
+                }
+            }
+            Ok(Head::Heights {
+                origin: [g.origin[0], g.origin[1]],
+                spacing: [g.spacing[0], g.spacing[1]],
+                nodes,
+                h: g.heights.iter().flatten().copied().collect(),
+            })
+        }
+    }
+}
+
+/// What checking the water needs to know of the scene.
+pub struct Frame<'a> {
+    /// The scene's gravity (one entry an axis), if any.
+    pub gravity: Option<&'a [f64]>,
+    /// The grid's lowest and highest corner (m), one entry an axis.
+    pub lo: &'a [f64],
+    /// The grid's highest corner (m).
+    pub hi: &'a [f64],
+    /// The materials' names and dry densities, in `MaterialId` order.
+    pub materials: &'a [(&'a str, f64)],
+}
+
+impl Frame<'_> {
+    /// Gravity's axis: gravity must point down one axis.
+    fn axis(&self) -> Result<usize, Refusal> {
+        let Some(g) = self.gravity else {
+            return Err((
+                String::new(),
+                "pore pressure is hydrostatic: the scene needs gravity".into(),
+            ));
+        };
+        let along: Vec<usize> = (0..g.len()).filter(|&a| g[a] != 0.0).collect();
+        match along[..] {
+            [axis] if g[axis] < 0.0 => Ok(axis),
+            _ => Err((
+                "gravity.acceleration".into(),
+                "with water, gravity points down one axis (a negative entry, the others 0): \
+                 heights are measured up that axis"
+                    .into(),
+            )),
+        }
+    }
+
+    /// The surfaces `table` and `material_tables` checked against the grid and the
+    /// materials: (heads, each material's head). Fields are relative to the water.
+    fn heads(
+        &self,
+        axis: usize,
+        table: &Surface,
+        material_tables: &BTreeMap<String, Surface>,
+    ) -> Result<(Vec<Head>, Vec<u16>), Refusal> {
+        let n = self.lo.len();
+        let across: Vec<usize> = (0..n).filter(|&a| a != axis).collect();
+        let (mut lo, mut hi) = ([0.0; 2], [0.0; 2]);
+        for (k, &a) in across.iter().enumerate() {
+            (lo[k], hi[k]) = (self.lo[a], self.hi[a]);
+        }
+        let within = |f: &str, (g, r): Refusal| {
+            let field = if g.is_empty() {
+                f.to_string()
+            } else {
+                format!("{f}.{g}")
+            };
+            (field, r)
+        };
+        let mut heads = vec![head(table, n - 1, lo, hi).map_err(|e| within("table", e))?];
+        let mut of_material = vec![0u16; self.materials.len()];
+        for (name, surface) in material_tables {
+            let field = format!("material_tables.{name}");
+            let Some(m) = self.materials.iter().position(|(n, _)| n == name) else {
+                return Err((field, format!("the scene has no material \"{name}\"")));
+            };
+            of_material[m] = heads.len() as u16;
+            heads.push(head(surface, n - 1, lo, hi).map_err(|e| within(&field, e))?);
+        }
+        Ok((heads, of_material))
+    }
+
+    fn across(axis: usize, n: usize) -> [usize; 2] {
+        let a: Vec<usize> = (0..3).filter(|&a| a != axis).collect();
+        // In 2D the second axis across is z, which no point moves along.
+        if n == 2 {
+            [a[0], 2]
+        } else {
+            [a[0], a[1]]
+        }
     }
 }
 
 impl WaterSpec {
-    /// The checked water of a scene whose gravity is `gravity` (one entry an axis): gravity
-    /// must point along one axis. As (field, rule) on failure.
-    pub fn checked(&self, gravity: Option<&[f64]>) -> Result<Water, (String, String)> {
-        let bad = |f: &str, r: String| Err((f.to_string(), r));
+    /// The checked water of a scene framed by `frame`. As (field under `water`, rule) on
+    /// failure; a field that starts with `gravity` is the scene's own.
+    pub fn checked(&self, frame: &Frame) -> Result<Water, Refusal> {
         if !(self.unit_weight.is_finite() && self.unit_weight > 0.0) {
-            return bad(
-                "water.unit_weight",
+            return Err((
+                "unit_weight".into(),
                 format!("must be above 0 N/m³, found {}", self.unit_weight),
-            );
+            ));
         }
-        if !self.table.is_finite() {
-            return bad(
-                "water.table",
-                format!("must be a finite height (m), found {}", self.table),
-            );
+        let axis = frame.axis()?;
+        let mut wet_ratio = vec![1.0; frame.materials.len()];
+        for (name, &rho) in &self.saturated_density {
+            let field = format!("saturated_density.{name}");
+            let Some(m) = frame.materials.iter().position(|(n, _)| n == name) else {
+                return Err((field, format!("the scene has no material \"{name}\"")));
+            };
+            let dry = frame.materials[m].1;
+            if !(rho.is_finite() && rho >= dry) {
+                return Err((
+                    field,
+                    format!("must be at least the material's dry density ({dry} kg/m³), found {rho}"),
+                ));
+            }
+            wet_ratio[m] = rho / dry;
         }
-        let Some(g) = gravity else {
-            return bad(
-                "water",
-                "pore pressure is hydrostatic: the scene needs gravity".into(),
-            );
-        };
-        let along: Vec<usize> = (0..g.len()).filter(|&a| g[a] != 0.0).collect();
-        match along[..] {
-            [axis] if g[axis] < 0.0 => Ok(Water {
-                unit_weight: self.unit_weight,
-                table: self.table,
-                axis,
-            }),
-            _ => bad(
-                "gravity.acceleration",
-                "with water, gravity points down one axis (a negative entry, the others 0): the \
-                 table is level across the others and heights are measured up that axis"
-                    .into(),
-            ),
-        }
+        let (heads, of_material) = frame.heads(axis, &self.table, &self.material_tables)?;
+        Ok(Water {
+            unit_weight: self.unit_weight,
+            axis,
+            across: Frame::across(axis, frame.lo.len()),
+            heads: heads.into(),
+            of_material: of_material.into(),
+            wet_ratio: wet_ratio.into(),
+        })
+    }
+}
+
+impl StageWaterSpec {
+    /// The scene's `water` with this stage's surfaces. As (field under the stage's `water`,
+    /// rule) on failure.
+    pub fn checked(&self, water: &Water, frame: &Frame) -> Result<Water, Refusal> {
+        let (heads, of_material) = frame.heads(water.axis, &self.table, &self.material_tables)?;
+        Ok(Water {
+            heads: heads.into(),
+            of_material: of_material.into(),
+            ..water.clone()
+        })
     }
 }
 
@@ -101,17 +466,91 @@ impl WaterSpec {
 mod tests {
     use super::*;
 
-    #[test]
-    fn the_pore_pressure_is_hydrostatic_below_the_table_and_zero_above() {
-        let w = WaterSpec {
+    fn frame_2d<'a>(materials: &'a [(&'a str, f64)]) -> Frame<'a> {
+        Frame {
+            gravity: Some(&[0.0, -9.81]),
+            lo: &[0.0, 0.0],
+            hi: &[20.0, 10.0],
+            materials,
+        }
+    }
+
+    fn spec(table: Surface) -> WaterSpec {
+        WaterSpec {
             unit_weight: 10.0e3,
-            table: 5.0,
+            table,
+            material_tables: BTreeMap::new(),
             saturated_density: BTreeMap::new(),
         }
-        .checked(Some(&[0.0, -9.81]))
-        .unwrap();
-        assert_eq!(w.pore_pressure([0.0, 2.0, 0.0]), 30.0e3);
-        assert_eq!(w.pore_pressure([0.0, 6.0, 0.0]), 0.0);
-        assert!(w.below([0.0, 4.9, 0.0]) && !w.below([0.0, 5.0, 0.0]));
+    }
+
+    #[test]
+    fn the_pore_pressure_is_hydrostatic_below_a_level_table_and_zero_above() {
+        let m = [("soil", 2000.0)];
+        let w = spec(Surface::Level(5.0)).checked(&frame_2d(&m)).unwrap();
+        assert_eq!(w.pore_pressure(0, [0.0, 2.0, 0.0]), 30.0e3);
+        assert_eq!(w.pore_pressure(0, [0.0, 6.0, 0.0]), 0.0);
+        assert_eq!(w.body_force(0, [3.0, 2.0, 0.0], 0.5), [0.0, 10.0e3, 0.0]);
+        assert_eq!(w.body_force(0, [3.0, 6.0, 0.0], 0.5), [0.0; 3]);
+        // A point astride the table: a quarter of it below, a quarter of its buoyancy.
+        assert_eq!(w.body_force(0, [3.0, 5.125, 0.0], 0.5), [0.0, 2.5e3, 0.0]);
+    }
+
+    /// A polyline's pressure is γ_w times the vertical height below it; its slope adds a
+    /// seepage force −γ_w dh/dx across.
+    #[test]
+    fn a_sloping_polyline_gives_vertical_head_and_a_seepage_force() {
+        let m = [("soil", 2000.0)];
+        let line = Surface::Polyline(vec![vec![-1.0, 8.0], vec![10.0, 8.0], vec![21.0, 2.5]]);
+        let w = spec(line).checked(&frame_2d(&m)).unwrap();
+        assert_eq!(w.pore_pressure(0, [5.0, 3.0, 0.0]), 50.0e3);
+        assert!((w.pore_pressure(0, [15.5, 1.0, 0.0]) - 42.5e3).abs() < 1e-9);
+        let f = w.body_force(0, [15.5, 1.0, 0.0], 0.5);
+        assert!(
+            (f[0] - 5.0e3).abs() < 1e-9 && f[1] == 10.0e3 && f[2] == 0.0,
+            "{f:?}"
+        );
+    }
+
+    #[test]
+    fn a_height_grid_is_bilinear_between_its_nodes() {
+        let m = [("soil", 2000.0)];
+        let frame = Frame {
+            gravity: Some(&[0.0, 0.0, -9.81]),
+            lo: &[0.0, 0.0, 0.0],
+            hi: &[2.0, 2.0, 10.0],
+            materials: &m,
+        };
+        let grid = Surface::Heights {
+            origin: vec![0.0, 0.0],
+            spacing: vec![2.0, 2.0],
+            heights: vec![vec![4.0, 6.0], vec![8.0, 10.0]],
+        };
+        let w = spec(grid).checked(&frame).unwrap();
+        // h(1, 1) = 7, ∂h/∂x = 1, ∂h/∂y = 2.
+        assert!((w.pore_pressure(0, [1.0, 1.0, 0.0]) - 70.0e3).abs() < 1e-9);
+        let f = w.body_force(0, [1.0, 1.0, 0.0], 0.5);
+        assert!((f[0] + 10.0e3).abs() < 1e-9 && (f[1] + 20.0e3).abs() < 1e-9 && f[2] == 10.0e3);
+    }
+
+    #[test]
+    fn surfaces_that_are_not_functions_or_do_not_span_the_grid_are_refused() {
+        let m = [("soil", 2000.0)];
+        let f = frame_2d(&m);
+        let back = spec(Surface::Polyline(vec![
+            vec![0.0, 5.0],
+            vec![12.0, 5.0],
+            vec![11.0, 4.0],
+            vec![20.0, 4.0],
+        ]));
+        let (field, rule) = back.checked(&f).unwrap_err();
+        assert_eq!(field, "table");
+        assert!(rule.contains("not a function of x"), "{rule}");
+        let short = spec(Surface::Polyline(vec![vec![0.0, 5.0], vec![15.0, 5.0]]));
+        assert!(short
+            .checked(&f)
+            .unwrap_err()
+            .1
+            .contains("reach across the whole grid"));
     }
 }

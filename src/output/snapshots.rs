@@ -165,7 +165,7 @@ impl<D: Dim> System<D> for Snapshots<D> {
             &ctx.world,
             ctx.state.clock.step,
             ctx.state.clock.time,
-            ctx.settings.water,
+            ctx.settings.water.clone(),
         );
         let start = Instant::now();
         if tx.send(frame).is_err() {

@@ -26,15 +26,15 @@ enum Field {
     DeviatoricStress,
     Volume,
     PlasticStrain,
-    /// u = γ_w · depth below the water table (Pa, compression positive).
+    /// u = γ_w · depth below the point's piezometric surface (Pa, compression positive).
     PorePressure,
     /// σ = σ′ − u I (Pa, tension positive: xx yy zz xy yz zx).
     TotalStress,
 }
 
-/// Pore pressure `u` at `x` and the total stress of the effective stress `s` there.
-fn total(water: &Water, x: [f64; 3], s: &[f64; 6]) -> [f64; 6] {
-    let u = water.pore_pressure(x);
+/// The total stress of the effective stress `s` at `x` in `material`.
+fn total(water: &Water, material: u16, x: [f64; 3], s: &[f64; 6]) -> [f64; 6] {
+    let u = water.pore_pressure(material, x);
     [s[0] - u, s[1] - u, s[2] - u, s[3], s[4], s[5]]
 }
 
@@ -46,7 +46,7 @@ trait Source {
     /// True when displacements are kept (`output.displacements`).
     fn has_displacement(&self) -> bool;
     /// The water table, when the scene has one (the stress is then effective).
-    fn water(&self) -> Option<Water>;
+    fn water(&self) -> Option<&Water>;
     /// Writes `field` of every point, in id order.
     fn write(&self, field: Field, out: &mut BufWriter<File>) -> std::io::Result<()>;
 }
@@ -163,7 +163,7 @@ fn arrays<S: Source>(src: &S) -> Vec<Array<'_>> {
 /// raise the run's peak memory. Snapshots during a run copy the points into a [`Frame`]
 /// instead, for the writer thread.
 pub fn write_points<D: Dim>(sim: &Simulation<D>, path: &Path) -> std::io::Result<()> {
-    let columns = Columns::<D>::of(&sim.ctx.world, sim.ctx.settings.water);
+    let columns = Columns::<D>::of(&sim.ctx.world, sim.ctx.settings.water.clone());
     let arrays = arrays(&columns);
     crate::output::dir::write_atomic(path, |out| write_arrays(out, columns.len(), &arrays))
 }
@@ -176,7 +176,7 @@ pub fn write_parallel_points<D: Dim>(
     path: &Path,
     parts: &[String],
 ) -> std::io::Result<()> {
-    let columns = Columns::<D>::of(&sim.ctx.world, sim.ctx.settings.water);
+    let columns = Columns::<D>::of(&sim.ctx.world, sim.ctx.settings.water.clone());
     let arrays = arrays(&columns);
     crate::output::dir::write_atomic(path, |out| {
         out.write_all(b"<?xml version=\"1.0\"?>\n<VTKFile type=\"PUnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n<PUnstructuredGrid GhostLevel=\"0\">\n")?;
@@ -249,8 +249,8 @@ impl<D: Dim> Source for Columns<'_, D> {
     fn has_displacement(&self) -> bool {
         self.displacements
     }
-    fn water(&self) -> Option<Water> {
-        self.water
+    fn water(&self) -> Option<&Water> {
+        self.water.as_ref()
     }
     fn write(&self, field: Field, out: &mut BufWriter<File>) -> std::io::Result<()> {
         let (archs, order) = (&self.archs[..], &self.order);
@@ -279,15 +279,16 @@ impl<D: Dim> Source for Columns<'_, D> {
             }),
             Field::Volume => each::<Volume>(archs, order, out, |out, v| f64s(out, &[v.0])),
             Field::PorePressure | Field::TotalStress => {
-                let w = self.water.expect("written only with water");
+                let w = self.water.as_ref().expect("written only with water");
                 // Read straight from the columns, in id order: no copy of the points.
                 let xs: Vec<_> = archs.iter().map(|a| col::<Position<D::Vec>>(a)).collect();
+                let ms: Vec<_> = archs.iter().map(|a| col::<MaterialId>(a)).collect();
                 let ss: Vec<_> = archs.iter().map(|a| col::<Stress<D::Stress>>(a)).collect();
                 order.points().try_for_each(|(_, a, r)| {
-                    let x = D::vec_to3(xs[a][r].0);
+                    let (x, m) = (D::vec_to3(xs[a][r].0), ms[a][r].0);
                     match field {
-                        Field::PorePressure => f64s(out, &[w.pore_pressure(x)]),
-                        _ => f64s(out, &total(&w, x, &voigt::<D>(&ss[a][r]))),
+                        Field::PorePressure => f64s(out, &[w.pore_pressure(m, x)]),
+                        _ => f64s(out, &total(w, m, x, &voigt::<D>(&ss[a][r]))),
                     }
                 })
             }
@@ -395,7 +396,7 @@ impl Frame {
             PointId(id).place(&mut order, row as u32, u32::MAX);
         }
         order.retain(|&r| r != u32::MAX);
-        (sorted.step, sorted.time, sorted.water) = (self.step, self.time, self.water);
+        (sorted.step, sorted.time, sorted.water) = (self.step, self.time, self.water.clone());
         permute(&self.material, &order, &mut sorted.material);
         permute(&self.position, &order, &mut sorted.position);
         match &self.displacement {
@@ -431,8 +432,8 @@ impl Source for Frame {
     fn has_displacement(&self) -> bool {
         self.displacement.is_some()
     }
-    fn water(&self) -> Option<Water> {
-        self.water
+    fn water(&self) -> Option<&Water> {
+        self.water.as_ref()
     }
     fn write(&self, field: Field, out: &mut BufWriter<File>) -> std::io::Result<()> {
         // Whole columns at a time: a frame is written on the writer thread, which shares
@@ -465,23 +466,25 @@ impl Source for Frame {
             Field::Volume => f64_block(out, &self.volume),
             Field::PlasticStrain => f64_block(out, &self.plastic_strain),
             Field::PorePressure => {
-                let w = self.water.expect("written only with water");
+                let w = self.water.as_ref().expect("written only with water");
                 f64_block(
                     out,
                     &self
                         .position
                         .iter()
-                        .map(|&x| w.pore_pressure(x))
+                        .zip(&self.material)
+                        .map(|(&x, &m)| w.pore_pressure(m, x))
                         .collect::<Vec<_>>(),
                 )
             }
             Field::TotalStress => {
-                let w = self.water.expect("written only with water");
+                let w = self.water.as_ref().expect("written only with water");
                 let t: Vec<[f64; 6]> = self
                     .position
                     .iter()
+                    .zip(&self.material)
                     .zip(&self.stress)
-                    .map(|(&x, s)| total(&w, x, s))
+                    .map(|((&x, &m), s)| total(w, m, x, s))
                     .collect();
                 f64_block(out, bytemuck::cast_slice(&t))
             }

@@ -209,7 +209,15 @@ fn stages<D: Dim>(
     shares: &[(String, Vec<(u32, f64)>)],
 ) -> Vec<LoadStage> {
     let mut out = Vec::new();
-    for (st, CheckedStage { materials, faces }) in loaded.scene.stages.iter().zip(checked) {
+    for (
+        st,
+        CheckedStage {
+            materials,
+            faces,
+            water,
+        },
+    ) in loaded.scene.stages.iter().zip(checked)
+    {
         let mut loads: Vec<(u32, [f64; 3])> = st
             .point_loads
             .iter()
@@ -234,6 +242,7 @@ fn stages<D: Dim>(
             name: st.name.clone(),
             materials,
             loads,
+            water,
             reset_displacements: st.reset_displacements,
         });
     }
@@ -260,12 +269,21 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         ids: body_ids,
         next_id,
         full_node_mass,
-    } = spawn_bodies(loaded, &grid, &table, water.as_ref(), &mut world)?;
+    } = {
+        // Every water the run will see, to find the points below a surface at set-up.
+        let mut waters: Vec<(String, &crate::water::Water)> = Vec::new();
+        if let Some(w) = &water {
+            waters.push(("water.table".into(), w));
+        }
+        for (k, st) in checked_stages.iter().enumerate() {
+            if let Some(w) = &st.water {
+                waters.push((format!("stages[{k}].water"), w));
+            }
+        }
+        spawn_bodies(loaded, &grid, &table, &waters, &mut world)?
+    };
     let touched = touched_nodes(&world, &grid, s.shape);
     validate::check_motion_boxes(loaded, &grid, &touched)?;
-    if let Some(w) = &water {
-        validate::check_ground(loaded, &grid, w, &world)?;
-    }
     let (load_ids, _) = spawn_point_loads(loaded, &grid, &mut world, &touched, next_id)?;
     let placed = super::tractions::place::<D>(&mut world, loaded, &body_ids)?;
 
@@ -410,7 +428,7 @@ fn spawn_bodies<D: Dim>(
     loaded: &LoadedScene,
     grid: &Grid<D>,
     table: &[(String, MaterialModel)],
-    water: Option<&crate::water::Water>,
+    waters: &[(String, &crate::water::Water)],
     world: &mut World,
 ) -> Result<Bodies, SceneError> {
     let s = &loaded.scene;
@@ -463,7 +481,7 @@ fn spawn_bodies<D: Dim>(
                 "the body holds no material point (is it smaller than a sub-cell?)",
             ));
         }
-        let spawned = spawn_body::<D>(loaded, b, table, water, world, xs, next_id)?;
+        let spawned = spawn_body::<D>(loaded, b, table, waters, world, xs, next_id)?;
         full_node_mass = full_node_mass.min(spawned.full_node_mass);
         body_ids.push(next_id..spawned.next_id);
         next_id = spawned.next_id;
@@ -489,7 +507,7 @@ fn spawn_body<D: Dim>(
     loaded: &LoadedScene,
     b: usize,
     table: &[(String, MaterialModel)],
-    water: Option<&crate::water::Water>,
+    waters: &[(String, &crate::water::Water)],
     world: &mut World,
     xs: Counted<impl Iterator<Item = ([f64; 3], u32)> + Clone>,
     first: u32,
@@ -508,14 +526,23 @@ fn spawn_body<D: Dim>(
     let state = carried_state(loaded, table, &body.material).expect("validated");
     let volume = cell_volume / body.points_per_cell.iter().product::<usize>() as f64;
     let mass = model.density() * volume;
-    // Below the water table a point weighs its material's saturated density.
-    let saturated = water.zip(s.water.as_ref()).and_then(|(w, spec)| {
-        let rho = *spec.saturated_density.get(&body.material)?;
-        Some((w, rho * volume))
+    // Below its piezometric surface a point weighs its material's saturated density (by the
+    // share of its height below the surface, for a point astride it).
+    let named: Vec<(&str, &crate::water::Water)> = waters.iter().map(|(f, w)| (f.as_str(), *w)).collect();
+    let side = waters.first().map_or(0.0, |(_, w)| {
+        s.grid.cell_size / body.points_per_cell[w.axis] as f64
     });
-    let mass_at = |x: [f64; 3]| match saturated {
-        Some((w, m)) if w.below(x) => m,
-        _ => mass,
+    validate::check_saturated(
+        loaded,
+        &named,
+        mat as u16,
+        &body.material,
+        side,
+        xs.clone().map(|(x, _)| x),
+    )?;
+    let mass_at = |x: [f64; 3]| match waters.first() {
+        Some((_, w)) => mass * w.density_factor(mat as u16, x, side),
+        None => mass,
     };
     let next_id = u32::try_from(count)
         .ok()

@@ -140,6 +140,10 @@ pub struct StageSpec {
     /// Tractions' new values, by name (Pa).
     #[serde(default, deserialize_with = "unique_keys")]
     pub tractions: BTreeMap<String, Vec<f64>>,
+    /// The piezometric surfaces from this stage on (filling a reservoir, a drawdown); the
+    /// scene must have `water`.
+    #[serde(default)]
+    pub water: Option<crate::water::StageWaterSpec>,
     /// Zero the accumulated displacements when the stage begins.
     #[serde(default)]
     pub reset_displacements: bool,

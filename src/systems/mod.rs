@@ -385,13 +385,13 @@ fn loading<D: Dim, S: Shape>() -> Vec<Entry<D>> {
             St::Forces,
             Needed(|s, _| s.water.is_some(), "the scene has water"),
             &[
-                ("p2g", "the pore pressure adds to the internal force p2g maps"),
+                ("p2g", "the pore water's load adds to the forces p2g maps"),
                 (
                     "p2g_force",
-                    "the pore pressure adds to the internal force p2g_force maps",
+                    "the pore water's load adds to the forces p2g_force maps",
                 ),
             ],
-            "pore water: +Σ V u ∇w (total = effective − u I)",
+            "pore water: buoyancy and seepage −∇u, open water's pressure (σ = σ′ − u I)",
             |_| Box::new(PorePressure::<D, S>::default()),
         ),
         e(

@@ -1,7 +1,7 @@
 //! Loading stages: a scene's `stages` run one after another, each to the static stop; a
 //! stage changes materials (e.g. elastic soil for the geostatic state, then its
-//! Mohr-Coulomb strength), gravity, point loads and tractions when it begins, and may zero
-//! the displacements.
+//! Mohr-Coulomb strength), gravity, point loads, tractions and the water's piezometric
+//! surfaces when it begins, and may zero the displacements.
 
 use crate::components::*;
 use crate::context::Context;
@@ -40,7 +40,29 @@ fn apply<D: Dim>(ctx: &mut Context<D>, stage: &LoadStage, start: f64) {
     for (id, model) in &stage.materials {
         ctx.materials[*id as usize] = model.clone();
     }
+    if let Some(w) = &stage.water {
+        ctx.settings.water = Some(w.clone());
+    }
     set_point_loads(ctx, &stage.loads, 1.0);
+}
+
+/// Weighs again the points `stage`'s water moves across a surface: ρ_sat below the new
+/// surface, ρ_dry above it ([`crate::water::Water::density_ratio`], judged at each point's
+/// current place). Called once as the stage begins, before [`apply`] sets the new water.
+fn rewet<D: Dim>(ctx: &mut Context<D>, stage: &LoadStage) {
+    let (Some(old), Some(new)) = (&ctx.settings.water, &stage.water) else {
+        return;
+    };
+    for arch in points_with::<MaterialId>(&ctx.world) {
+        let ids = col::<MaterialId>(arch);
+        let xs = col::<Position<D::Vec>>(arch);
+        let vs = col::<Volume>(arch);
+        let mut mass = col_mut::<Mass>(arch);
+        for (((m, id), x), v) in mass.iter_mut().zip(ids.iter()).zip(xs.iter()).zip(vs.iter()) {
+            let side = if D::N == 2 { v.0.sqrt() } else { v.0.cbrt() };
+            m.0 *= old.density_ratio(new, id.0, D::vec_to3(x.0), side);
+        }
+    }
 }
 
 /// Scales the mass of every point whose material `stage` gives another density by
@@ -86,6 +108,7 @@ impl<D: Dim> System<D> for Stages {
             // has the masses of its stage in its checkpoint.
             if k == 0 && ctx.state.clock.step == 0 {
                 reweigh(ctx, stage);
+                rewet(ctx, stage);
             }
             apply(ctx, stage, start);
         }
@@ -116,6 +139,7 @@ impl<D: Dim> System<D> for Stages {
         let stage = stages[s.control.stage].clone();
         let start = ctx.state.clock.time;
         reweigh(ctx, &stage);
+        rewet(ctx, &stage);
         apply(ctx, &stage, start);
         if stage.reset_displacements {
             for arch in points_with::<Displacement<D::Vec>>(&ctx.world) {

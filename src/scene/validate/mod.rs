@@ -29,7 +29,7 @@ use memory::check_memory;
 use motions::check_motions_and_analyses;
 use solver::{check_solver, time_step};
 use stages::check_stages;
-pub(crate) use water::check_ground;
+pub(crate) use water::check_saturated;
 use water::check_water;
 
 use super::LoadedScene;
@@ -116,7 +116,7 @@ pub struct Checked {
     pub unused_materials: Vec<String>,
     /// What the run will hold in memory, at most.
     pub estimate: Estimate,
-    /// The water table, if any.
+    /// The water, if any.
     pub water: Option<crate::water::Water>,
 }
 
@@ -216,7 +216,11 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
     let step = time_step(&r, &table)?;
     let stages = check_stages(&r, &table, step.p_wave_speed)?;
     let estimate = check_memory(&r, &table)?;
-    let water = check_water(&r, &table)?;
+    let (water, stage_waters) = check_water(&r, &grid, &table)?;
+    let mut stages = stages;
+    for (st, w) in stages.iter_mut().zip(stage_waters) {
+        st.water = w;
+    }
     Ok(Checked {
         grid,
         materials: table,

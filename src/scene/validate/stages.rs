@@ -13,6 +13,8 @@ pub struct CheckedStage {
     pub materials: Vec<(u16, MaterialModel)>,
     /// The face conditions the stage sets, replacing the scene's.
     pub faces: Option<Vec<FaceHold>>,
+    /// The water from this stage on (the scene's with the stage's surfaces), if it moves it.
+    pub water: Option<crate::water::Water>,
 }
 
 /// The stages: each material, load, face condition and gravity they set.
@@ -133,6 +135,7 @@ pub(super) fn check_stages(
         built.push(CheckedStage {
             materials: models,
             faces,
+            water: None, // set by the water's check
         });
     }
     Ok(built)

@@ -1,95 +1,95 @@
-//! The water table: itself ([`crate::water::WaterSpec::checked`]), and the saturated
-//! densities of the materials that lie below it. That the ground stands above the table
-//! everywhere is checked once the points are placed ([`check_ground`]).
+//! The water: its surfaces and saturated densities ([`crate::water::WaterSpec::checked`]),
+//! and each stage's surfaces. That every material with points below a surface has a
+//! saturated density is checked as the points are placed ([`check_saturated`]).
 
+use super::grid::CheckedGrid;
 use super::*;
-use crate::components::Position;
-use crate::dim::{Dim, Vector};
 use crate::error::SceneError;
-use crate::grid::Grid;
-use crate::infra::columns::{col, points_with};
 use crate::materials::MaterialModel;
-use crate::water::Water;
+use crate::water::{Frame, Water};
 
-/// The scene's water, checked, or `None` when the scene is dry.
-pub(super) fn check_water(r: &Rules, table: &[(String, MaterialModel)]) -> Result<Option<Water>, SceneError> {
+/// The scene's water, checked, or `None` when the scene is dry; with each stage's (`None`
+/// where a stage leaves the water as it is).
+pub(super) fn check_water(
+    r: &Rules,
+    grid: &CheckedGrid,
+    table: &[(String, MaterialModel)],
+) -> Result<(Option<Water>, Vec<Option<Water>>), SceneError> {
     let (loaded, s) = (r.loaded, &r.loaded.scene);
-    let Some(spec) = &s.water else {
-        return Ok(None);
+    let n = r.n;
+    let hi: Vec<f64> = (0..n)
+        .map(|a| grid.origin[a] + grid.cell_size * grid.cells[a] as f64)
+        .collect();
+    let materials: Vec<(&str, f64)> = table.iter().map(|(n, m)| (n.as_str(), m.density())).collect();
+    let frame = Frame {
+        gravity: s.gravity.as_ref().map(|g| g.acceleration.as_slice()),
+        lo: &grid.origin[..n],
+        hi: &hi,
+        materials: &materials,
     };
-    let gravity = s.gravity.as_ref().map(|g| g.acceleration.as_slice());
-    let water = spec
-        .checked(gravity)
-        .map_err(|(f, rule)| loaded.invalid(&f, rule))?;
-    for (name, &rho) in &spec.saturated_density {
-        let field = format!("water.saturated_density.{name}");
-        let Some((_, m)) = table.iter().find(|(n, _)| n == name) else {
-            return r.bad(&field, format!("the scene has no material \"{name}\""));
+    let at = |prefix: &str, (field, rule): (String, String)| {
+        let field = match field.as_str() {
+            "" => prefix.to_string(),
+            f if f.starts_with("gravity") => f.to_string(),
+            f => format!("{prefix}.{f}"),
         };
-        if !(rho.is_finite() && rho >= m.density()) {
+        loaded.invalid(&field, rule)
+    };
+    let Some(spec) = &s.water else {
+        if let Some(k) = s.stages.iter().position(|st| st.water.is_some()) {
             return r.bad(
-                &field,
-                format!(
-                    "must be at least the material's dry density ({} kg/m³), found {rho}",
-                    m.density()
-                ),
+                &format!("stages[{k}].water"),
+                "a stage moves the scene's water: give the scene a `water` (its unit weight, \
+                 first table and saturated densities)"
+                    .into(),
             );
         }
+        return Ok((None, vec![None; s.stages.len()]));
+    };
+    let water = spec.checked(&frame).map_err(|e| at("water", e))?;
+    let mut stages = Vec::with_capacity(s.stages.len());
+    for (k, st) in s.stages.iter().enumerate() {
+        stages.push(match &st.water {
+            Some(w) => Some(
+                w.checked(&water, &frame)
+                    .map_err(|e| at(&format!("stages[{k}].water"), e))?,
+            ),
+            None => None,
+        });
     }
-    for (b, body) in s.bodies.iter().enumerate() {
-        let (lo, _) = crate::scene::region_bounds(&body.region, r.n);
-        if lo[water.axis] < water.table && !spec.saturated_density.contains_key(&body.material) {
-            return r.bad(
-                "water.saturated_density",
-                format!(
-                    "bodies[{b}] reaches below the table: give its material \"{}\" a saturated \
-                     density",
-                    body.material
-                ),
-            );
-        }
-    }
-    Ok(Some(water))
+    Ok((Some(water), stages))
 }
 
-/// The ground stands above the table in every column of cells: open water above the ground
-/// would press on its surface, which this engine does not model yet, and leaving it out
-/// would make a slope with a table above its toe fail far too early.
-pub(crate) fn check_ground<D: Dim>(
+/// Every point of material `material` (`name`) that starts below a surface, wholly or in
+/// part (the scene's or a stage's, judged at its place at set-up; `side` its height along
+/// gravity, m), has a saturated density to weigh.
+pub(crate) fn check_saturated(
     loaded: &LoadedScene,
-    grid: &Grid<D>,
-    water: &Water,
-    world: &hecs::World,
+    waters: &[(&str, &Water)],
+    material: u16,
+    name: &str,
+    side: f64,
+    mut xs: impl Iterator<Item = [f64; 3]>,
 ) -> Result<(), SceneError> {
-    // The highest point of each column of cells across gravity's axis.
-    let across: Vec<usize> = (0..D::N).filter(|&a| a != water.axis).collect();
-    let cells: Vec<usize> = across.iter().map(|&a| grid.axes[a].cells).collect();
-    let mut top = vec![f64::NEG_INFINITY; cells.iter().product()];
-    for arch in points_with::<Position<D::Vec>>(world) {
-        for x in col::<Position<D::Vec>>(arch).iter() {
-            let x = D::vec_to3(x.0);
-            let mut k = 0;
-            for (j, &a) in across.iter().enumerate() {
-                let c = ((x[a] - grid.origin.get(a)) * grid.inv_h)
-                    .floor()
-                    .clamp(0.0, (cells[j] - 1) as f64);
-                k = k * cells[j] + c as usize;
-            }
-            top[k] = top[k].max(x[water.axis]);
-        }
+    let has = loaded
+        .scene
+        .water
+        .as_ref()
+        .is_some_and(|w| w.saturated_density.contains_key(name));
+    if has {
+        return Ok(());
     }
-    let half = 0.5 * grid.cell_size;
-    if let Some(k) = top
-        .iter()
-        .position(|&t| t > f64::NEG_INFINITY && t + half < water.table)
-    {
+    if let Some(x) = xs.find(|&x| waters.iter().any(|(_, w)| w.wets(material, x, side))) {
+        let (field, _) = waters
+            .iter()
+            .find(|(_, w)| w.wets(material, x, side))
+            .expect("found");
         return Err(loaded.invalid(
-            "water.table",
+            "water.saturated_density",
             format!(
-                "the table ({} m) stands above the ground in column {k} of cells (its highest \
-                 point at {:.3} m): open water on the surface is not modelled yet; lower the \
-                 table below the ground",
-                water.table, top[k]
+                "material \"{name}\" has points below the piezometric surface of `{field}` (one \
+                 at {:?}): give it a saturated density",
+                &x[..loaded.scene.dimension as usize]
             ),
         ));
     }
