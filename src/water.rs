@@ -95,12 +95,16 @@ fn default_unit_weight() -> f64 {
 #[derive(Clone, Debug, PartialEq)]
 enum Head {
     Level(f64),
-    /// Knots at strictly increasing places (place, height).
-    Polyline(Vec<[f64; 2]>),
-    /// Origin, spacing, node counts, heights row-major (second axis outer).
+    /// The knots' places (strictly increasing) and each segment's start height and slope
+    /// (segment j runs from knot j to knot j + 1).
+    Polyline {
+        x: Vec<f64>,
+        segments: Vec<[f64; 2]>,
+    },
+    /// Origin, 1/spacing, node counts, heights row-major (second axis outer).
     Heights {
         origin: [f64; 2],
-        spacing: [f64; 2],
+        inv_spacing: [f64; 2],
         nodes: [usize; 2],
         h: Vec<f64>,
     },
@@ -108,27 +112,31 @@ enum Head {
 
 impl Head {
     /// The height h and its slope ∂h/∂s along each axis across, at the place `s`.
-    #[inline]
+    #[inline(always)]
     fn at(&self, s: [f64; 2]) -> (f64, [f64; 2]) {
         match self {
             Head::Level(h) => (*h, [0.0; 2]),
-            Head::Polyline(k) => {
-                // The segment holding s (checked: the knots span the grid).
-                let j = k.partition_point(|p| p[0] <= s[0]).clamp(1, k.len() - 1);
-                let ([x0, h0], [x1, h1]) = (k[j - 1], k[j]);
-                let slope = (h1 - h0) / (x1 - x0);
-                (h0 + slope * (s[0] - x0), [slope, 0.0])
+            Head::Polyline { x, segments } => {
+                // The segment holding s (checked: the knots span the grid). A scan, not a
+                // search: a polyline has few knots, and points come in cell order, so the
+                // branch is predicted.
+                let mut j = 0;
+                while j + 1 < segments.len() && x[j + 1] <= s[0] {
+                    j += 1;
+                }
+                let [h0, slope] = segments[j];
+                (slope.mul_add(s[0] - x[j], h0), [slope, 0.0])
             }
             Head::Heights {
                 origin,
-                spacing,
+                inv_spacing,
                 nodes,
                 h,
             } => {
                 let mut cell = [0usize; 2];
                 let mut t = [0.0; 2];
                 for a in 0..2 {
-                    let u = ((s[a] - origin[a]) / spacing[a]).clamp(0.0, (nodes[a] - 1) as f64);
+                    let u = ((s[a] - origin[a]) * inv_spacing[a]).clamp(0.0, (nodes[a] - 1) as f64);
                     cell[a] = (u.floor() as usize).min(nodes[a] - 2);
                     t[a] = u - cell[a] as f64;
                 }
@@ -138,8 +146,8 @@ impl Head {
                     + h10 * t[0] * (1.0 - t[1])
                     + h01 * (1.0 - t[0]) * t[1]
                     + h11 * t[0] * t[1];
-                let d0 = ((h10 - h00) * (1.0 - t[1]) + (h11 - h01) * t[1]) / spacing[0];
-                let d1 = ((h01 - h00) * (1.0 - t[0]) + (h11 - h10) * t[0]) / spacing[1];
+                let d0 = ((h10 - h00) * (1.0 - t[1]) + (h11 - h01) * t[1]) * inv_spacing[0];
+                let d1 = ((h01 - h00) * (1.0 - t[0]) + (h11 - h10) * t[0]) * inv_spacing[1];
                 (value, [d0, d1])
             }
         }
@@ -155,6 +163,8 @@ pub struct Water {
     pub axis: usize,
     /// The axes across gravity's, in order (the third is unused in 2D).
     across: [usize; 2],
+    /// 2 or 3.
+    dims: usize,
     /// The surfaces, and each material's (by `MaterialId`).
     heads: Arc<[Head]>,
     of_material: Arc<[u16]>,
@@ -177,50 +187,64 @@ impl Water {
         self.unit_weight * (self.head(material, x).0 - x[self.axis]).max(0.0)
     }
 
-    /// The share of a point at `x` of height `side` (m, along gravity's axis) that lies
-    /// below its surface, the surface taken level across the point: 0 to 1, linear in
-    /// between, so that a point crossing the surface gains its buoyancy gradually rather
-    /// than all at once.
+    /// The share of a point of volume `volume` whose centre lies `depth` below its surface
+    /// that is below it: 0 to 1, linear across the point's height (its volume taken as a
+    /// square, a cube in 3D) with the surface taken level across the point, so that a point
+    /// crossing the surface gains its buoyancy gradually rather than all at once.
     #[inline(always)]
-    fn submerged(&self, h: f64, x: [f64; 3], side: f64) -> f64 {
-        ((h - x[self.axis]) / side + 0.5).clamp(0.0, 1.0)
+    fn submerged(&self, depth: f64, volume: f64) -> f64 {
+        // |depth| ≥ side/2 without the root: 4 d² ≥ V in 2D, 8 |d|³ ≥ V in 3D.
+        let clear = if self.dims == 2 {
+            4.0 * depth * depth >= volume
+        } else {
+            8.0 * (depth * depth * depth).abs() >= volume
+        };
+        if clear {
+            return if depth > 0.0 { 1.0 } else { 0.0 };
+        }
+        let side = if self.dims == 2 {
+            volume.sqrt()
+        } else {
+            volume.cbrt()
+        };
+        (depth / side + 0.5).clamp(0.0, 1.0)
     }
 
-    /// The body force −∇u (N/m³) on a point at `x` in `material` of height `side` (m):
-    /// γ_w (e_axis − ∇h) times its submerged share (buoyancy and seepage), zero above the
-    /// surface.
+    /// The body force −∇u (N/m³) on a point at `x` in `material` of volume `volume` (m³;
+    /// m² in 2D): γ_w (e_axis − ∇h) times its submerged share (buoyancy and seepage), zero
+    /// above the surface.
     #[inline(always)]
-    pub fn body_force(&self, material: u16, x: [f64; 3], side: f64) -> [f64; 3] {
+    pub fn body_force(&self, material: u16, x: [f64; 3], volume: f64) -> [f64; 3] {
         let (h, slope) = self.head(material, x);
         let mut f = [0.0; 3];
-        let share = self.submerged(h, x, side);
+        let share = self.submerged(h - x[self.axis], volume);
         if share > 0.0 {
             let g = self.unit_weight * share;
             f[self.axis] = g;
             f[self.across[0]] = -g * slope[0];
-            if self.across[1] != self.axis {
+            if self.dims == 3 {
                 f[self.across[1]] = -g * slope[1];
             }
         }
         f
     }
 
-    /// True when some of a point at `x` of height `side` (m) lies below its surface.
-    pub fn wets(&self, material: u16, x: [f64; 3], side: f64) -> bool {
-        self.submerged(self.head(material, x).0, x, side) > 0.0
+    /// True when some of a point at `x` of volume `volume` lies below its surface.
+    pub fn wets(&self, material: u16, x: [f64; 3], volume: f64) -> bool {
+        self.submerged(self.head(material, x).0 - x[self.axis], volume) > 0.0
     }
 
     /// A point's density over its material's dry density: 1 + s (ρ_sat/ρ_dry − 1) for its
-    /// submerged share s at `x` (height `side`, m).
-    pub fn density_factor(&self, material: u16, x: [f64; 3], side: f64) -> f64 {
-        let share = self.submerged(self.head(material, x).0, x, side);
+    /// submerged share s at `x` (volume `volume`).
+    pub fn density_factor(&self, material: u16, x: [f64; 3], volume: f64) -> f64 {
+        let share = self.submerged(self.head(material, x).0 - x[self.axis], volume);
         1.0 + share * (self.wet_ratio[material as usize] - 1.0)
     }
 
     /// The factor a point's mass changes by when the water goes from `self` to `next`, judged
-    /// at the point's current place `x` (height `side`, m).
-    pub fn density_ratio(&self, next: &Water, material: u16, x: [f64; 3], side: f64) -> f64 {
-        next.density_factor(material, x, side) / self.density_factor(material, x, side)
+    /// at the point's current place `x` (volume `volume`).
+    pub fn density_ratio(&self, next: &Water, material: u16, x: [f64; 3], volume: f64) -> f64 {
+        next.density_factor(material, x, volume) / self.density_factor(material, x, volume)
     }
 
     /// The same water with the surfaces of `stage`.
@@ -275,7 +299,13 @@ fn head(surface: &Surface, n: usize, lo: [f64; 2], hi: [f64; 2]) -> Result<Head,
                     ),
                 );
             }
-            Ok(Head::Polyline(k))
+            Ok(Head::Polyline {
+                x: k.iter().map(|p| p[0]).collect(),
+                segments: k
+                    .windows(2)
+                    .map(|w| [w[0][1], (w[1][1] - w[0][1]) / (w[1][0] - w[0][0])])
+                    .collect(),
+            })
         }
         Surface::Heights { .. } if n != 2 => bad(
             "",
@@ -324,7 +354,7 @@ fn head(surface: &Surface, n: usize, lo: [f64; 2], hi: [f64; 2]) -> Result<Head,
             }
             Ok(Head::Heights {
                 origin: [g.origin[0], g.origin[1]],
-                spacing: [g.spacing[0], g.spacing[1]],
+                inv_spacing: [1.0 / g.spacing[0], 1.0 / g.spacing[1]],
                 nodes,
                 h: g.heights.iter().flatten().copied().collect(),
             })
@@ -442,6 +472,7 @@ impl WaterSpec {
             unit_weight: self.unit_weight,
             axis,
             across: Frame::across(axis, frame.lo.len()),
+            dims: frame.lo.len(),
             heads: heads.into(),
             of_material: of_material.into(),
             wet_ratio: wet_ratio.into(),
@@ -490,10 +521,10 @@ mod tests {
         let w = spec(Surface::Level(5.0)).checked(&frame_2d(&m)).unwrap();
         assert_eq!(w.pore_pressure(0, [0.0, 2.0, 0.0]), 30.0e3);
         assert_eq!(w.pore_pressure(0, [0.0, 6.0, 0.0]), 0.0);
-        assert_eq!(w.body_force(0, [3.0, 2.0, 0.0], 0.5), [0.0, 10.0e3, 0.0]);
-        assert_eq!(w.body_force(0, [3.0, 6.0, 0.0], 0.5), [0.0; 3]);
+        assert_eq!(w.body_force(0, [3.0, 2.0, 0.0], 0.25), [0.0, 10.0e3, 0.0]);
+        assert_eq!(w.body_force(0, [3.0, 6.0, 0.0], 0.25), [0.0; 3]);
         // A point astride the table: a quarter of it below, a quarter of its buoyancy.
-        assert_eq!(w.body_force(0, [3.0, 5.125, 0.0], 0.5), [0.0, 2.5e3, 0.0]);
+        assert_eq!(w.body_force(0, [3.0, 5.125, 0.0], 0.25), [0.0, 2.5e3, 0.0]);
     }
 
     /// A polyline's pressure is γ_w times the vertical height below it; its slope adds a
@@ -505,7 +536,7 @@ mod tests {
         let w = spec(line).checked(&frame_2d(&m)).unwrap();
         assert_eq!(w.pore_pressure(0, [5.0, 3.0, 0.0]), 50.0e3);
         assert!((w.pore_pressure(0, [15.5, 1.0, 0.0]) - 42.5e3).abs() < 1e-9);
-        let f = w.body_force(0, [15.5, 1.0, 0.0], 0.5);
+        let f = w.body_force(0, [15.5, 1.0, 0.0], 0.25);
         assert!(
             (f[0] - 5.0e3).abs() < 1e-9 && f[1] == 10.0e3 && f[2] == 0.0,
             "{f:?}"
@@ -529,7 +560,7 @@ mod tests {
         let w = spec(grid).checked(&frame).unwrap();
         // h(1, 1) = 7, ∂h/∂x = 1, ∂h/∂y = 2.
         assert!((w.pore_pressure(0, [1.0, 1.0, 0.0]) - 70.0e3).abs() < 1e-9);
-        let f = w.body_force(0, [1.0, 1.0, 0.0], 0.5);
+        let f = w.body_force(0, [1.0, 1.0, 0.0], 0.125);
         assert!((f[0] + 10.0e3).abs() < 1e-9 && (f[1] + 20.0e3).abs() < 1e-9 && f[2] == 10.0e3);
     }
 

@@ -271,3 +271,16 @@ fn two_runs_on_the_same_ranks_give_the_same_bits() {
     let (b, _) = run_on("slope_fast.ron", 2, "again-b", &["solver.max_time=3.0"]);
     assert!(files(&a) == files(&b), "the runs differ");
 }
+
+/// The slope with a water table (scenes/slope_water.ron, without the volumetric smoothing
+/// that ranks do not sum yet) on 2 and 4 ranks follows one rank step for step: the pore
+/// water's load is mapped by each rank from its own points and summed with the rest.
+#[test]
+fn the_slope_with_a_water_table_on_2_and_4_ranks_agrees_with_one_rank_to_1e_10() {
+    let plain = ["solver.volumetric_smoothing=false"];
+    let (_, one) = run_on("slope_water.ron", 1, "water", &plain);
+    for ranks in [2, 4] {
+        let (_, many) = run_on("slope_water.ron", ranks, "water", &plain);
+        agrees(&one, &many, 1e-10, &format!("water on {ranks} ranks"));
+    }
+}

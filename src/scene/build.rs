@@ -529,19 +529,16 @@ fn spawn_body<D: Dim>(
     // Below its piezometric surface a point weighs its material's saturated density (by the
     // share of its height below the surface, for a point astride it).
     let named: Vec<(&str, &crate::water::Water)> = waters.iter().map(|(f, w)| (f.as_str(), *w)).collect();
-    let side = waters.first().map_or(0.0, |(_, w)| {
-        s.grid.cell_size / body.points_per_cell[w.axis] as f64
-    });
     validate::check_saturated(
         loaded,
         &named,
         mat as u16,
         &body.material,
-        side,
+        volume,
         xs.clone().map(|(x, _)| x),
     )?;
     let mass_at = |x: [f64; 3]| match waters.first() {
-        Some((_, w)) => mass * w.density_factor(mat as u16, x, side),
+        Some((_, w)) => mass * w.density_factor(mat as u16, x, volume),
         None => mass,
     };
     let next_id = u32::try_from(count)

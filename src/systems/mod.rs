@@ -30,7 +30,6 @@ mod node_pairs;
 pub mod p2g;
 pub mod peak_watch;
 pub mod point_loads;
-pub mod pore_pressure;
 pub mod prescribed_motion;
 pub mod remap;
 pub mod spatial_sort;
@@ -52,7 +51,6 @@ pub use nodal_velocity::NodalVelocity;
 pub use p2g::{P2g, P2gPart};
 pub use peak_watch::PeakWatch;
 pub use point_loads::PointLoads;
-pub use pore_pressure::PorePressure;
 pub use prescribed_motion::PrescribedMotion;
 pub use remap::Remap;
 pub use spatial_sort::SpatialSort;
@@ -258,7 +256,7 @@ fn mapping<D: Dim, S: Shape>() -> Vec<Entry<D>> {
             St::Map,
             Schemes(MUSL_USL),
             &[SORTED],
-            "mass, momentum, internal force to the nodes",
+            "mass, momentum, internal force (and the pore water's load) to the nodes",
             |_| Box::new(P2g::<D, S>::new(P2gPart::All)),
         ),
         e(
@@ -344,7 +342,7 @@ fn straining<D: Dim, S: Shape>() -> Vec<Entry<D>> {
             St::MapForce,
             Schemes(USF),
             &[("stress_update", "p2g_force maps the updated stress")],
-            "USF: internal force of the updated stress",
+            "USF: internal force of the updated stress (and the pore water's load)",
             |_| Box::new(P2g::<D, S>::new(P2gPart::InternalForce)),
         ),
     ]
@@ -381,20 +379,6 @@ fn loading<D: Dim, S: Shape>() -> Vec<Entry<D>> {
             |_| Box::new(PointLoads::<D, S>::default()),
         ),
         e(
-            "pore_pressure",
-            St::Forces,
-            Needed(|s, _| s.water.is_some(), "the scene has water"),
-            &[
-                ("p2g", "the pore water's load adds to the forces p2g maps"),
-                (
-                    "p2g_force",
-                    "the pore water's load adds to the forces p2g_force maps",
-                ),
-            ],
-            "pore water: buoyancy and seepage −∇u, open water's pressure (σ = σ′ − u I)",
-            |_| Box::new(PorePressure::<D, S>::default()),
-        ),
-        e(
             "boundary",
             St::Constrain,
             Always,
@@ -403,7 +387,6 @@ fn loading<D: Dim, S: Shape>() -> Vec<Entry<D>> {
                 ("p2g_force", COMPLETE),
                 ("gravity", COMPLETE),
                 ("point_loads", COMPLETE),
-                ("pore_pressure", COMPLETE),
             ],
             "held components: fixed at zero, or at a motion's velocity",
             |_| Box::new(Boundary),

@@ -2,7 +2,7 @@
 
 use crate::components::*;
 use crate::context::Context;
-use crate::dim::Dim;
+use crate::dim::{Dim, Vector};
 use crate::error::StepError;
 use crate::infra::columns::{col, col_mut, nodes, points_with};
 use crate::infra::lanes::F64x4;
@@ -25,6 +25,13 @@ pub enum P2gPart {
 }
 
 /// Maps point mass m_p, momentum m_p v_p and internal force −V_p σ_p·∇w_ip to the grid.
+///
+/// With water, the force pass also maps the pore water's load on each point below its
+/// piezometric surface, V_p w_ip (−∇u_p) ([`crate::water::Water::body_force`]: buoyancy,
+/// seepage, and with them the pressure of open water on a submerged surface), to the
+/// nodal force and, as applied load, to the external force. It rides on the stress's pass
+/// because the weights are already at hand there: a pass of its own would cost as much
+/// again as the mapping of the stress.
 ///
 /// Points are grouped in slabs of grid rows that scatter in parallel, slabs that share no
 /// node at a time (see `parallel::scatter`).
@@ -73,6 +80,8 @@ impl<D: Dim, S: Shape> P2g<D, S> {
         let mut nm = col_mut::<NodeMass>(n);
         let mut np = col_mut::<NodeMomentum<D::Vec>>(n);
         let mut nf = col_mut::<NodeForce<D::Vec>>(n);
+        let mut ne = col_mut::<NodeExternalForce<D::Vec>>(n);
+        let water = ctx.settings.water.as_ref();
         let (mass_momentum, force) = match self.part {
             P2gPart::All => (true, true),
             P2gPart::MassMomentum => (true, false),
@@ -87,22 +96,25 @@ impl<D: Dim, S: Shape> P2g<D, S> {
             let volg = arch.get::<&Volume>();
             let stressed = sg.as_deref().zip(volg.as_deref());
             let force = force && stressed.is_some();
+            // The points' materials, where the scene has water.
+            let idg = water.and(arch.get::<&MaterialId>());
+            let wet = water.zip(idg.as_deref());
             if !mass_momentum && !force {
                 continue;
             }
             let (x, m): (&[Position<D::Vec>], &[Mass]) = (&xg, &mg);
             let v: &[Velocity<D::Vec>] = &vg;
             let target = (
-                Disjoint::new(&mut nm),
-                Disjoint::new(&mut np),
+                (Disjoint::new(&mut nm), Disjoint::new(&mut np)),
                 Disjoint::new(&mut nf),
+                Disjoint::new(&mut ne),
             );
             reached = reached.union(scatter(
                 ctx.slabs.slabs(grid, x),
                 grid,
                 S::SUPPORT,
                 &target,
-                |points, (nm, np, nf), lo| {
+                |points, ((nm, np), nf, ne), lo| {
                     for &p in points {
                         let p = p as usize;
                         let (mp, mv) = (m[p].0, v[p].0 * m[p].0);
@@ -110,8 +122,36 @@ impl<D: Dim, S: Shape> P2g<D, S> {
                             (Some((s, vol)), true) => Some((&s[p].0, -vol[p].0)),
                             _ => None,
                         };
+                        // The pore water's load on the point, per unit of its mass (N/kg).
+                        let pore = match (wet, f) {
+                            (Some((w, ids)), Some((_, neg_vol))) => {
+                                let vol = -neg_vol;
+                                let b = w.body_force(ids[p].0, D::vec_to3(x[p].0), vol);
+                                (b != [0.0; 3]).then(|| D::vec_from(b) * (vol / mp))
+                            }
+                            _ => None,
+                        };
                         // One loop per case, so that the node loop holds no branch.
                         match (mass_momentum, f) {
+                            (true, Some((s, neg_vol))) if pore.is_some() => {
+                                let a = pore.expect("matched");
+                                S::scatter_with_gradient(
+                                    grid,
+                                    x[p].0,
+                                    mp,
+                                    mv,
+                                    &s.to_sym3(),
+                                    neg_vol,
+                                    |i, dm, dp, df| {
+                                        // dm = w_ip m_p, so a dm = w_ip V_p (−∇u_p).
+                                        let k = i - lo;
+                                        nm[k].0 += dm;
+                                        np[k].0 += dp;
+                                        nf[k].0 += a.madd(dm, df);
+                                        ne[k].0 += a * dm;
+                                    },
+                                )
+                            }
                             (true, Some((s, neg_vol))) => S::scatter_with_gradient(
                                 grid,
                                 x[p].0,
@@ -134,10 +174,20 @@ impl<D: Dim, S: Shape> P2g<D, S> {
                             (false, Some((s, neg_vol))) => {
                                 let sigma = StressColumns::of(&s.to_sym3(), 1.0);
                                 let neg_vol = F64x4::splat(neg_vol);
-                                for_each_node::<D, S>(grid, x[p].0, |i, _, grad| {
-                                    let f = sigma.dot::<D>(grad) * neg_vol;
-                                    nf[i - lo].0 += from_lanes::<D>(f);
-                                })
+                                match pore {
+                                    Some(a) => {
+                                        let a = a * mp;
+                                        for_each_node::<D, S>(grid, x[p].0, |i, w, grad| {
+                                            let f = sigma.dot::<D>(grad) * neg_vol;
+                                            nf[i - lo].0 += a.madd(w, from_lanes::<D>(f));
+                                            ne[i - lo].0 += a * w;
+                                        })
+                                    }
+                                    None => for_each_node::<D, S>(grid, x[p].0, |i, _, grad| {
+                                        let f = sigma.dot::<D>(grad) * neg_vol;
+                                        nf[i - lo].0 += from_lanes::<D>(f);
+                                    }),
+                                }
                             }
                             (false, None) => {}
                         }
@@ -151,7 +201,7 @@ impl<D: Dim, S: Shape> P2g<D, S> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::dim::Vector;
+
     use crate::infra::columns::col_mut;
     use crate::scene::{build, LoadedScene};
     use crate::shape::{Linear, QuadraticBSpline};

@@ -59,8 +59,7 @@ fn rewet<D: Dim>(ctx: &mut Context<D>, stage: &LoadStage) {
         let vs = col::<Volume>(arch);
         let mut mass = col_mut::<Mass>(arch);
         for (((m, id), x), v) in mass.iter_mut().zip(ids.iter()).zip(xs.iter()).zip(vs.iter()) {
-            let side = if D::N == 2 { v.0.sqrt() } else { v.0.cbrt() };
-            m.0 *= old.density_ratio(new, id.0, D::vec_to3(x.0), side);
+            m.0 *= old.density_ratio(new, id.0, D::vec_to3(x.0), v.0);
         }
     }
 }

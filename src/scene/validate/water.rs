@@ -61,14 +61,14 @@ pub(super) fn check_water(
 }
 
 /// Every point of material `material` (`name`) that starts below a surface, wholly or in
-/// part (the scene's or a stage's, judged at its place at set-up; `side` its height along
-/// gravity, m), has a saturated density to weigh.
+/// part (the scene's or a stage's, judged at its place at set-up; `volume` a point's), has
+/// a saturated density to weigh.
 pub(crate) fn check_saturated(
     loaded: &LoadedScene,
     waters: &[(&str, &Water)],
     material: u16,
     name: &str,
-    side: f64,
+    volume: f64,
     mut xs: impl Iterator<Item = [f64; 3]>,
 ) -> Result<(), SceneError> {
     let has = loaded
@@ -79,10 +79,10 @@ pub(crate) fn check_saturated(
     if has {
         return Ok(());
     }
-    if let Some(x) = xs.find(|&x| waters.iter().any(|(_, w)| w.wets(material, x, side))) {
+    if let Some(x) = xs.find(|&x| waters.iter().any(|(_, w)| w.wets(material, x, volume))) {
         let (field, _) = waters
             .iter()
-            .find(|(_, w)| w.wets(material, x, side))
+            .find(|(_, w)| w.wets(material, x, volume))
             .expect("found");
         return Err(loaded.invalid(
             "water.saturated_density",
