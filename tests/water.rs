@@ -275,7 +275,9 @@ fn a_cohesionless_slope_has_one_factor_of_safety_dry_and_submerged() {
 /// slope or the full reservoir in the package's direction.
 #[test]
 fn the_slopes_with_water_stand_beside_bishops_method() {
-    let cases: [(&str, &str, &[&str], [f64; 2], f64); 5] = [
+    // (output, scene, overrides, bracket at h = 1 m, Bishop's factor by XSLOPE)
+    type Case<'a> = (&'a str, &'a str, &'a [&'a str], [f64; 2], f64);
+    let cases: [Case; 5] = [
         ("lem-dry", "slope_fos.ron", &[], [1.40625, 1.421875], 1.378),
         ("lem-water", "slope_water.ron", &[], [1.21875, 1.234375], 1.182),
         (
