@@ -80,6 +80,10 @@ pub struct FosReport {
     /// The water the trials held (pore pressures are not reduced), when the scene has some.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub water: Option<crate::water::WaterSpec>,
+    /// The water of each stage that moves it, by stage name, in stage order: the trials end
+    /// in the last one's (a drawdown's lowered table).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub stage_water: Vec<(String, crate::water::StageWaterSpec)>,
     /// Wall-clock seconds of the whole analysis.
     pub wall_seconds: f64,
 }
@@ -228,6 +232,12 @@ pub fn strength_reduction(
         mechanism,
         steps: trials.iter().map(|t| t.steps).sum(),
         water: loaded.scene.water.clone(),
+        stage_water: loaded
+            .scene
+            .stages
+            .iter()
+            .filter_map(|st| Some((st.name.clone(), st.water.clone()?)))
+            .collect(),
         trials,
         wall_seconds: start.elapsed().as_secs_f64(),
     };

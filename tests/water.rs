@@ -186,6 +186,59 @@ fn strength_reduction_holds_the_pore_pressures_and_names_the_water() {
     assert_eq!(wet["water"]["saturated_density"]["soil"], 2100.0);
 }
 
+/// The saturated column in 3D, gravity along z and the table given as a height grid over x
+/// and y (level at 8 m, 1 × 1 m, between rollers): the same effective stress as in plane
+/// strain. Quadratic B-splines, h = 0.25 m: −66.264 kPa at z = 4.81 m against −66.271 kPa
+/// with its 3.2 cm settlement (−0.01 %), pinned.
+#[test]
+fn a_saturated_column_in_3d_under_a_height_grid_carries_its_buoyant_weight() {
+    let s = common::run_text("column_3d.ron", COLUMN_3D);
+    assert!(s.converged, "{:?}", s.error);
+    let mid = &s.traced[0];
+    let (z, settlement) = (mid.initial_position[2], -mid.displacement[2]);
+    let g = 9.81;
+    let weight = 1800.0 * g * 2.0 + 2000.0 * g * (8.0 - z);
+    let settled = -(weight - 9810.0 * (8.0 - z + settlement));
+    let szz = mid.stress.zz;
+    assert!(rel(szz, -66263.598819919).abs() < 1e-9, "{szz}");
+    assert!(rel(szz, settled).abs() < 0.001, "{szz} Pa against {settled}");
+    assert!(rel(mid.stress.xx / szz, 0.3 / 0.7).abs() < 1e-6, "K0");
+}
+
+const COLUMN_3D: &str = r#"Scene(
+    dimension: 3,
+    grid: (origin: [0.0, 0.0, 0.0], cell_size: 0.25, cells: [4, 4, 40]),
+    shape: QuadraticBSpline,
+    materials: {
+        "soil": MohrCoulomb(
+            density: 1800.0,
+            youngs_modulus: 10.0e6,
+            poisson_ratio: 0.3,
+            cohesion: 0.0,
+            friction_angle: 30.0,
+            dilatancy_angle: 0.0,
+        ),
+    },
+    bodies: [
+        (material: "soil", region: Box(min: [0.0, 0.0, 0.0], max: [1.0, 1.0, 10.0]), points_per_cell: [2, 2, 2]),
+    ],
+    boundaries: [
+        (face: ZMin, condition: Fixed),
+        (face: XMin, condition: Roller),
+        (face: XMax, condition: Roller),
+        (face: YMin, condition: Roller),
+        (face: YMax, condition: Roller),
+    ],
+    gravity: (acceleration: [0.0, 0.0, -9.81]),
+    water: (
+        table: Heights(origin: [0.0, 0.0], spacing: [1.0, 1.0], heights: [[8.0, 8.0], [8.0, 8.0]]),
+        saturated_density: {"soil": 2000.0},
+    ),
+    traced: [(name: "mid", position: [0.4375, 0.4375, 4.8125])],
+    solver: (damping: Kinetic, time_step: Courant(0.5), tolerance: 1e-4, max_time: 20.0),
+)
+"#;
+
 /// A stage that raises the table wets the soil it reaches: the column dry in a first stage
 /// (the table below its base), then with the table 2 m below its top, comes to the
 /// effective stress of the column built wet (to the tolerance of two static states, not
@@ -306,6 +359,13 @@ fn the_slopes_with_water_stand_beside_bishops_method() {
     for (name, scene, sets, bracket, bishop) in cases {
         let s = fos_at_1m(name, scene, sets);
         assert_eq!(s["bracket"], serde_json::json!(bracket), "{name}");
+        if name == "lem-drawdown" {
+            assert_eq!(s["water"]["table"], serde_json::json!({"Level": 10.0}));
+            assert_eq!(
+                s["stage_water"],
+                serde_json::json!([["drawn down", {"table": {"Level": 3.0}, "material_tables": {}}]])
+            );
+        }
         let f = s["factor_of_safety"].as_f64().unwrap();
         assert!(
             rel(f, bishop).abs() < 0.07,
