@@ -258,6 +258,14 @@ fn a_staged_run_resumed_in_its_second_stage_writes_the_same_files() {
     resume_from_last_checkpoint("bar.ron", 2_000, &[stages]);
 }
 
+/// The drained drawdown (scenes/slope_drawdown.ron), checkpointed in its second stage (step
+/// 2 000 of 2 756): the lowered table comes back with the stage, the points' weights with
+/// the points.
+#[test]
+fn a_drawdown_resumed_below_its_lowered_table_writes_the_same_files() {
+    resume_from_last_checkpoint("slope_drawdown.ron", 2_000, &[]);
+}
+
 /// The footing, checkpointed in its sixth increment (step 5 000 of 7 753): the motion's
 /// travel, its hold and the curve so far come back with the points.
 #[test]
