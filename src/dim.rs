@@ -1,9 +1,10 @@
 //! The spatial dimension as a type parameter.
 //!
 //! Every solver type is generic over [`Dim`], implemented by [`Dim2`] (plane strain, unit
-//! thickness) and [`Dim3`]. A 2D scene therefore stores two-component vectors, visits four
-//! nodes per point with linear shape functions and never touches a third axis; the only
-//! 3D quantity it keeps is the out-of-plane normal stress, which plane strain requires.
+//! thickness), [`DimAxi`] (axisymmetric, per radian) and [`Dim3`]. A 2D scene therefore
+//! stores two-component vectors, visits four nodes per point with linear shape functions
+//! and never touches a third axis; the only 3D quantity it keeps is the out-of-plane normal
+//! stress, which plane strain requires and which is the hoop stress σ_θθ in axisymmetry.
 
 use crate::infra::lanes::{madd, Lanes};
 use crate::tensor::{PlanarSym3, StoredSym, Sym, Sym3};
@@ -79,6 +80,13 @@ impl_vector!(DVec3);
 pub trait Dim: Copy + Send + Sync + Debug + Default + 'static {
     /// Number of spatial axes (2 or 3).
     const N: usize;
+    /// Axisymmetric about the y axis, x being the radius r (a point's volume and mass are
+    /// per radian; the hoop strain rate v_r/r and the hoop stress's force −σ_θθ/r join the
+    /// in-plane ones).
+    const AXISYMMETRIC: bool = false;
+    /// Normal strains that can be non-zero: 2 in plane strain, 3 in 3D and in axisymmetry
+    /// (the hoop strain).
+    const STRAIN_AXES: usize = Self::N;
     /// Position, velocity, force (m, m/s, N).
     type Vec: Vector;
     /// Velocity gradient L_ij = ∂v_i/∂x_j (1/s), column-major glam matrix.
@@ -109,6 +117,10 @@ pub trait Dim: Copy + Send + Sync + Debug + Default + 'static {
     fn add_identity(m: &mut Self::Mat, k: f64);
     /// The matrix whose column j is `c[j]`, for the first `N` columns.
     fn mat_from_cols(c: [Self::Vec; 3]) -> Self::Mat;
+    /// Completes a point's velocity gradient `l` from its place `x` and velocity `v`: the
+    /// hoop strain rate v_r/r in axisymmetry, nothing otherwise.
+    #[inline(always)]
+    fn complete_gradient(_l: &mut Self::Mat, _x: Self::Vec, _v: Self::Vec) {}
 }
 
 /// Plane strain, unit thickness (m).
@@ -118,6 +130,12 @@ pub struct Dim2;
 /// Three dimensions.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Dim3;
+
+/// Axisymmetric about the y axis: x is the radius r ≥ 0, y the axial coordinate z, and the
+/// stress's out-of-plane normal the hoop stress σ_θθ. Volumes and masses are per radian
+/// (V = r · area), so are forces; the velocity gradient carries v_r/r at (2, 2).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct DimAxi;
 
 impl Dim for Dim2 {
     const N: usize = 2;
@@ -225,6 +243,58 @@ impl Dim for Dim3 {
     #[inline(always)]
     fn mat_from_cols(c: [DVec3; 3]) -> DMat3 {
         DMat3::from_cols(c[0], c[1], c[2])
+    }
+}
+
+impl Dim for DimAxi {
+    const N: usize = 2;
+    const AXISYMMETRIC: bool = true;
+    const STRAIN_AXES: usize = 3;
+    type Vec = DVec2;
+    /// The in-plane gradient in the upper 2 × 2, the hoop rate v_r/r at (2, 2).
+    type Mat = DMat3;
+    type Stress = PlanarSym3;
+    const MAT_ZERO: DMat3 = DMat3::ZERO;
+
+    #[inline(always)]
+    fn vec_from(xyz: [f64; 3]) -> DVec2 {
+        Dim2::vec_from(xyz)
+    }
+    #[inline(always)]
+    fn vec_to3(v: DVec2) -> [f64; 3] {
+        Dim2::vec_to3(v)
+    }
+    #[inline(always)]
+    fn jaumann_rotate<T: Lanes>(s: &Sym<T>, w: [T; 3]) -> Sym<T> {
+        // The spin is in the r–z plane, about the hoop direction, as plane strain's.
+        crate::tensor::jaumann_rotate_about_z(s, w[2])
+    }
+    #[inline(always)]
+    fn strain_spin<T: Lanes>(l: impl Fn(usize, usize) -> T, dt: T) -> (Sym<T>, [T; 3]) {
+        let (mut strain, spin) = Dim2::strain_spin(&l, dt);
+        strain.zz = l(2, 2) * dt;
+        (strain, spin)
+    }
+    #[inline(always)]
+    fn mat_entry(m: &DMat3, i: usize, j: usize) -> f64 {
+        m.col(j)[i]
+    }
+    #[inline(always)]
+    fn volume_ratio(l: &DMat3, dt: f64) -> f64 {
+        (DMat3::IDENTITY + *l * dt).determinant()
+    }
+    #[inline(always)]
+    fn add_identity(m: &mut DMat3, k: f64) {
+        Dim3::add_identity(m, k)
+    }
+    #[inline(always)]
+    fn mat_from_cols(c: [DVec2; 3]) -> DMat3 {
+        DMat3::from_cols(c[0].extend(0.0), c[1].extend(0.0), DVec3::ZERO)
+    }
+    #[inline(always)]
+    fn complete_gradient(l: &mut DMat3, x: DVec2, v: DVec2) {
+        // v_r/r (1/s); points lie off the axis (r > 0) by construction.
+        l.z_axis.z = v.x / x.x;
     }
 }
 

@@ -60,7 +60,7 @@ mod testing;
 pub mod water;
 
 pub use context::Context;
-pub use dim::{Dim, Dim2, Dim3};
+pub use dim::{Dim, Dim2, Dim3, DimAxi};
 pub use error::{SceneError, StepError};
 pub use interrupt::StopSignal;
 pub use output::{Outcome, Summary};

@@ -2,7 +2,7 @@
 
 use crate::components::*;
 use crate::context::Context;
-use crate::dim::{Dim, Dim2, Dim3};
+use crate::dim::{Dim, Dim2, Dim3, DimAxi};
 use crate::error::StepError;
 use crate::infra::columns::{col, points_with};
 use crate::materials::first_non_finite_state;
@@ -267,6 +267,8 @@ pub enum AnySimulation {
     Two(Simulation<Dim2>),
     /// Three dimensions.
     Three(Simulation<Dim3>),
+    /// Axisymmetric, per radian.
+    Axi(Simulation<DimAxi>),
 }
 
 /// Evaluates `$body` with `$sim` bound to the inner [`Simulation`] of an [`AnySimulation`].
@@ -276,6 +278,7 @@ macro_rules! with_simulation {
         match $any {
             $crate::simulation::AnySimulation::Two($sim) => $body,
             $crate::simulation::AnySimulation::Three($sim) => $body,
+            $crate::simulation::AnySimulation::Axi($sim) => $body,
         }
     };
 }

@@ -165,6 +165,9 @@ pub struct Water {
     across: [usize; 2],
     /// 2 or 3.
     dims: usize,
+    /// Volumes are per radian (axisymmetry, x the radius): a point's height comes from its
+    /// area, V / r.
+    axisymmetric: bool,
     /// The surfaces, and each material's (by `MaterialId`).
     heads: Arc<[Head]>,
     of_material: Arc<[u16]>,
@@ -192,7 +195,8 @@ impl Water {
     /// square, a cube in 3D) with the surface taken level across the point, so that a point
     /// crossing the surface gains its buoyancy gradually rather than all at once.
     #[inline(always)]
-    fn submerged(&self, depth: f64, volume: f64) -> f64 {
+    fn submerged(&self, depth: f64, volume: f64, x: [f64; 3]) -> f64 {
+        let volume = if self.axisymmetric { volume / x[0] } else { volume };
         // |depth| ≥ side/2 without the root: 4 d² ≥ V in 2D, 8 |d|³ ≥ V in 3D.
         let clear = if self.dims == 2 {
             4.0 * depth * depth >= volume
@@ -217,7 +221,7 @@ impl Water {
     pub fn body_force(&self, material: u16, x: [f64; 3], volume: f64) -> [f64; 3] {
         let (h, slope) = self.head(material, x);
         let mut f = [0.0; 3];
-        let share = self.submerged(h - x[self.axis], volume);
+        let share = self.submerged(h - x[self.axis], volume, x);
         if share > 0.0 {
             let g = self.unit_weight * share;
             f[self.axis] = g;
@@ -231,13 +235,13 @@ impl Water {
 
     /// True when some of a point at `x` of volume `volume` lies below its surface.
     pub fn wets(&self, material: u16, x: [f64; 3], volume: f64) -> bool {
-        self.submerged(self.head(material, x).0 - x[self.axis], volume) > 0.0
+        self.submerged(self.head(material, x).0 - x[self.axis], volume, x) > 0.0
     }
 
     /// A point's density over its material's dry density: 1 + s (ρ_sat/ρ_dry − 1) for its
     /// submerged share s at `x` (volume `volume`).
     pub fn density_factor(&self, material: u16, x: [f64; 3], volume: f64) -> f64 {
-        let share = self.submerged(self.head(material, x).0 - x[self.axis], volume);
+        let share = self.submerged(self.head(material, x).0 - x[self.axis], volume, x);
         1.0 + share * (self.wet_ratio[material as usize] - 1.0)
     }
 
@@ -372,6 +376,8 @@ pub struct Frame<'a> {
     pub hi: &'a [f64],
     /// The materials' names and dry densities, in `MaterialId` order.
     pub materials: &'a [(&'a str, f64)],
+    /// The scene is axisymmetric (volumes per radian).
+    pub axisymmetric: bool,
 }
 
 impl Frame<'_> {
@@ -473,6 +479,7 @@ impl WaterSpec {
             axis,
             across: Frame::across(axis, frame.lo.len()),
             dims: frame.lo.len(),
+            axisymmetric: frame.axisymmetric,
             heads: heads.into(),
             of_material: of_material.into(),
             wet_ratio: wet_ratio.into(),
@@ -503,6 +510,7 @@ mod tests {
             lo: &[0.0, 0.0],
             hi: &[20.0, 10.0],
             materials,
+            axisymmetric: false,
         }
     }
 
@@ -551,6 +559,7 @@ mod tests {
             lo: &[0.0, 0.0, 0.0],
             hi: &[2.0, 2.0, 10.0],
             materials: &m,
+            axisymmetric: false,
         };
         let grid = Surface::Heights {
             origin: vec![0.0, 0.0],

@@ -22,6 +22,7 @@ fn sim<D: Dim>(loaded: &LoadedScene) -> Simulation<D> {
     let any: Box<dyn std::any::Any> = match build(loaded).unwrap().0 {
         AnySimulation::Two(s) => Box::new(s),
         AnySimulation::Three(s) => Box::new(s),
+        AnySimulation::Axi(s) => Box::new(s),
     };
     *any.downcast().expect("the scene's dimension")
 }
@@ -271,6 +272,12 @@ fn a_drawdown_resumed_below_its_lowered_table_writes_the_same_files() {
 #[test]
 fn the_footing_resumed_in_the_middle_of_an_increment_writes_the_same_curve() {
     resume_from_last_checkpoint("footing.ron", 5_000, &[]);
+}
+
+/// The circular footing (axisymmetric), checkpointed in its sixth increment.
+#[test]
+fn an_axisymmetric_footing_resumed_in_an_increment_writes_the_same_curve() {
+    resume_from_last_checkpoint("footing_circular.ron", 5_000, &[]);
 }
 
 /// The paper's slope, checkpointed in the middle of its run (step 15 000 of 28 131).

@@ -2,10 +2,10 @@
 //! and the schedule. Only what the scene uses is created.
 
 use super::validate::{self, carried_state, Checked, CheckedGrid, CheckedStage, Derived, FaceHold};
-use super::{pad3, LoadedScene, Region, Scene};
+use super::{pad3, Dimension, LoadedScene, Region, Scene};
 use crate::components::*;
 use crate::context::Context;
-use crate::dim::{Dim, Dim2, Dim3, Vector};
+use crate::dim::{Dim, Dim2, Dim3, DimAxi, Vector};
 use crate::error::SceneError;
 use crate::grid::Grid;
 use crate::infra::columns::{col, points_with};
@@ -24,11 +24,15 @@ use hecs::{ColumnBatchBuilder, ColumnBatchType, Entity, World};
 pub fn build(loaded: &LoadedScene) -> Result<(AnySimulation, Derived), SceneError> {
     let checked = validate::check(loaded)?;
     Ok(match loaded.scene.dimension {
-        2 => {
+        Dimension::Two => {
             let (sim, d) = build_dim::<Dim2>(loaded, checked)?;
             (AnySimulation::Two(sim), d)
         }
-        _ => {
+        Dimension::Axisymmetric => {
+            let (sim, d) = build_dim::<DimAxi>(loaded, checked)?;
+            (AnySimulation::Axi(sim), d)
+        }
+        Dimension::Three => {
             let (sim, d) = build_dim::<Dim3>(loaded, checked)?;
             (AnySimulation::Three(sim), d)
         }
@@ -525,7 +529,8 @@ fn spawn_body<D: Dim>(
     // The points carry the state of every model their material takes, from the start.
     let state = carried_state(loaded, table, &body.material).expect("validated");
     let volume = cell_volume / body.points_per_cell.iter().product::<usize>() as f64;
-    let mass = model.density() * volume;
+    // In axisymmetry a point's volume is per radian: its area times its radius.
+    let vol_at = |x: [f64; 3]| if D::AXISYMMETRIC { volume * x[0] } else { volume };
     // Below its piezometric surface a point weighs its material's saturated density (by the
     // share of its height below the surface, for a point astride it).
     let named: Vec<(&str, &crate::water::Water)> = waters.iter().map(|(f, w)| (f.as_str(), *w)).collect();
@@ -534,12 +539,14 @@ fn spawn_body<D: Dim>(
         &named,
         mat as u16,
         &body.material,
-        volume,
-        xs.clone().map(|(x, _)| x),
+        xs.clone().map(|(x, _)| (x, vol_at(x))),
     )?;
-    let mass_at = |x: [f64; 3]| match waters.first() {
-        Some((_, w)) => mass * w.density_factor(mat as u16, x, volume),
-        None => mass,
+    let mass_at = |x: [f64; 3]| {
+        let (v, rho) = (vol_at(x), model.density());
+        match waters.first() {
+            Some((_, w)) => rho * v * w.density_factor(mat as u16, x, v),
+            None => rho * v,
+        }
     };
     let next_id = u32::try_from(count)
         .ok()
@@ -574,17 +581,19 @@ fn spawn_body<D: Dim>(
     fill(&batch, xs.clone().map(|(_, id)| PointId(id)));
     fill(&batch, xs.clone().map(|(x, _)| Position(D::vec_from(x))));
     fill(&batch, std::iter::repeat_n(Velocity(z), count));
-    fill(&batch, xs.map(|(x, _)| Mass(mass_at(x))));
-    fill(&batch, std::iter::repeat_n(Volume(volume), count));
+    fill(&batch, xs.clone().map(|(x, _)| Mass(mass_at(x))));
+    fill(&batch, xs.map(|(x, _)| Volume(vol_at(x))));
     fill(&batch, std::iter::repeat_n(Stress(D::Stress::default()), count));
     fill(&batch, std::iter::repeat_n(VelocityGradient(D::MAT_ZERO), count));
     fill(&batch, std::iter::repeat_n(MaterialId(mat as u16), count));
     state.visit_state(&mut FillState(&batch, count));
     fill(&batch, std::iter::repeat_n(Displacement(z), count));
     world.spawn_column_batch(batch.build().expect("every column of the batch is filled"));
+    // A full node's mass ρ h^D; per radian at r = h in axisymmetry, ρ h³.
+    let radius = if D::AXISYMMETRIC { s.grid.cell_size } else { 1.0 };
     Ok(Spawned {
         next_id,
-        full_node_mass: model.density() * cell_volume,
+        full_node_mass: model.density() * cell_volume * radius,
     })
 }
 

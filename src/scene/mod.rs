@@ -21,12 +21,80 @@ use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
+/// A scene's dimension: `2`, `3` or `Axisymmetric`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(try_from = "DimensionText")]
+pub enum Dimension {
+    /// Plane strain, unit thickness.
+    Two,
+    /// Three dimensions.
+    Three,
+    /// Axisymmetric about the y axis: x is the radius, volumes and forces are per radian.
+    Axisymmetric,
+}
+
+impl Dimension {
+    /// Axes of the grid and the points (2 or 3).
+    pub fn axes(self) -> usize {
+        match self {
+            Dimension::Three => 3,
+            _ => 2,
+        }
+    }
+}
+
+impl std::fmt::Display for Dimension {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Dimension::Two => f.write_str("2"),
+            Dimension::Three => f.write_str("3"),
+            Dimension::Axisymmetric => f.write_str("Axisymmetric"),
+        }
+    }
+}
+
+impl Serialize for Dimension {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        match self {
+            Dimension::Two => s.serialize_u8(2),
+            Dimension::Three => s.serialize_u8(3),
+            Dimension::Axisymmetric => s.serialize_unit_variant("Dimension", 2, "Axisymmetric"),
+        }
+    }
+}
+
+/// How a scene writes its dimension: a number, or the name `Axisymmetric` (RON hands an
+/// untagged enum a bare name as text, where a plain visitor would see a unit value).
+#[derive(Deserialize)]
+#[serde(untagged)]
+enum DimensionText {
+    Number(i64),
+    Name(DimensionName),
+}
+
+#[derive(Deserialize)]
+enum DimensionName {
+    Axisymmetric,
+}
+
+impl TryFrom<DimensionText> for Dimension {
+    type Error = String;
+    fn try_from(t: DimensionText) -> Result<Self, String> {
+        match t {
+            DimensionText::Number(2) => Ok(Dimension::Two),
+            DimensionText::Number(3) => Ok(Dimension::Three),
+            DimensionText::Number(n) => Err(format!("must be 2, 3 or Axisymmetric, found {n}")),
+            DimensionText::Name(DimensionName::Axisymmetric) => Ok(Dimension::Axisymmetric),
+        }
+    }
+}
+
 /// A whole problem: grid, materials, bodies, boundary conditions, loads and solver settings.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Scene {
-    /// 2 (plane strain, unit thickness) or 3.
-    pub dimension: u8,
+    /// `2` (plane strain, unit thickness), `3`, or `Axisymmetric` (x the radius, y the axis).
+    pub dimension: Dimension,
     /// Background grid.
     pub grid: GridSpec,
     /// Shape functions.

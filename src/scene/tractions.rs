@@ -43,7 +43,16 @@ pub(super) fn place<D: Dim>(
                 .filter(|&a| a != normal)
                 .map(|a| (x[a] / sub(a)).floor() as i64)
                 .collect();
-            let share: f64 = (0..n).filter(|&a| a != normal).map(sub).product();
+            // The column's share of the surface; per radian in axisymmetry, times the
+            // surface's radius: the point's own on a face across the axis, the edge of its
+            // sub-cell on a face normal to r.
+            let radius = match (D::AXISYMMETRIC, normal) {
+                (false, _) => 1.0,
+                (true, 0) if upper => x[0] + 0.5 * sub(0),
+                (true, 0) => x[0] - 0.5 * sub(0),
+                (true, _) => x[0],
+            };
+            let share: f64 = (0..n).filter(|&a| a != normal).map(sub).product::<f64>() * radius;
             let out = if upper { x[normal] } else { -x[normal] };
             let entry = outermost.entry(key).or_insert((out, e, share));
             if entry.0 < out {

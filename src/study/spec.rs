@@ -397,7 +397,7 @@ fn check_quantities(
     at: &Place,
 ) -> Result<(), SceneError> {
     let traced: Vec<&str> = base.scene.traced.iter().map(|t| t.name.as_str()).collect();
-    let dim = base.scene.dimension as usize;
+    let dim = base.scene.dimension.axes();
     if spec.quantities.is_empty() {
         return Err(at.invalid("quantities", "a study measures at least one quantity".into()));
     }

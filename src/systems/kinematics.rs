@@ -96,6 +96,7 @@ impl<D: Dim, S: Shape> System<D> for Kinematics<D, S> {
                         // One loop per case, so that the node loop holds no branch.
                         if gradient {
                             (l[k].0, vel) = S::gather_with_gradient(grid, x[k].0, |i| nv[i].0);
+                            D::complete_gradient(&mut l[k].0, x[k].0, vel);
                         } else {
                             for_each_node::<D, S>(grid, x[k].0, |i, w, _| vel = nv[i].0.madd(w, vel));
                         }

@@ -33,6 +33,10 @@ pub enum P2gPart {
 /// because the weights are already at hand there: a pass of its own would cost as much
 /// again as the mapping of the stress.
 ///
+/// In axisymmetry (per radian, x = r) the internal force gains the hoop stress's part
+/// −V_p σ_θθ w_ip / r_p along r: the weak form of ∂σ_rr/∂r + ∂σ_rz/∂z + (σ_rr − σ_θθ)/r = 0
+/// with volumes r dr dz, whose (σ_rr/r) term the in-plane divergence of V σ already holds.
+///
 /// Points are grouped in slabs of grid rows that scatter in parallel, slabs that share no
 /// node at a time (see `parallel::scatter`).
 #[derive(Debug)]
@@ -122,7 +126,10 @@ impl<D: Dim, S: Shape> P2g<D, S> {
                             (Some((s, vol)), true) => Some((&s[p].0, -vol[p].0)),
                             _ => None,
                         };
-                        // The pore water's load on the point, per unit of its mass (N/kg).
+                        // Forces on the point besides its stress's divergence, per unit of its
+                        // mass (N/kg): all of them, and the applied part. The pore water's
+                        // load is applied; the hoop stress's −V σ_θθ/r (axisymmetry) is
+                        // internal.
                         let pore = match (wet, f) {
                             (Some((w, ids)), Some((_, neg_vol))) => {
                                 let vol = -neg_vol;
@@ -131,10 +138,21 @@ impl<D: Dim, S: Shape> P2g<D, S> {
                             }
                             _ => None,
                         };
+                        let extra = match f {
+                            Some((s, neg_vol)) if D::AXISYMMETRIC => {
+                                let r = x[p].0.get(0);
+                                let hoop = D::vec_from([neg_vol * s.to_sym3().zz / (r * mp), 0.0, 0.0]);
+                                Some(match pore {
+                                    Some(a) => (a + hoop, a),
+                                    None => (hoop, D::Vec::ZERO),
+                                })
+                            }
+                            _ => pore.map(|a| (a, a)),
+                        };
                         // One loop per case, so that the node loop holds no branch.
                         match (mass_momentum, f) {
-                            (true, Some((s, neg_vol))) if pore.is_some() => {
-                                let a = pore.expect("matched");
+                            (true, Some((s, neg_vol))) if extra.is_some() => {
+                                let (a, applied) = extra.expect("matched");
                                 S::scatter_with_gradient(
                                     grid,
                                     x[p].0,
@@ -143,12 +161,12 @@ impl<D: Dim, S: Shape> P2g<D, S> {
                                     &s.to_sym3(),
                                     neg_vol,
                                     |i, dm, dp, df| {
-                                        // dm = w_ip m_p, so a dm = w_ip V_p (−∇u_p).
+                                        // dm = w_ip m_p, so a dm = w_ip F_p.
                                         let k = i - lo;
                                         nm[k].0 += dm;
                                         np[k].0 += dp;
                                         nf[k].0 += a.madd(dm, df);
-                                        ne[k].0 += a * dm;
+                                        ne[k].0 += applied * dm;
                                     },
                                 )
                             }
@@ -174,13 +192,13 @@ impl<D: Dim, S: Shape> P2g<D, S> {
                             (false, Some((s, neg_vol))) => {
                                 let sigma = StressColumns::of(&s.to_sym3(), 1.0);
                                 let neg_vol = F64x4::splat(neg_vol);
-                                match pore {
-                                    Some(a) => {
-                                        let a = a * mp;
+                                match extra {
+                                    Some((a, applied)) => {
+                                        let (a, applied) = (a * mp, applied * mp);
                                         for_each_node::<D, S>(grid, x[p].0, |i, w, grad| {
                                             let f = sigma.dot::<D>(grad) * neg_vol;
                                             nf[i - lo].0 += a.madd(w, from_lanes::<D>(f));
-                                            ne[i - lo].0 += a * w;
+                                            ne[i - lo].0 += applied * w;
                                         })
                                     }
                                     None => for_each_node::<D, S>(grid, x[p].0, |i, _, grad| {
@@ -285,6 +303,7 @@ mod tests {
                     AnySimulation::Two(mut s) => check::<_, Linear>(&mut s),
                     AnySimulation::Three(mut s) if bspline => check::<_, QuadraticBSpline>(&mut s),
                     AnySimulation::Three(mut s) => check::<_, Linear>(&mut s),
+                    AnySimulation::Axi(_) => unreachable!("the scenes here are 2D or 3D"),
                 }
             }
         }

@@ -75,7 +75,7 @@ impl<D: Dim, S: Shape> System<D> for VolumetricSmoothing<D, S> {
         }
         sums.map(grid, |s| [if s[1] > 0.0 { s[0] / s[1] } else { 0.0 }, 0.0]);
         let nodal = sums.pairs();
-        let n = D::N as f64;
+        let n = D::STRAIN_AXES as f64;
         for arch in points_with::<Volume>(&ctx.world) {
             let xg = col::<Position<D::Vec>>(arch);
             let x: &[Position<D::Vec>] = &xg;

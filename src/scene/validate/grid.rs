@@ -36,6 +36,21 @@ pub struct FaceHold {
     pub friction: Option<f64>,
 }
 
+/// In an axisymmetric scene the lower x face is the axis, a symmetry face: a `Roller`
+/// (u_r = 0 and free along it), and nothing else. `field`: where the faces are.
+pub(super) fn check_axis(faces: &[FaceHold], field: &str) -> Result<(), (String, String)> {
+    let axis = faces.iter().find(|f| f.axis == 0 && !f.upper);
+    match axis {
+        Some(f) if f.mask == 1 && f.friction.is_none() => Ok(()),
+        _ => Err((
+            field.to_string(),
+            "the axis of an axisymmetric scene (the XMin face, r = 0) is a symmetry face: give it \
+             `(face: XMin, condition: Roller)`, and no other condition"
+                .into(),
+        )),
+    }
+}
+
 /// Checks a list of face conditions (`field`: where it is in the scene): faces of the
 /// grid's dimension `n`, one condition a face. Returns them as the nodes hold them.
 pub(super) fn check_faces(
@@ -142,6 +157,27 @@ pub(super) fn check_grid(r: &Rules) -> Result<CheckedGrid, SceneError> {
     }
     let faces = check_faces(&s.boundaries, "boundaries", n)
         .map_err(|(field, rule)| r.loaded.invalid(&field, rule))?;
+    if s.dimension == crate::scene::Dimension::Axisymmetric {
+        if s.grid.origin[0] != 0.0 {
+            return r.bad(
+                "grid.origin",
+                format!(
+                    "an axisymmetric grid starts on the axis, at x = r = 0 (found x = {}): the \
+                     points lie at r ≥ 0",
+                    s.grid.origin[0]
+                ),
+            );
+        }
+        check_axis(&faces, "boundaries").map_err(|(field, rule)| r.loaded.invalid(&field, rule))?;
+        if let Some(g) = &s.gravity {
+            if g.acceleration.first().is_some_and(|&gx| gx != 0.0) {
+                return r.bad(
+                    "gravity.acceleration",
+                    "in an axisymmetric scene gravity acts along the axis (y): its x entry must be 0".into(),
+                );
+            }
+        }
+    }
     let mut cells = [0usize; 3];
     cells[..n].copy_from_slice(&s.grid.cells);
     let mut half_width = [0.25; 3];

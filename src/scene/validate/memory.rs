@@ -157,7 +157,7 @@ pub(super) fn estimate(
     table: &[(String, MaterialModel)],
 ) -> Result<Estimate, SceneError> {
     let s = &loaded.scene;
-    let n = s.dimension as usize;
+    let n = s.dimension.axes();
     let too_many =
         |field: &str, what: &str| loaded.invalid(field, format!("{what} overflows a 64-bit count"));
     let nodes = s

@@ -198,12 +198,9 @@ impl Rules<'_> {
 /// Checks every rule that does not need the points, part by part.
 pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
     let s = &loaded.scene;
-    if s.dimension != 2 && s.dimension != 3 {
-        return Err(loaded.invalid("dimension", format!("must be 2 or 3, found {}", s.dimension)));
-    }
     let r = Rules {
         loaded,
-        n: s.dimension as usize,
+        n: s.dimension.axes(),
     };
     let grid = check_grid(&r)?;
     let table = check_materials(&r)?;

@@ -26,7 +26,7 @@ pub(super) fn check_motions_and_analyses(r: &Rules) -> Result<(), SceneError> {
         );
     }
     for (i, m) in s.motions.iter().enumerate() {
-        m.check(s.dimension as usize)
+        m.check(s.dimension.axes())
             .map_err(|(field, rule)| loaded.invalid(&format!("motions[{i}].{field}"), rule))?;
     }
     unique_names(s).map_err(|(field, rule)| loaded.invalid(&field, rule))?;

@@ -1,7 +1,7 @@
 //! Loading stages: each stage's changes, checked against the scene, and its materials
 //! built once.
 
-use super::grid::{check_faces, FaceHold};
+use super::grid::{check_axis, check_faces, FaceHold};
 use super::*;
 use crate::error::SceneError;
 use crate::materials::MaterialModel;
@@ -101,6 +101,10 @@ pub(super) fn check_stages(
             ),
             None => None,
         };
+        if let (Some(f), crate::scene::Dimension::Axisymmetric) = (&faces, s.dimension) {
+            check_axis(f, &format!("stages[{k}].boundaries"))
+                .map_err(|(field, rule)| loaded.invalid(&field, rule))?;
+        }
         if let Some(i) = faces.iter().flatten().position(|f| f.friction.is_some()) {
             return r.bad(
                 &format!("stages[{k}].boundaries[{i}].condition"),

@@ -26,6 +26,7 @@ pub(super) fn check_water(
         lo: &grid.origin[..n],
         hi: &hi,
         materials: &materials,
+        axisymmetric: s.dimension == crate::scene::Dimension::Axisymmetric,
     };
     let at = |prefix: &str, (field, rule): (String, String)| {
         let field = match field.as_str() {
@@ -61,15 +62,14 @@ pub(super) fn check_water(
 }
 
 /// Every point of material `material` (`name`) that starts below a surface, wholly or in
-/// part (the scene's or a stage's, judged at its place at set-up; `volume` a point's), has
-/// a saturated density to weigh.
+/// part (the scene's or a stage's, judged at its place at set-up; `xs` the points' places
+/// and volumes), has a saturated density to weigh.
 pub(crate) fn check_saturated(
     loaded: &LoadedScene,
     waters: &[(&str, &Water)],
     material: u16,
     name: &str,
-    volume: f64,
-    mut xs: impl Iterator<Item = [f64; 3]>,
+    mut xs: impl Iterator<Item = ([f64; 3], f64)>,
 ) -> Result<(), SceneError> {
     let has = loaded
         .scene
@@ -79,7 +79,7 @@ pub(crate) fn check_saturated(
     if has {
         return Ok(());
     }
-    if let Some(x) = xs.find(|&x| waters.iter().any(|(_, w)| w.wets(material, x, volume))) {
+    if let Some((x, volume)) = xs.find(|&(x, v)| waters.iter().any(|(_, w)| w.wets(material, x, v))) {
         let (field, _) = waters
             .iter()
             .find(|(_, w)| w.wets(material, x, volume))
@@ -89,7 +89,7 @@ pub(crate) fn check_saturated(
             format!(
                 "material \"{name}\" has points below the piezometric surface of `{field}` (one \
                  at {:?}): give it a saturated density",
-                &x[..loaded.scene.dimension as usize]
+                &x[..loaded.scene.dimension.axes()]
             ),
         ));
     }

@@ -1,0 +1,120 @@
+//! `dimension: Axisymmetric`: the hoop strain and stress, volumes per radian, the axis as a
+//! symmetry face, and the refusals.
+
+mod common;
+
+use common::{refusal, rel, run};
+
+/// Lamé's thick cylinder (`scenes/cylinder.ron`: a = 1 m, b = 2 m, p = 100 kPa on the bore,
+/// plane strain along the axis): σ_rr = A − B/r², σ_θθ = A + B/r², σ_zz = 2νA with
+/// A = p a²/(b² − a²), B = p a² b²/(b² − a²). Through the wall from four cells off the loaded
+/// bore, σ_rr and σ_zz within 1 % of p and σ_θθ within 1 % of itself (measured at every
+/// point: 0.39 %, 0.28 % and 0.45 % at most); nearer the bore the traction's points disturb the stress, as in plane strain. The
+/// traced point at r = 1.49 m is pinned, and its radial displacement is within 0.5 % of
+/// (1 + ν)/E [(1 − 2ν) A r + B/r] = 1.4231 mm.
+#[test]
+fn a_thick_cylinder_under_internal_pressure_has_lames_stresses() {
+    let dir = common::scratch("axisymmetric", "lame");
+    let o = common::run_into(&common::scene("cylinder.ron"), &dir, &[]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let (a, b, p, nu, e) = (1.0, 2.0, 100.0e3, 0.3, 100.0e6);
+    let big_a = p * a * a / (b * b - a * a);
+    let big_b = p * a * a * b * b / (b * b - a * a);
+    let vtu = common::read_vtu(&dir.join("points.vtu"));
+    let (x, s) = (&vtu["Points"].1, &vtu["stress"].1);
+    let mut checked = 0;
+    for q in 0..x.len() / 3 {
+        let r = x[3 * q];
+        if r < a + 4.0 * 0.05 {
+            continue;
+        }
+        let (srr, stt, szz) = (s[6 * q], s[6 * q + 2], s[6 * q + 1]);
+        let (lrr, ltt) = (big_a - big_b / (r * r), big_a + big_b / (r * r));
+        assert!(
+            (srr - lrr).abs() < 0.01 * p,
+            "σ_rr {srr} against {lrr} at r = {r}"
+        );
+        assert!(rel(stt, ltt).abs() < 0.01, "σ_θθ {stt} against {ltt} at r = {r}");
+        assert!((szz - 2.0 * nu * big_a).abs() < 0.01 * p, "σ_zz {szz} at r = {r}");
+        checked += 1;
+    }
+    assert!(checked > 200, "{checked} points checked");
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+    let wall = &summary["traced"][0];
+    assert_eq!(wall["stress"]["zz"], 93178.3408655163);
+    let r = wall["initial_position"][0].as_f64().unwrap();
+    let u = wall["displacement"][0].as_f64().unwrap();
+    let lame = (1.0 + nu) / e * ((1.0 - 2.0 * nu) * big_a * r + big_b / r);
+    assert!(rel(u, lame).abs() < 0.005, "u_r {u} against {lame}");
+}
+
+/// A self-weight column turned about its axis (`soil_column.ron`, a 2 m radius cylinder in
+/// a smooth rigid tube) carries the plane-strain column's stresses: σ_v = −ρ g d to 1e-4 of
+/// it, σ_rr/σ_zz and σ_θθ/σ_zz = K0 = ν/(1 − ν) to 1e-3, the same settlement to 1e-4.
+/// Quadratic B-splines, h = 0.125 m; −91.061 kPa at mid height, pinned.
+#[test]
+fn an_axisymmetric_column_carries_the_plane_strain_columns_stresses() {
+    let fine = [
+        "shape=QuadraticBSpline",
+        "grid.cell_size=0.125",
+        "grid.cells=[16, 96]",
+    ];
+    let plane = run("soil_column.ron", &fine);
+    let axi = run(
+        "soil_column.ron",
+        &[&fine[..], &["dimension=Axisymmetric"][..]].concat(),
+    );
+    assert!(axi.converged, "{:?}", axi.error);
+    let mid = |s: &kdmpm::output::Summary| s.traced[0].clone();
+    let (p, a) = (mid(&plane), mid(&axi));
+    assert_eq!(a.stress.yy, -91061.12608479687);
+    assert!(rel(a.stress.yy, p.stress.yy).abs() < 1e-4);
+    let k0 = 0.3 / 0.7;
+    assert!(rel(a.stress.xx / a.stress.yy, k0).abs() < 1e-3, "σ_rr/σ_zz");
+    assert!(rel(a.stress.zz / a.stress.yy, k0).abs() < 1e-3, "σ_θθ/σ_zz");
+    assert!(rel(a.displacement[1], p.displacement[1]).abs() < 1e-4);
+}
+
+/// A smooth rigid circular footing on weightless Tresca clay (`scenes/footing_circular.ron`,
+/// R = 1 m, c_u = 10 kPa, h = 0.25 m): 58.08 kPa, N_c = 5.81 against Eason & Shield's
+/// (1960) and Cox's (1962) exact 5.69 for a smooth footing, +2.1 %; pinned.
+#[test]
+fn a_smooth_circular_footing_bears_eason_and_shields_pressure() {
+    let s = run("footing_circular.ron", &[]);
+    let q = s.limit_pressure.expect("the footing's limit pressure");
+    assert!(rel(q, 58079.85024305896).abs() < 1e-9, "{q}");
+    assert!(rel(q / 10.0e3, 5.69).abs() < 0.07, "N_c = {}", q / 10.0e3);
+}
+
+#[test]
+fn axisymmetric_scenes_that_cannot_be_are_refused() {
+    let text = std::fs::read_to_string(common::scene("cylinder.ron")).unwrap();
+    for (from, to, says) in [
+        (
+            "(face: XMin, condition: Roller),",
+            "(face: XMin, condition: Fixed),",
+            "is a symmetry face",
+        ),
+        ("(face: XMin, condition: Roller),", "", "is a symmetry face"),
+        ("origin: [0.0, 0.0]", "origin: [-0.5, 0.0]", "starts on the axis"),
+        (
+            "    tractions:",
+            "    gravity: (acceleration: [-1.0, -9.81]),\n    tractions:",
+            "gravity acts along the axis",
+        ),
+        (
+            "dimension: Axisymmetric",
+            "dimension: 4",
+            "must be 2, 3 or Axisymmetric",
+        ),
+    ] {
+        let changed = text.replace(from, to);
+        assert_ne!(changed, text, "{from}");
+        let e = match kdmpm::scene::LoadedScene::from_text(std::path::Path::new("r.ron"), &changed, &[]) {
+            Ok(_) => refusal(&changed),
+            Err(e) => e.to_string(),
+        };
+        assert!(e.contains(says), "{to}: {e}");
+    }
+}
