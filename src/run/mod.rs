@@ -288,9 +288,13 @@ impl Watch<'_> {
             .transpose()?;
         if !self.quiet {
             eprintln!(
-                "{scene}: {} points, {}D, Δt = {:.4e} s{}",
+                "{scene}: {} points, {}, Δt = {:.4e} s{}",
                 sim.point_count(),
-                D::N,
+                if D::AXISYMMETRIC {
+                    "axisymmetric (per radian)".to_string()
+                } else {
+                    format!("{}D", D::N)
+                },
                 sim.ctx.settings.dt,
                 if sim.ctx.state.clock.step > 0 {
                     format!(", resumed at step {}", sim.ctx.state.clock.step)
