@@ -41,6 +41,7 @@ fn a_thick_cylinder_under_internal_pressure_has_lames_stresses() {
     assert!(checked > 200, "{checked} points checked");
     let summary: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["axisymmetric"], true);
     let wall = &summary["traced"][0];
     assert_eq!(wall["stress"]["zz"], 93178.3408655163);
     let r = wall["initial_position"][0].as_f64().unwrap();

@@ -16,6 +16,9 @@ pub struct Summary {
     pub scene: String,
     /// 2 or 3.
     pub dimension: usize,
+    /// An axisymmetric run (x the radius): masses, forces and work are per radian.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub axisymmetric: bool,
     /// How the run ended.
     pub outcome: Outcome,
     /// True when K_F and K_E both reached the tolerance.
@@ -257,6 +260,7 @@ impl Summary {
         Summary {
             scene: scene.to_string(),
             dimension: D::N,
+            axisymmetric: D::AXISYMMETRIC,
             outcome: match (&error, s.stop) {
                 (Some(_), _) | (None, None) => Outcome::Failed,
                 (None, Some(StopReason::Converged)) => Outcome::Converged,
