@@ -162,6 +162,21 @@ const SOLID: &str = r#"Scene(
 )
 "#;
 
+/// The same footing fully rough (its nodes held across as well): 62.41 kPa, N_c = 6.24
+/// against Eason & Shield's exact 6.05 for a rough footing, +3.2 %, and above the smooth
+/// one; pinned.
+#[test]
+fn a_rough_circular_footing_bears_more_than_a_smooth_one() {
+    let s = run(
+        "footing_circular.ron",
+        &["motions[0].velocity=[Some(0.0), Some(-0.01)]"],
+    );
+    let q = s.limit_pressure.expect("the footing's limit pressure");
+    assert!(rel(q, 62413.52250944504).abs() < 1e-9, "{q}");
+    assert!(rel(q / 10.0e3, 6.05).abs() < 0.07, "N_c = {}", q / 10.0e3);
+    assert!(q > 58079.85024305896);
+}
+
 #[test]
 fn axisymmetric_scenes_that_cannot_be_are_refused() {
     let text = std::fs::read_to_string(common::scene("cylinder.ron")).unwrap();
