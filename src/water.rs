@@ -11,8 +11,8 @@
 //! `p2g` maps) and +∫ u ∇·w dV = ∮ u w·n dS − ∫ w·∇u dV. The surface term is the pressure of
 //! open water on the ground wherever the surface stands above it; with it applied as load,
 //! what is left is the body force −∇u = γ_w (e_z − ∇h) below the surface: buoyancy, plus a
-//! seepage force where the surface slopes. The system `pore_pressure` maps that body force
-//! (Σ_p V_p w_ip (−∇u_p)) as applied load. So a submerged slope face carries γ_w · depth
+//! seepage force where the surface slopes. `p2g` maps that body force (Σ_p V_p w_ip (−∇u_p))
+//! with the stress, as applied load. So a submerged slope face carries γ_w · depth
 //! normal to itself without the engine having to find the face, exactly as
 //! Archimedes has it, and a table below the ground leaves its surface load-free. On the
 //! grid's held faces the same term is part of the reaction.
@@ -47,13 +47,6 @@ pub enum Surface {
         /// Heights (m): one row per node along the second axis, each row along the first.
         heights: Vec<Vec<f64>>,
     },
-}
-
-/// A height grid's fields, borrowed.
-struct HeightGrid<'a> {
-    origin: &'a [f64],
-    spacing: &'a [f64],
-    heights: &'a [Vec<f64>],
 }
 
 /// The water as the scene gives it.
@@ -320,47 +313,42 @@ fn head(surface: &Surface, n: usize, lo: [f64; 2], hi: [f64; 2]) -> Result<Head,
             spacing,
             heights,
         } => {
-            let g = HeightGrid {
-                origin,
-                spacing,
-                heights,
-            };
-            let rows = g.heights.len();
-            let cols = g.heights.first().map_or(0, Vec::len);
-            if rows < 2 || cols < 2 || g.heights.iter().any(|r| r.len() != cols) {
+            let rows = heights.len();
+            let cols = heights.first().map_or(0, Vec::len);
+            if rows < 2 || cols < 2 || heights.iter().any(|r| r.len() != cols) {
                 return bad(
                     "heights",
                     "needs at least two rows of at least two heights, every row as long".into(),
                 );
             }
-            if g.origin.len() != 2 || g.spacing.len() != 2 {
+            if origin.len() != 2 || spacing.len() != 2 {
                 return bad("origin", "origin and spacing need two entries each".into());
             }
-            if g.heights.iter().flatten().any(|h| !h.is_finite()) || !g.origin.iter().all(|o| o.is_finite()) {
+            if heights.iter().flatten().any(|h| !h.is_finite()) || !origin.iter().all(|o| o.is_finite()) {
                 return bad("heights", "heights and origin must be finite".into());
             }
-            if !g.spacing.iter().all(|s| s.is_finite() && *s > 0.0) {
-                return bad("spacing", format!("must be above 0 m, found {:?}", g.spacing));
+            if !spacing.iter().all(|s| s.is_finite() && *s > 0.0) {
+                return bad("spacing", format!("must be above 0 m, found {:?}", spacing));
             }
             let nodes = [cols, rows];
             for a in 0..2 {
-                let end = g.origin[a] + g.spacing[a] * (nodes[a] - 1) as f64;
-                if g.origin[a] > lo[a] || end < hi[a] {
+                let end = origin[a] + spacing[a] * (nodes[a] - 1) as f64;
+                if origin[a] > lo[a] || end < hi[a] {
                     return bad(
                         "",
                         format!(
                             "spans {} to {end} m along its axis {a} but the grid spans {} to {} \
                              m: the surface must reach across the whole grid",
-                            g.origin[a], lo[a], hi[a]
+                            origin[a], lo[a], hi[a]
                         ),
                     );
                 }
             }
             Ok(Head::Heights {
-                origin: [g.origin[0], g.origin[1]],
-                inv_spacing: [1.0 / g.spacing[0], 1.0 / g.spacing[1]],
+                origin: [origin[0], origin[1]],
+                inv_spacing: [1.0 / spacing[0], 1.0 / spacing[1]],
                 nodes,
-                h: g.heights.iter().flatten().copied().collect(),
+                h: heights.iter().flatten().copied().collect(),
             })
         }
     }
@@ -370,7 +358,7 @@ fn head(surface: &Surface, n: usize, lo: [f64; 2], hi: [f64; 2]) -> Result<Head,
 pub struct Frame<'a> {
     /// The scene's gravity (one entry an axis), if any.
     pub gravity: Option<&'a [f64]>,
-    /// The grid's lowest and highest corner (m), one entry an axis.
+    /// The grid's lowest corner (m), one entry an axis.
     pub lo: &'a [f64],
     /// The grid's highest corner (m).
     pub hi: &'a [f64],
