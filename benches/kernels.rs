@@ -1,5 +1,7 @@
 //! Per-system micro-benchmarks on the 2D slope after 200 steps of failure: particle-to-grid,
-//! grid-to-particle, the Mohr-Coulomb stress update and the convergence monitor.
+//! grid-to-particle, the Mohr-Coulomb stress update and the convergence monitor; and what
+//! water costs a step of the slope with a water table (particle-to-grid with and without
+//! its water, on the same points, and a whole step).
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use kdmpm::infra::lanes::LANES;
@@ -16,7 +18,11 @@ use std::path::Path;
 static ALLOCATOR: kdmpm::infra::alloc::Coloured = kdmpm::infra::alloc::Coloured;
 
 fn slope() -> Simulation<Dim2> {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/slope.ron");
+    after_200_steps("scenes/slope.ron")
+}
+
+fn after_200_steps(scene: &str) -> Simulation<Dim2> {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(scene);
     let loaded = LoadedScene::from_file(&path, &[]).unwrap();
     let AnySimulation::Two(mut sim) = build(&loaded).unwrap().0 else {
         unreachable!()
@@ -94,5 +100,28 @@ fn kernels(c: &mut Criterion) {
     });
 }
 
-criterion_group!(benches, kernels);
+/// The pore water's load rides on p2g: its cost is p2g with the water less p2g without it,
+/// on the same points in the same run; beside it, a whole step of the wet slope.
+fn water(c: &mut Criterion) {
+    let mut sim = after_200_steps("scenes/slope_water.ron");
+    let mut p2g = P2g::<Dim2, QuadraticBSpline>::new(P2gPart::All);
+    let water = sim.ctx.settings.water.clone();
+    c.bench_function("p2g (slope_water, with its water)", |b| {
+        b.iter(|| {
+            GridReset.run(&mut sim.ctx).unwrap();
+            p2g.run(&mut sim.ctx).unwrap();
+        })
+    });
+    sim.ctx.settings.water = None;
+    c.bench_function("p2g (slope_water, the same points dry)", |b| {
+        b.iter(|| {
+            GridReset.run(&mut sim.ctx).unwrap();
+            p2g.run(&mut sim.ctx).unwrap();
+        })
+    });
+    sim.ctx.settings.water = water;
+    c.bench_function("step (slope_water)", |b| b.iter(|| sim.step().unwrap()));
+}
+
+criterion_group!(benches, kernels, water);
 criterion_main!(benches);
