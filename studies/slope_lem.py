@@ -36,6 +36,7 @@ CONDITIONS = {
     "reservoir 5 m (slope_reservoir.ron)": [(0.0, 5.0), (55.0, 5.0)],
     "reservoir 10 m (slope_drawdown.ron, full)": [(0.0, 10.0), (55.0, 10.0)],
     "drawn down to 3 m (slope_drawdown.ron, drained)": [(0.0, 3.0), (55.0, 3.0)],
+    "reservoir 6 m, table falling to 2 m (one polyline)": [(0.0, 6.0), (27.0, 6.0), (55.0, 2.0)],
 }
 
 
