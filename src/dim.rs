@@ -277,11 +277,12 @@ impl Dim for DimAxi {
     }
     #[inline(always)]
     fn mat_entry(m: &DMat3, i: usize, j: usize) -> f64 {
-        m.col(j)[i]
+        Dim3::mat_entry(m, i, j)
     }
     #[inline(always)]
     fn volume_ratio(l: &DMat3, dt: f64) -> f64 {
-        (DMat3::IDENTITY + *l * dt).determinant()
+        // det(I + L dt) with L's hoop entry: the in-plane ratio times (1 + v_r/r dt).
+        Dim3::volume_ratio(l, dt)
     }
     #[inline(always)]
     fn add_identity(m: &mut DMat3, k: f64) {

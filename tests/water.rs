@@ -155,29 +155,11 @@ fn the_pore_pressure_and_the_total_stress_are_written_for_paraview() {
 /// has no `water`.
 #[test]
 fn strength_reduction_holds_the_pore_pressures_and_names_the_water() {
-    let coarse = ["grid.cell_size=1.0", "grid.cells=[55, 12]"];
-    let fos = |name: &str, water: Option<&str>| {
-        let dir = common::scratch("water", name);
-        let scene = common::scene("slope_fos.ron");
-        let mut args = vec![
-            "fos",
-            scene.to_str().unwrap(),
-            "--quiet",
-            "--out",
-            dir.to_str().unwrap(),
-        ];
-        for s in coarse.iter().copied().chain(water) {
-            args.extend(["--set", s]);
-        }
-        let o = common::kdmpm(&args);
-        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-        let text = std::fs::read_to_string(dir.join("summary.json")).unwrap();
-        serde_json::from_str::<serde_json::Value>(&text).unwrap()
-    };
-    let dry = fos("fos-dry", None);
-    let wet = fos(
+    let dry = fos_at_1m("fos-dry", "slope_fos.ron", &[]);
+    let wet = fos_at_1m(
         "fos-wet",
-        Some(r#"water=(table: Level(0.5), saturated_density: {"soil": 2100.0})"#),
+        "slope_fos.ron",
+        &[r#"water=(table: Level(0.5), saturated_density: {"soil": 2100.0})"#],
     );
     assert_eq!(dry["bracket"], serde_json::json!([1.40625, 1.421875]));
     assert_eq!(wet["bracket"], serde_json::json!([1.390625, 1.40625]));

@@ -533,10 +533,9 @@ fn spawn_body<D: Dim>(
     let vol_at = |x: [f64; 3]| if D::AXISYMMETRIC { volume * x[0] } else { volume };
     // Below its piezometric surface a point weighs its material's saturated density (by the
     // share of its height below the surface, for a point astride it).
-    let named: Vec<(&str, &crate::water::Water)> = waters.iter().map(|(f, w)| (f.as_str(), *w)).collect();
     validate::check_saturated(
         loaded,
-        &named,
+        waters,
         mat as u16,
         &body.material,
         xs.clone().map(|(x, _)| (x, vol_at(x))),

@@ -66,7 +66,7 @@ pub(super) fn check_water(
 /// and volumes), has a saturated density to weigh.
 pub(crate) fn check_saturated(
     loaded: &LoadedScene,
-    waters: &[(&str, &Water)],
+    waters: &[(String, &Water)],
     material: u16,
     name: &str,
     mut xs: impl Iterator<Item = ([f64; 3], f64)>,
@@ -79,11 +79,11 @@ pub(crate) fn check_saturated(
     if has {
         return Ok(());
     }
-    if let Some((x, volume)) = xs.find(|&(x, v)| waters.iter().any(|(_, w)| w.wets(material, x, v))) {
-        let (field, _) = waters
-            .iter()
-            .find(|(_, w)| w.wets(material, x, volume))
-            .expect("found");
+    let below = |(x, v): ([f64; 3], f64)| {
+        let (field, _) = waters.iter().find(|(_, w)| w.wets(material, x, v))?;
+        Some((x, field))
+    };
+    if let Some((x, field)) = xs.find_map(below) {
         return Err(loaded.invalid(
             "water.saturated_density",
             format!(
