@@ -20,6 +20,7 @@ use crate::dim::Dim;
 use crate::grid::NodeBox;
 use crate::infra::columns::points_with;
 use crate::parallel::SlabCache;
+use crate::rigid::BodyState;
 use crate::simulation::Simulation;
 use crate::state::{
     Clock, Control, Convergence, CurvePoint, Drive, EnergyWindow, Peak, RankCounters, Resets, SolverState,
@@ -32,7 +33,7 @@ use thiserror::Error;
 /// The first bytes of a checkpoint file.
 const MAGIC: &[u8; 8] = b"KDMPMCK\0";
 /// Format version; a file of another version is refused.
-const VERSION: u32 = 8;
+const VERSION: u32 = 9;
 /// The build that writes and reads checkpoints: the crate's version and a fingerprint of
 /// its sources (build.rs).
 pub const BUILD_ID: &str = concat!(env!("CARGO_PKG_VERSION"), "+", env!("KDMPM_SOURCE_HASH"));
@@ -236,6 +237,13 @@ fn check_ids<D: Dim>(sim: &Simulation<D>, state: &SolverState) -> Result<(), Str
             settings.motions.len()
         ));
     }
+    if state.control.bodies.len() != settings.bodies.len() {
+        return Err(format!(
+            "{} rigid bodies saved, the scene has {}",
+            state.control.bodies.len(),
+            settings.bodies.len()
+        ));
+    }
     if state.control.stage >= settings.stages.len().max(1)
         || state.control.stages.len() > settings.stages.len()
     {
@@ -420,6 +428,8 @@ fn decode_static_window(r: &mut Reader) -> Result<StaticWindow, CheckpointError>
 fn encode_control(w: &mut Writer, c: &Control) {
     let Control {
         drives,
+        bodies,
+        contacts: _,
         curve,
         stage,
         stages,
@@ -441,6 +451,32 @@ fn encode_control(w: &mut Writer, c: &Control) {
         velocity.iter().chain(reaction).for_each(|&c| w.f64(c));
         w.f64(*travel);
         w.u64(*increments as u64);
+    }
+    w.u64(bodies.len() as u64);
+    for b in bodies {
+        let BodyState {
+            name,
+            velocity,
+            offset,
+            travel,
+            increments,
+            reaction,
+            parts,
+            entries,
+            deepest_entry,
+        } = b;
+        w.str(name);
+        velocity
+            .iter()
+            .chain(offset)
+            .chain(reaction)
+            .for_each(|&c| w.f64(c));
+        w.f64(*travel);
+        w.u64(*increments as u64);
+        w.u64(parts.len() as u64);
+        parts.iter().flatten().for_each(|&c| w.f64(c));
+        w.u64(*entries);
+        w.f64(*deepest_entry);
     }
     w.u64(curve.len() as u64);
     for c in curve {
@@ -492,6 +528,25 @@ fn decode_control(r: &mut Reader) -> Result<Control, CheckpointError> {
             reaction: [r.f64()?, r.f64()?, r.f64()?],
             travel: r.f64()?,
             increments: r.u64()? as u32,
+        });
+    }
+    for _ in 0..r.u64()? {
+        c.bodies.push(BodyState {
+            name: r.str()?,
+            velocity: [r.f64()?, r.f64()?, r.f64()?],
+            offset: [r.f64()?, r.f64()?, r.f64()?],
+            reaction: [r.f64()?, r.f64()?, r.f64()?],
+            travel: r.f64()?,
+            increments: r.u64()? as u32,
+            parts: {
+                let mut parts = Vec::new();
+                for _ in 0..r.u64()? {
+                    parts.push([r.f64()?, r.f64()?, r.f64()?]);
+                }
+                parts
+            },
+            entries: r.u64()?,
+            deepest_entry: r.f64()?,
         });
     }
     for _ in 0..r.u64()? {

@@ -47,6 +47,7 @@ pub mod measure;
 pub mod output;
 pub(crate) mod parallel;
 pub mod refine;
+pub mod rigid;
 pub mod run;
 pub mod scene;
 pub mod schedule;

@@ -154,6 +154,8 @@ pub struct Settings {
     pub water: Option<crate::water::Water>,
     /// Prescribed motions (displacement control), in scene order.
     pub motions: Vec<MotionSpec>,
+    /// Rigid bodies, in scene order.
+    pub bodies: Vec<crate::rigid::RigidBodySpec>,
     /// The scene's `Friction` faces: (normal axis, upper face, tan δ).
     pub friction_faces: Vec<(usize, bool, f64)>,
     /// Loading stages, in order; the first is the scene as built.
@@ -550,6 +552,11 @@ pub struct Control {
     ///
     /// [`NodeFixity::driver`]: crate::components::NodeFixity::driver
     pub drives: Vec<Drive>,
+    /// Rigid bodies, in scene order.
+    pub bodies: Vec<crate::rigid::BodyState>,
+    /// The nodes in contact with a body this step, in node order (rebuilt each step by
+    /// `rigid_contact` before anything reads it; not checkpointed).
+    pub contacts: crate::rigid::contact::Contacts,
     /// Static states of the load–displacement curve so far.
     pub curve: Vec<CurvePoint>,
     /// The loading stage under way (index in `Settings::stages`).
@@ -564,9 +571,11 @@ pub struct Control {
 }
 
 impl Control {
-    /// True while a prescribed motion moves: not a static state, however balanced.
+    /// True while a prescribed motion or a rigid body moves: not a static state, however
+    /// balanced.
     pub fn driving(&self) -> bool {
         self.drives.iter().any(|d| d.velocity != [0.0; 3])
+            || self.bodies.iter().any(|b| b.velocity != [0.0; 3])
     }
 }
 

@@ -254,7 +254,10 @@ impl Summary {
             .control
             .curve
             .iter()
-            .filter(|c| st.motions.iter().any(|m| m.name == c.name))
+            // Motions' and whole bodies' rows (a part's row has its own name).
+            .filter(|c| {
+                st.motions.iter().any(|m| m.name == c.name) || st.bodies.iter().any(|b| b.name == c.name)
+            })
             .cloned()
             .collect();
         Summary {

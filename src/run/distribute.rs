@@ -19,7 +19,9 @@ use std::sync::Arc;
 /// can be split.
 pub fn unsupported<D: Dim>(sim: &Simulation<D>) -> Option<&'static str> {
     let s = &sim.ctx.settings;
-    if !s.motions.is_empty() {
+    if !s.bodies.is_empty() {
+        Some("rigid bodies (their contact forces are not yet summed over the ranks)")
+    } else if !s.motions.is_empty() {
         Some("prescribed motions (their reaction is not yet summed over the ranks)")
     } else if !s.stages.is_empty() {
         Some("stages")

@@ -108,6 +108,7 @@ fn fill_points<'a, D: Dim>(
     grid: &Grid<D>,
     region: &'a Region,
     ppc: &[usize],
+    rigid: &'a [crate::rigid::RigidBodySpec],
 ) -> impl Iterator<Item = [f64; 3]> + Clone + 'a {
     let n = D::N;
     let (lo, hi) = region_bounds(region, n);
@@ -128,7 +129,9 @@ fn fill_points<'a, D: Dim>(
             along(0).filter_map(move |x| {
                 let z = if n == 3 { coordinate(z) } else { 0.0 };
                 let p = [coordinate(x), coordinate(y), z];
-                region_contains(region, p, n).then_some(p)
+                // A rigid body stands where it is put: no point has its centre in or on one.
+                let solid = rigid.iter().any(|b| b.distance(p, n).0 <= 0.0);
+                (region_contains(region, p, n) && !solid).then_some(p)
             })
         })
     })
@@ -324,6 +327,7 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         }),
         min_node_mass: s.solver.node_mass_cutoff * full_node_mass,
         motions: s.motions.clone(),
+        bodies: s.rigid_bodies.clone(),
         water,
         friction_faces: checked_grid
             .faces
@@ -364,6 +368,11 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
     let state = SolverState {
         control: Control {
             drives: s.motions.iter().map(MotionSpec::drive).collect(),
+            bodies: s
+                .rigid_bodies
+                .iter()
+                .map(crate::rigid::RigidBodySpec::state)
+                .collect(),
             ..Control::default()
         },
         ..SolverState::default()
@@ -457,7 +466,7 @@ fn spawn_bodies<D: Dim>(
                 ),
             ));
         }
-        let points = fill_points(grid, &body.region, &body.points_per_cell);
+        let points = fill_points(grid, &body.region, &body.points_per_cell, &s.rigid_bodies);
         // Bodies may not overlap: a point inside two bodies would be two points, its mass
         // counted twice. Split the region or change one body's material instead.
         let earlier = &s.bodies[..b];
@@ -582,7 +591,20 @@ fn spawn_body<D: Dim>(
     fill(&batch, std::iter::repeat_n(Velocity(z), count));
     fill(&batch, xs.clone().map(|(x, _)| Mass(mass_at(x))));
     fill(&batch, xs.map(|(x, _)| Volume(vol_at(x))));
-    fill(&batch, std::iter::repeat_n(Stress(D::Stress::default()), count));
+    let p = -body.initial_pressure;
+    let start = crate::tensor::Sym3 {
+        xx: p,
+        yy: p,
+        zz: p,
+        ..crate::tensor::Sym3::ZERO
+    };
+    fill(
+        &batch,
+        std::iter::repeat_n(
+            Stress(<D::Stress as crate::tensor::StoredSym>::from_sym3(&start)),
+            count,
+        ),
+    );
     fill(&batch, std::iter::repeat_n(VelocityGradient(D::MAT_ZERO), count));
     fill(&batch, std::iter::repeat_n(MaterialId(mat as u16), count));
     state.visit_state(&mut FillState(&batch, count));

@@ -121,6 +121,10 @@ pub struct Scene {
     /// a load–displacement curve of static states.
     #[serde(default)]
     pub motions: Vec<MotionSpec>,
+    /// Rigid bodies that travel through the soil (displacement control), each with its
+    /// interface, its reaction and a load–displacement curve of static states.
+    #[serde(default)]
+    pub rigid_bodies: Vec<crate::rigid::RigidBodySpec>,
     /// Loading stages, each run to its static stop (the first names the scene as built).
     #[serde(default)]
     pub stages: Vec<StageSpec>,
@@ -162,6 +166,10 @@ pub struct BodySpec {
     pub region: Region,
     /// Points per cell along each axis, ≥ 1 (placed at the centres of equal sub-cells).
     pub points_per_cell: Vec<usize>,
+    /// Isotropic stress the points start at (Pa, compression positive: σ = −p I), for a
+    /// weightless soil under a confining pressure; balance it with a traction on free faces.
+    #[serde(default)]
+    pub initial_pressure: f64,
 }
 
 /// The shape of a body.
@@ -543,9 +551,10 @@ impl Scene {
         self.materials.iter_mut().chain(staged)
     }
 
-    /// True when a motion has a loaded `area`: the run then has a `limit_pressure`.
+    /// True when a motion or a rigid body has a loaded `area`: the run then has a
+    /// `limit_pressure`.
     pub fn has_limit_pressure(&self) -> bool {
-        self.motions.iter().any(|m| m.area.is_some())
+        self.motions.iter().any(|m| m.area.is_some()) || self.rigid_bodies.iter().any(|b| b.area.is_some())
     }
 }
 

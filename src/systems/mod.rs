@@ -32,6 +32,8 @@ pub mod peak_watch;
 pub mod point_loads;
 pub mod prescribed_motion;
 pub mod remap;
+pub mod rigid_contact;
+pub mod rigid_control;
 pub mod spatial_sort;
 pub mod stages;
 pub mod stress_update;
@@ -53,6 +55,8 @@ pub use peak_watch::PeakWatch;
 pub use point_loads::PointLoads;
 pub use prescribed_motion::PrescribedMotion;
 pub use remap::Remap;
+pub use rigid_contact::RigidContact;
+pub use rigid_control::RigidControl;
 pub use spatial_sort::SpatialSort;
 pub use stages::Stages;
 pub use stress_update::StressUpdate;
@@ -392,10 +396,21 @@ fn loading<D: Dim, S: Shape>() -> Vec<Entry<D>> {
             |_| Box::new(Boundary),
         ),
         e(
+            "rigid_contact",
+            St::Constrain,
+            Needed(|s, _| !s.bodies.is_empty(), "the scene has rigid bodies"),
+            &[("boundary", "contact acts on the held, complete nodal forces")],
+            "soil–body contact: no entry, friction; the bodies' forces",
+            |_| Box::new(RigidContact::<D, S>::default()),
+        ),
+        e(
             "integrate",
             St::Integrate,
             Always,
-            &[("boundary", "integration needs constrained momentum and force")],
+            &[
+                ("boundary", "integration needs constrained momentum and force"),
+                ("rigid_contact", "integration needs the contact forces"),
+            ],
             "nodal acceleration and velocity (+ viscous or local damping)",
             |_| Box::new(Integrate),
         ),
@@ -473,6 +488,17 @@ fn relaxing<D: Dim, S: Shape>() -> Vec<Entry<D>> {
             |s| Box::new(PrescribedMotion::new(s.motions.clone())),
         ),
         e(
+            "rigid_control",
+            St::Control,
+            Needed(|s, _| !s.bodies.is_empty(), "the scene has rigid bodies"),
+            &[
+                ("convergence", "it acts on the step's static state"),
+                ("prescribed_motion", "the bodies' rows follow the motions'"),
+            ],
+            "rigid bodies: travel, hold, curve of static states",
+            |s| Box::new(RigidControl::new(s.bodies.clone())),
+        ),
+        e(
             "load_steps",
             St::Control,
             Needed(
@@ -482,6 +508,7 @@ fn relaxing<D: Dim, S: Shape>() -> Vec<Entry<D>> {
             &[
                 ("convergence", "it acts on the step's static state"),
                 ("prescribed_motion", "a load increment follows the motions' last"),
+                ("rigid_control", "a load increment follows the bodies' last"),
             ],
             "load control: the next load increment at each static state",
             |_| Box::new(LoadControl),
@@ -493,6 +520,7 @@ fn relaxing<D: Dim, S: Shape>() -> Vec<Entry<D>> {
             &[
                 ("convergence", "it acts on the step's static state"),
                 ("prescribed_motion", "a stage ends once the motions are done"),
+                ("rigid_control", "a stage ends once the bodies are done"),
                 ("load_steps", "a stage ends once its load increments are done"),
             ],
             "loading stages: the next stage at each static state",
@@ -702,6 +730,7 @@ mod tests {
             flip: 1.0,
             min_node_mass: 0.0,
             motions: Vec::new(),
+            bodies: Vec::new(),
             water: None,
             friction_faces: Vec::new(),
             stages: Vec::new(),

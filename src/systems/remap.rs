@@ -75,6 +75,7 @@ impl<D: Dim, S: Shape> System<D> for Remap<D, S> {
         }
         exchange_again(ctx, MOMENTUM);
         velocity_from_momentum(ctx);
+        super::rigid_contact::project(ctx);
         Ok(())
     }
 }

@@ -82,6 +82,15 @@ pub(super) fn check_bodies(r: &Rules) -> Result<(), SceneError> {
             &format!("bodies[{b}].points_per_cell"),
             body.points_per_cell.len(),
         )?;
+        if !(body.initial_pressure.is_finite() && body.initial_pressure >= 0.0) {
+            return r.bad(
+                &format!("bodies[{b}].initial_pressure"),
+                format!(
+                    "must be a finite pressure ≥ 0 Pa, found {}",
+                    body.initial_pressure
+                ),
+            );
+        }
         if body.points_per_cell.contains(&0) {
             return r.bad(
                 &format!("bodies[{b}].points_per_cell"),

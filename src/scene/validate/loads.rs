@@ -83,15 +83,16 @@ pub(super) fn check_has_load(r: &Rules) -> Result<(), SceneError> {
         .is_some_and(|g| g.acceleration.iter().any(|&a| a != 0.0));
     let loads = s.point_loads.iter().any(|l| l.force.iter().any(|&f| f != 0.0))
         || s.tractions.iter().any(|t| t.traction.iter().any(|&f| f != 0.0));
-    if !gravity && !loads && s.motions.is_empty() {
+    if !gravity && !loads && s.motions.is_empty() && s.rigid_bodies.is_empty() {
         return r.bad(
             if s.gravity.is_some() {
                 "gravity.acceleration"
             } else {
                 "gravity"
             },
-            "the scene applies no load (no gravity, no non-zero point load, no motion): its \
-             static state is the state it starts in; add gravity, point_loads or motions"
+            "the scene applies no load (no gravity, no non-zero point load, no motion, no rigid \
+             body): its static state is the state it starts in; add gravity, point_loads, \
+             motions or rigid_bodies"
                 .into(),
         );
     }

@@ -1,0 +1,256 @@
+//! Rigid bodies that travel through the ground (`rigid_bodies` in a scene): a footing, a
+//! T-bar, a wall, a pile, with an interface to the soil and a displacement control.
+//!
+//! A body is a [`Geometry`] that moves with its control's velocity. It meets the soil at
+//! the grid (`systems::rigid_contact`): at each node the soil touches it, the soil may not
+//! move into the body along the geometry's normal, and the tangential motion is free
+//! (smooth), the body's (rough), or limited by Coulomb friction and an adhesion cap. The
+//! force this takes is summed per body in node order (its reaction is the opposite). The body travels in
+//! increments (`systems::rigid_control`), each relaxed to a static state and recorded as
+//! a row of `curve.csv`, as `motions` do; kinetic damping never stops the body.
+
+pub mod contact;
+pub mod geometry;
+
+pub use contact::Contact;
+pub use geometry::{Geometry, Sample};
+
+use serde::{Deserialize, Serialize};
+
+/// A rigid body as the scene gives it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RigidBodySpec {
+    /// Name: `curve.csv` rows carry it (and `name.part` for each part's share).
+    pub name: String,
+    /// Its shape at the start: one or more named parts (a cone's `tip` and `shaft`), whose
+    /// union is the body; the resistance is summed per part as well as per body.
+    pub parts: Vec<PartSpec>,
+    /// How the soil slides along it.
+    #[serde(default)]
+    pub interface: Interface,
+    /// How it moves.
+    pub motion: BodyMotion,
+    /// Loaded area (m²; m per metre of thickness in 2D; m² per radian when axisymmetric),
+    /// for the mean pressure in `curve.csv` and `limit_pressure` in summary.json.
+    #[serde(default)]
+    pub area: Option<f64>,
+}
+
+/// A named part of a rigid body.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PartSpec {
+    /// Name, unique within the body.
+    pub name: String,
+    /// Its shape at the start (m).
+    pub geometry: Geometry,
+    /// Loaded area, as the body's, for the part's mean pressure.
+    #[serde(default)]
+    pub area: Option<f64>,
+}
+
+/// The soil–structure interface.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub enum Interface {
+    /// No shear: the soil slides freely along the body.
+    #[default]
+    Smooth,
+    /// No slip: soil in contact moves with the body.
+    Rough,
+    /// Coulomb friction τ ≤ tan δ · σ_n + a, δ in degrees, the adhesion a in Pa (α·c_u on
+    /// clay).
+    Frictional {
+        /// Interface friction angle δ (degrees, 0 ≤ δ < 90).
+        angle: f64,
+        /// Adhesion a (Pa, ≥ 0): shear the interface carries without normal stress.
+        #[serde(default)]
+        adhesion: f64,
+    },
+}
+
+/// Displacement control: a constant velocity, a travel, and increments each ending at a
+/// static state.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BodyMotion {
+    /// Velocity (m/s, one entry per axis).
+    pub velocity: Vec<f64>,
+    /// Distance to travel along it (m).
+    pub travel: f64,
+    /// Distance of one increment (m). Default: the whole travel in one.
+    #[serde(default)]
+    pub increment: Option<f64>,
+}
+
+impl BodyMotion {
+    /// The velocity as x y z (m/s).
+    pub fn vector(&self) -> [f64; 3] {
+        std::array::from_fn(|a| self.velocity.get(a).copied().unwrap_or(0.0))
+    }
+
+    /// Speed (m/s).
+    pub fn speed(&self) -> f64 {
+        self.vector().iter().map(|v| v * v).sum::<f64>().sqrt()
+    }
+
+    /// Travel at the end of increment `k` (0-based), m.
+    pub fn target(&self, k: u32) -> f64 {
+        match self.increment {
+            Some(inc) => (inc * f64::from(k + 1)).min(self.travel),
+            None => self.travel,
+        }
+    }
+}
+
+impl Interface {
+    /// tan δ, and the adhesion (Pa).
+    pub fn friction(&self) -> (f64, f64) {
+        match *self {
+            Interface::Smooth => (0.0, 0.0),
+            Interface::Rough => (f64::INFINITY, f64::INFINITY),
+            Interface::Frictional { angle, adhesion } => (angle.to_radians().tan(), adhesion),
+        }
+    }
+}
+
+impl RigidBodySpec {
+    /// Signed distance φ (m, negative inside) from `x` (m, in the body's starting frame) to
+    /// the body, the unit outward normal there and the part it belongs to (the nearest
+    /// surface; inside, the part that holds `x` deepest).
+    pub fn distance(&self, x: [f64; 3], n: usize) -> (f64, [f64; 3], usize) {
+        let mut best = (f64::INFINITY, [0.0; 3], 0);
+        for (k, p) in self.parts.iter().enumerate() {
+            let (phi, normal) = p.geometry.distance(x, n);
+            if phi < best.0 {
+                best = (phi, normal, k);
+            }
+        }
+        best
+    }
+
+    /// Axis-aligned bounds (m) of the body at its starting position.
+    pub fn bounds(&self, n: usize) -> ([f64; 3], [f64; 3]) {
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        for p in &self.parts {
+            let (l, h) = p.geometry.bounds(n);
+            for a in 0..3 {
+                lo[a] = lo[a].min(l[a]);
+                hi[a] = hi[a].max(h[a]);
+            }
+        }
+        (lo, hi)
+    }
+
+    /// The rules a body holds by itself in `n` dimensions (`axisymmetric`: (r, z)), as
+    /// (field, rule). Its place in the grid is checked with the grid
+    /// (`scene::validate::rigid_bodies`).
+    pub fn check(&self, n: usize, axisymmetric: bool) -> Result<(), (String, String)> {
+        let bad = |f: &str, r: String| Err((f.to_string(), r));
+        if self.parts.is_empty() {
+            return bad("parts", "a body needs at least one part".into());
+        }
+        for (k, p) in self.parts.iter().enumerate() {
+            if let Some(j) = self.parts[..k].iter().position(|o| o.name == p.name) {
+                return bad(
+                    &format!("parts[{k}].name"),
+                    format!(
+                        "\"{}\" is also the name of parts[{j}]: each part needs its own name",
+                        p.name
+                    ),
+                );
+            }
+            if let Some(a) = p.area {
+                if !(a.is_finite() && a > 0.0) {
+                    return bad(&format!("parts[{k}].area"), format!("must be above 0, found {a}"));
+                }
+            }
+            p.geometry
+                .check(n, axisymmetric)
+                .map_err(|(f, r)| (format!("parts[{k}].{f}"), r))?;
+        }
+        self.check_interface_and_motion(n)
+    }
+
+    fn check_interface_and_motion(&self, n: usize) -> Result<(), (String, String)> {
+        let bad = |f: &str, r: String| Err((f.to_string(), r));
+        let finite = |v: &[f64]| v.iter().all(|c| c.is_finite());
+        if let Interface::Frictional { angle, adhesion } = self.interface {
+            if !(angle.is_finite() && (0.0..90.0).contains(&angle)) {
+                return bad(
+                    "interface",
+                    format!("the friction angle is 0 ≤ δ < 90°, found {angle}"),
+                );
+            }
+            if !(adhesion.is_finite() && adhesion >= 0.0) {
+                return bad("interface", format!("the adhesion is ≥ 0 Pa, found {adhesion}"));
+            }
+        }
+        let m = &self.motion;
+        if m.velocity.len() != n || !finite(&m.velocity) {
+            return bad(
+                "motion.velocity",
+                format!("needs {n} finite entries (m/s), found {:?}", m.velocity),
+            );
+        }
+        if m.speed() <= 0.0 {
+            return bad(
+                "motion.velocity",
+                "the body does not move: give it a velocity".into(),
+            );
+        }
+        if !(m.travel.is_finite() && m.travel > 0.0) {
+            return bad("motion.travel", format!("must be above 0 m, found {}", m.travel));
+        }
+        if let Some(inc) = m.increment {
+            if !(inc.is_finite() && inc > 0.0) {
+                return bad("motion.increment", format!("must be above 0 m, found {inc}"));
+            }
+            if m.travel / inc > 1e6 {
+                return bad("motion.increment", "more than a million increments".into());
+            }
+        }
+        if let Some(a) = self.area {
+            if !(a.is_finite() && a > 0.0) {
+                return bad("area", format!("must be above 0, found {a}"));
+            }
+        }
+        Ok(())
+    }
+
+    /// The body's state at the start of a run: moving.
+    pub fn state(&self) -> BodyState {
+        BodyState {
+            name: self.name.clone(),
+            velocity: self.motion.vector(),
+            parts: vec![[0.0; 3]; self.parts.len()],
+            ..BodyState::default()
+        }
+    }
+}
+
+/// A body's state during a run (checkpointed).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct BodyState {
+    /// Name given in the scene.
+    pub name: String,
+    /// Velocity this step (m/s, x y z; zero while holding).
+    pub velocity: [f64; 3],
+    /// Displacement from its scene position (m, x y z).
+    pub offset: [f64; 3],
+    /// Distance travelled (m).
+    pub travel: f64,
+    /// Increments finished, each ending at a static state.
+    pub increments: u32,
+    /// Force the body exerts on the soil this step, Σ f_c over its contacts (N; N/m in
+    /// 2D; N/rad when axisymmetric); the soil's resistance on the body is the opposite.
+    pub reaction: [f64; 3],
+    /// The same, per part (in the order of `parts`).
+    pub parts: Vec<[f64; 3]>,
+    /// Points put back on the surface after a step ended with their centre inside
+    /// (counted once per step each).
+    pub entries: u64,
+    /// The deepest such entry (m).
+    pub deepest_entry: f64,
+}

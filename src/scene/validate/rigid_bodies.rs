@@ -1,0 +1,80 @@
+//! Rigid bodies: each checks itself ([`crate::rigid::RigidBodySpec::check`]); here, their
+//! names beside the motions' (they share `curve.csv`), their place in the grid over the
+//! whole travel along the axes they move on, and that no two overlap.
+
+use super::*;
+use crate::error::SceneError;
+
+/// Every rigid body, then the rules between bodies and with the grid.
+pub(super) fn check_rigid_bodies(r: &Rules) -> Result<(), SceneError> {
+    let (loaded, s, n) = (r.loaded, &r.loaded.scene, r.n);
+    if s.rigid_bodies.len() > 32 {
+        return r.bad(
+            "rigid_bodies",
+            format!("at most 32 bodies, found {}", s.rigid_bodies.len()),
+        );
+    }
+    let g = &s.grid;
+    let lo: Vec<f64> = g.origin.clone();
+    let hi: Vec<f64> = (0..n)
+        .map(|a| g.origin[a] + g.cells[a] as f64 * g.cell_size)
+        .collect();
+    let mut boxes: Vec<([f64; 3], [f64; 3])> = Vec::new();
+    for (i, b) in s.rigid_bodies.iter().enumerate() {
+        let field = |f: &str| format!("rigid_bodies[{i}].{f}");
+        b.check(n, s.dimension == crate::scene::Dimension::Axisymmetric)
+            .map_err(|(f, rule)| loaded.invalid(&field(&f), rule))?;
+        if let Some(j) = s.motions.iter().position(|m| m.name == b.name) {
+            return r.bad(
+                &field("name"),
+                format!(
+                    "\"{}\" is also the name of motions[{j}]: the curve tells them apart by name",
+                    b.name
+                ),
+            );
+        }
+        if let Some(j) = s.rigid_bodies[..i].iter().position(|o| o.name == b.name) {
+            return r.bad(
+                &field("name"),
+                format!(
+                    "\"{}\" is also the name of rigid_bodies[{j}]: each needs its own name",
+                    b.name
+                ),
+            );
+        }
+        // Its bounds at the start and at the end of its travel, on every axis it moves
+        // along; across the others it may reach past the grid (half a T-bar on a
+        // symmetry face: the part outside meets no soil).
+        let (start_lo, start_hi) = b.bounds(n);
+        let v = b.motion.vector();
+        let step = b.motion.travel / b.motion.speed();
+        for (when, shift) in [("at the start", 0.0), ("at the end of its travel", step)] {
+            for a in (0..n).filter(|&a| v[a] != 0.0) {
+                let (l, h) = (start_lo[a] + v[a] * shift, start_hi[a] + v[a] * shift);
+                if l < lo[a] || h > hi[a] {
+                    return r.bad(
+                        &field("geometry"),
+                        format!(
+                            "the body {when} spans {l}..{h} m on axis {a}, outside the grid's \
+                             {}..{} m: give the grid room for the whole travel",
+                            lo[a], hi[a]
+                        ),
+                    );
+                }
+            }
+        }
+        for (j, (olo, ohi)) in boxes.iter().enumerate() {
+            let apart = (0..n).any(|a: usize| start_hi[a] <= olo[a] || ohi[a] <= start_lo[a]);
+            if !apart {
+                return r.bad(
+                    &field("geometry"),
+                    format!(
+                        "the body overlaps rigid_bodies[{j}] (their bounding boxes meet): give them room"
+                    ),
+                );
+            }
+        }
+        boxes.push((start_lo, start_hi));
+    }
+    Ok(())
+}

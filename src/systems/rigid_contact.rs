@@ -1,0 +1,208 @@
+//! Contact between the soil and the scene's rigid bodies, held at the bodies' surfaces.
+//!
+//! Each body's surface is sampled every half cell ([`crate::rigid::Sample`]: a place, the
+//! geometry's outward normal n and the surface it stands for). At a sample x_s the soil's
+//! velocity is the grid's, v(x_s) = Σ_i w_i(x_s) v_i / Σ_i w_i over the nodes that carry
+//! soil, built from the trial velocities v_i* = p_i/m_i + f_i Δt/m̃_i (m̃ the node's
+//! inertia, as `integrate` takes it). Contact holds (v(x_s) − v_b)·n ≥ 0: the soil may
+//! leave the body but not enter it. A violated sample takes an impulse λ n spread over its
+//! nodes as Δv_i = λ w_i n / m̃_i, with λ = −C / Σ w_i²/m̃_i for the violation C; the
+//! samples are visited in a fixed order a few times over (projected Gauss–Seidel, λ ≥ 0
+//! summed per sample), so that overlapping samples share their nodes' correction. Where a
+//! sample presses (λ > 0), the tangential slip is removed the same way, by at most
+//! tan δ · λ + a·A_s·Δt (Coulomb friction with an adhesion cap a on the sample's surface
+//! A_s; no cap when rough, nothing when smooth).
+//!
+//! The constraint is held where the body's surface is, between nodes, so a body is as big
+//! as its geometry whatever the grid: holding the nodes inside a body instead makes it
+//! smaller or larger by up to a cell as it moves across the grid (docs/tried-and-dropped).
+//!
+//! The change is made as a force f_c = m̃ Δv/Δt added to the node's force and, since the
+//! body applies it, to its external force (K_F counts it as applied load, W_ext its work).
+//! Σ f_c, in sample order, is the force the body exerts on the soil, summed per body and
+//! per part; the soil's resistance on the body is the opposite. MUSL maps the points' new
+//! velocities back to the grid (`remap`); [`project`] holds the same contacts there.
+
+use crate::components::*;
+use crate::context::Context;
+use crate::dim::Dim;
+use crate::error::StepError;
+use crate::infra::columns::{col, col_mut, nodes};
+use crate::rigid::contact::{solve, Contact, Contacts, Slot};
+use crate::rigid::Sample;
+use crate::schedule::System;
+use crate::shape::{for_each_node, Shape};
+use crate::systems::boundary::{hold, Hold};
+use std::collections::HashMap;
+use std::marker::PhantomData;
+
+/// Samples the bodies' surfaces once, then at every step holds the contacts at them (after
+/// `boundary`).
+#[derive(Debug)]
+pub struct RigidContact<D: Dim, S> {
+    /// Per body: its samples in its starting frame and the part each belongs to.
+    samples: Vec<Vec<(Sample, usize)>>,
+    _marker: PhantomData<fn() -> (D, S)>,
+}
+
+impl<D: Dim, S> Default for RigidContact<D, S> {
+    fn default() -> Self {
+        RigidContact {
+            samples: Vec::new(),
+            _marker: PhantomData,
+        }
+    }
+}
+
+/// Places every sample that meets soil at its body's current place: its nodes that carry
+/// soil and their weights, each node's trial velocity p/m + f Δt/m̃. A sample meets soil
+/// when nodes carrying mass hold at least half its support.
+fn place<D: Dim, S: Shape>(ctx: &Context<D>, samples: &[Vec<(Sample, usize)>]) -> Contacts {
+    let n = nodes(&ctx.world);
+    let (nm, np, nf, fix) = (
+        col::<NodeMass>(n),
+        col::<NodeMomentum<D::Vec>>(n),
+        col::<NodeForce<D::Vec>>(n),
+        col::<NodeFixity>(n),
+    );
+    let (grid, st) = (&ctx.grid, &ctx.settings);
+    let drives = &ctx.state.control.drives;
+    let mut set = Contacts::default();
+    let mut slot_of: HashMap<usize, usize> = HashMap::new();
+    for (b, body) in samples.iter().enumerate() {
+        let state = &ctx.state.control.bodies[b];
+        let (_, adhesion) = st.bodies[b].interface.friction();
+        for (s, part) in body {
+            let x3: [f64; 3] = std::array::from_fn(|a| s.x[a] + state.offset[a]);
+            let x = D::vec_from(x3);
+            if !grid.contains(x) {
+                continue;
+            }
+            let mut reach = Vec::new();
+            let mut weight = 0.0;
+            for_each_node::<D, S>(grid, x, |i, w, _| {
+                let m = nm[i].0;
+                if w <= 0.0 || !grid.carries(i, m, st.min_node_mass) {
+                    return;
+                }
+                let k = *slot_of.entry(i).or_insert_with(|| {
+                    let inertia = grid.inertia(i, m, st.virtual_mass_floor);
+                    let v = D::vec_to3(np[i].0 * (1.0 / m) + nf[i].0 * (st.dt / inertia));
+                    set.slots.push(Slot {
+                        node: i,
+                        v,
+                        v0: v,
+                        inertia,
+                        free: std::array::from_fn(|a| a < D::N && hold(fix[i], a, drives) == Hold::Free),
+                    });
+                    set.slots.len() - 1
+                });
+                reach.push((k, w));
+                weight += w;
+            });
+            if weight < 0.5 {
+                continue;
+            }
+            // The sample's surface, per radian when axisymmetric (as volumes are).
+            let area = if D::AXISYMMETRIC {
+                s.measure * x3[0]
+            } else {
+                s.measure
+            };
+            set.contacts.push(Contact {
+                body: b,
+                part: *part,
+                normal: s.normal,
+                adhesion: adhesion * area * st.dt,
+                nodes: reach,
+                weight,
+                normal_impulse: 0.0,
+                impulse: [0.0; 3],
+            });
+        }
+    }
+    set
+}
+
+impl<D: Dim, S: Shape> System<D> for RigidContact<D, S> {
+    fn name(&self) -> &str {
+        "rigid_contact"
+    }
+
+    fn prepare(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
+        let spacing = 0.5 * ctx.grid.cell_size;
+        self.samples = ctx
+            .settings
+            .bodies
+            .iter()
+            .map(|b| {
+                b.parts
+                    .iter()
+                    .enumerate()
+                    .flat_map(|(k, p)| p.geometry.samples(spacing).into_iter().map(move |s| (s, k)))
+                    .collect()
+            })
+            .collect();
+        Ok(())
+    }
+
+    fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
+        let mut set = place::<D, S>(ctx, &self.samples);
+        let bodies = &ctx.settings.bodies;
+        let velocities: Vec<[f64; 3]> = ctx.state.control.bodies.iter().map(|b| b.velocity).collect();
+        let mu: Vec<f64> = bodies.iter().map(|b| b.interface.friction().0).collect();
+        solve(&mut set, &velocities, &mu);
+        let dt = ctx.settings.dt;
+        let n = nodes(&ctx.world);
+        let mut nf = col_mut::<NodeForce<D::Vec>>(n);
+        let mut ne = col_mut::<NodeExternalForce<D::Vec>>(n);
+        for s in &set.slots {
+            let fc = D::vec_from(std::array::from_fn(|a| s.inertia * (s.v[a] - s.v0[a]) / dt));
+            nf[s.node].0 += fc;
+            ne[s.node].0 += fc;
+        }
+        let control = &mut ctx.state.control;
+        for (b, state) in control.bodies.iter_mut().enumerate() {
+            state.reaction = [0.0; 3];
+            state.parts = vec![[0.0; 3]; bodies[b].parts.len()];
+        }
+        for p in &set.contacts {
+            let state = &mut control.bodies[p.body];
+            for a in 0..3 {
+                state.reaction[a] += p.impulse[a] / dt;
+                state.parts[p.part][a] += p.impulse[a] / dt;
+            }
+        }
+        control.contacts = set;
+        Ok(())
+    }
+}
+
+/// Holds this step's contacts on the nodal velocities built again from the points (MUSL's
+/// remap), each node's change weighted by its mass: the soil at each sample loses its
+/// velocity into the body and its slip as the interface allows.
+pub fn project<D: Dim>(ctx: &mut Context<D>) {
+    if ctx.state.control.contacts.contacts.is_empty() {
+        return;
+    }
+    let n = nodes(&ctx.world);
+    let nm = col::<NodeMass>(n);
+    let mut nv = col_mut::<NodeVelocity<D::Vec>>(n);
+    let control = &mut ctx.state.control;
+    for s in &mut control.contacts.slots {
+        s.v = D::vec_to3(nv[s.node].0);
+        s.v0 = s.v;
+        s.inertia = nm[s.node].0;
+    }
+    let velocities: Vec<[f64; 3]> = control.bodies.iter().map(|b| b.velocity).collect();
+    let mu: Vec<f64> = ctx
+        .settings
+        .bodies
+        .iter()
+        .map(|b| b.interface.friction().0)
+        .collect();
+    solve(&mut control.contacts, &velocities, &mu);
+    for s in &control.contacts.slots {
+        nv[s.node].0 = D::vec_from(s.v);
+    }
+}
