@@ -156,6 +156,9 @@ pub struct Settings {
     pub motions: Vec<MotionSpec>,
     /// Rigid bodies, in scene order.
     pub bodies: Vec<crate::rigid::RigidBodySpec>,
+    /// Strain energy the points' initial stress may give up, at most (J; J/m in 2D, J/rad
+    /// axisymmetric): the energy guard counts it beside the external work.
+    pub initial_energy: f64,
     /// The scene's `Friction` faces: (normal axis, upper face, tan δ).
     pub friction_faces: Vec<(usize, bool, f64)>,
     /// Loading stages, in order; the first is the scene as built.

@@ -274,6 +274,13 @@ fn the_footing_resumed_in_the_middle_of_an_increment_writes_the_same_curve() {
     resume_from_last_checkpoint("footing.ron", 5_000, &[]);
 }
 
+/// The rigid footing, checkpointed mid-penetration (step 5 000 of 8 344): the body's place,
+/// travel, hold and forces come back with the points, and its surface is sampled again.
+#[test]
+fn a_rigid_body_resumed_mid_penetration_writes_the_same_curve() {
+    resume_from_last_checkpoint("footing_rigid.ron", 5_000, &[]);
+}
+
 /// The circular footing (axisymmetric), checkpointed in its sixth increment.
 #[test]
 fn an_axisymmetric_footing_resumed_in_an_increment_writes_the_same_curve() {

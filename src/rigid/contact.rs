@@ -2,15 +2,20 @@
 //! body; friction and adhesion limit its slip where it presses.
 //!
 //! A sample's soil velocity is v(x_s) = Σ_i (w_i/W) v_i over the nodes that carry soil
-//! (W = Σ w_i). An impulse j along a unit direction d spreads as Δv_i = j (w_i/W) d / m̃_i
-//! over its free axes, the least change of kinetic energy that moves v(x_s) by j times the
-//! sample's compliance Σ (w_i/W)² d·d / m̃_i. The samples are visited in a fixed order
-//! four times (projected Gauss–Seidel: the normal impulse summed per sample stays
-//! ≥ 0, the tangential one within tan δ times it plus the adhesion cap), so overlapping
-//! samples share their nodes' correction and the result is the same on any thread count.
+//! (W = Σ w_i). A change δ of it along a unit direction d is spread as Δv_i ∝ (w_i/W) d / m̃_i
+//! over the free axes, the least change of kinetic energy that makes it; the impulse the
+//! soil takes is Σ m̃_i Δv_i. The nodes inside a body hold their normal velocity as
+//! constraints of their own (without them a node that only a point's tail reaches, inside
+//! the body, runs into it under a confining stress). The constraints are visited in a
+//! fixed order until the largest change of a sweep is a millionth of the first sweep's
+//! (projected Gauss–Seidel: the normal impulse summed per constraint stays ≥ 0, the
+//! tangential one within tan δ times it plus the adhesion cap); with a few sweeps only,
+//! the overlapping samples of a curved surface leave part of each step's entry, and a
+//! confined soil streams past the body. The order is fixed, so the result is the same on
+//! any thread count.
 
-/// Gauss–Seidel sweeps over the samples per solve.
-const SWEEPS: usize = 4;
+/// Most Gauss–Seidel sweeps over the samples per solve.
+const MAX_SWEEPS: usize = 200;
 
 /// A surface sample that meets soil this step: its nodes (slots of [`Contacts::slots`])
 /// and weights, and what it has pushed.
@@ -24,6 +29,9 @@ pub struct Contact {
     pub normal: [f64; 3],
     /// Adhesion cap on the sample's tangential impulse (N s), a·A_s·Δt.
     pub adhesion: f64,
+    /// False for a node inside the body: it holds the normal only (friction and adhesion
+    /// act at the surface samples).
+    pub surface: bool,
     /// (slot, weight) of the nodes that carry soil.
     pub nodes: Vec<(usize, f64)>,
     /// Σ w over those nodes.
@@ -64,40 +72,47 @@ fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
-/// One impulse `j` (N s, along the unit `dir`) on the sample's nodes; returns the impulse
-/// the soil took (N s, x y z; less than `j` along held axes).
-fn push(p: &Contact, slots: &mut [Slot], dir: [f64; 3], j: f64) -> [f64; 3] {
+/// How a change of the soil's velocity at the sample along the unit `dir` spreads over its
+/// nodes: Δv_i = δ (w_i/W) dir / s² on the free axes, s² = Σ (w_i/W)² (dir on free axes)²,
+/// which moves v(x_s) by δ. Returns (s², the impulse per unit δ, Σ m̃_i (w_i/W) dir² / s²).
+fn spread(p: &Contact, slots: &[Slot], dir: [f64; 3]) -> (f64, f64) {
+    let (mut s2, mut m) = (0.0, 0.0);
+    for &(k, w) in &p.nodes {
+        let s = &slots[k];
+        let share = w / p.weight;
+        let c = coefficient(share, s.inertia);
+        let d2: f64 = (0..3).filter(|&a| s.free[a]).map(|a| dir[a] * dir[a]).sum();
+        s2 += share * c * d2;
+        m += s.inertia * c * d2;
+    }
+    if s2 > 0.0 {
+        (s2, m / s2)
+    } else {
+        (0.0, 0.0)
+    }
+}
+
+/// A node's part of a change at the sample: its weight over its inertia, the least change
+/// of kinetic energy that makes it.
+fn coefficient(share: f64, inertia: f64) -> f64 {
+    share / inertia
+}
+
+/// Changes the soil's velocity at the sample by `delta` (m/s) along the unit `dir`, spread
+/// as [`spread`] says; returns the impulse the soil took (N s, x y z).
+fn push(p: &Contact, slots: &mut [Slot], dir: [f64; 3], delta: f64, s2: f64) -> [f64; 3] {
     let mut took = [0.0; 3];
     for &(k, w) in &p.nodes {
         let s = &mut slots[k];
+        let dv = delta * coefficient(w / p.weight, s.inertia) / s2;
         for a in 0..3 {
             if s.free[a] {
-                let dj = j * w / p.weight * dir[a];
-                s.v[a] += dj / s.inertia;
-                took[a] += dj;
+                s.v[a] += dv * dir[a];
+                took[a] += s.inertia * dv * dir[a];
             }
         }
     }
     took
-}
-
-/// Σ (w/W)² dir_a² / m̃ over the sample's nodes: the velocity an impulse of 1 N s along
-/// `dir` gives the soil at the sample.
-fn compliance(p: &Contact, slots: &[Slot], dir: [f64; 3]) -> f64 {
-    p.nodes
-        .iter()
-        .map(|&(k, w)| {
-            let s = &slots[k];
-            let share = w / p.weight;
-            (0..3)
-                .filter(|&a| s.free[a])
-                .map(|a| dir[a] * dir[a])
-                .sum::<f64>()
-                * share
-                * share
-                / s.inertia
-        })
-        .sum()
 }
 
 /// The soil's velocity at the sample (m/s).
@@ -120,27 +135,29 @@ pub fn solve(set: &mut Contacts, body_velocity: &[[f64; 3]], mu: &[f64]) {
         p.normal_impulse = 0.0;
         p.impulse = [0.0; 3];
     }
-    for _ in 0..SWEEPS {
+    // Until the largest change of a sweep is 1e-6 of the first sweep's largest.
+    let mut first = None;
+    for _ in 0..MAX_SWEEPS {
+        let mut largest: f64 = 0.0;
         for p in set.contacts.iter_mut() {
             let vb = body_velocity[p.body];
             let n = p.normal;
-            let c = compliance(p, slots, n);
-            if c <= 0.0 {
+            let (s2, mass) = spread(p, slots, n);
+            if s2 <= 0.0 || mass <= 0.0 {
                 continue;
             }
-            let rel: [f64; 3] = {
-                let v = velocity(p, slots);
-                std::array::from_fn(|a| v[a] - vb[a])
-            };
-            // λ ≥ 0 in total: a sample only pushes.
-            let want = (-dot(rel, n) / c).max(-p.normal_impulse);
-            if want != 0.0 {
-                p.normal_impulse += want;
-                let took = push(p, slots, n, want);
+            let v = velocity(p, slots);
+            let rel: [f64; 3] = std::array::from_fn(|a| v[a] - vb[a]);
+            // The normal impulse stays ≥ 0 in total: a sample only pushes.
+            let delta = (-dot(rel, n)).max(-p.normal_impulse / mass);
+            largest = largest.max(delta.abs());
+            if delta != 0.0 {
+                p.normal_impulse += delta * mass;
+                let took = push(p, slots, n, delta, s2);
                 (0..3).for_each(|a| p.impulse[a] += took[a]);
             }
             let m = mu[p.body];
-            if p.normal_impulse <= 0.0 || (m == 0.0 && p.adhesion == 0.0) {
+            if !p.surface || p.normal_impulse <= 0.0 || (m == 0.0 && p.adhesion == 0.0) {
                 continue;
             }
             let v = velocity(p, slots);
@@ -151,8 +168,8 @@ pub fn solve(set: &mut Contacts, body_velocity: &[[f64; 3]], mu: &[f64]) {
                 continue;
             }
             let t: [f64; 3] = slip.map(|c| -c / speed);
-            let ct = compliance(p, slots, t);
-            if ct <= 0.0 {
+            let (s2, mass) = spread(p, slots, t);
+            if s2 <= 0.0 || mass <= 0.0 {
                 continue;
             }
             // The tangential impulse so far, and the most it may reach.
@@ -162,11 +179,16 @@ pub fn solve(set: &mut Contacts, body_velocity: &[[f64; 3]], mu: &[f64]) {
             } else {
                 m * p.normal_impulse + p.adhesion
             };
-            let j = (speed / ct).min((cap - sofar).max(0.0));
-            if j > 0.0 {
-                let took = push(p, slots, t, j);
+            let delta = speed.min((cap - sofar).max(0.0) / mass);
+            largest = largest.max(delta);
+            if delta > 0.0 {
+                let took = push(p, slots, t, delta, s2);
                 (0..3).for_each(|a| p.impulse[a] += took[a]);
             }
+        }
+        let reference = *first.get_or_insert(largest);
+        if largest <= 1e-6 * reference {
+            break;
         }
     }
 }

@@ -276,6 +276,7 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         ids: body_ids,
         next_id,
         full_node_mass,
+        initial_energy,
     } = {
         // Every water the run will see, to find the points below a surface at set-up.
         let mut waters: Vec<(String, &crate::water::Water)> = Vec::new();
@@ -328,6 +329,7 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         min_node_mass: s.solver.node_mass_cutoff * full_node_mass,
         motions: s.motions.clone(),
         bodies: s.rigid_bodies.clone(),
+        initial_energy,
         water,
         friction_faces: checked_grid
             .faces
@@ -433,6 +435,8 @@ struct Bodies {
     ids: Vec<std::ops::Range<u32>>,
     next_id: u32,
     full_node_mass: f64,
+    /// Strain energy the points' initial stress may give up, at most (J; J/m in 2D).
+    initial_energy: f64,
 }
 
 /// Fills every body with points (refusing one outside the grid, one that overlaps an
@@ -448,6 +452,7 @@ fn spawn_bodies<D: Dim>(
     let n = D::N;
     // Mass of a node inside a filled region, ρ·h^D, for the lightest material in use.
     let mut full_node_mass = f64::INFINITY;
+    let mut initial_energy = 0.0;
     let (gmin, gmax) = (D::vec_to3(grid.origin), D::vec_to3(grid.max_corner()));
     let mut next_id = 0u32;
     // The ids of each body's points (spawn order).
@@ -496,6 +501,7 @@ fn spawn_bodies<D: Dim>(
         }
         let spawned = spawn_body::<D>(loaded, b, table, waters, world, xs, next_id)?;
         full_node_mass = full_node_mass.min(spawned.full_node_mass);
+        initial_energy += spawned.initial_energy;
         body_ids.push(next_id..spawned.next_id);
         next_id = spawned.next_id;
     }
@@ -504,6 +510,7 @@ fn spawn_bodies<D: Dim>(
         ids: body_ids,
         next_id,
         full_node_mass,
+        initial_energy,
     })
 }
 
@@ -512,6 +519,7 @@ fn spawn_bodies<D: Dim>(
 struct Spawned {
     next_id: u32,
     full_node_mass: f64,
+    initial_energy: f64,
 }
 
 /// Spawns body `b`'s points `xs` (positions and ids from `first`, as many as `xs.left`) as
@@ -589,6 +597,14 @@ fn spawn_body<D: Dim>(
     fill(&batch, xs.clone().map(|(_, id)| PointId(id)));
     fill(&batch, xs.clone().map(|(x, _)| Position(D::vec_from(x))));
     fill(&batch, std::iter::repeat_n(Velocity(z), count));
+    // The strain energy of σ = −p I is p²/(2K) a unit volume; K ≥ M/3 for ν ≥ 0, so
+    // 3p²/(2M) bounds it from the P-wave modulus M.
+    let initial_energy = if body.initial_pressure > 0.0 {
+        1.5 * body.initial_pressure.powi(2) / model.p_wave_modulus()
+            * xs.clone().map(|(x, _)| vol_at(x)).sum::<f64>()
+    } else {
+        0.0
+    };
     fill(&batch, xs.clone().map(|(x, _)| Mass(mass_at(x))));
     fill(&batch, xs.map(|(x, _)| Volume(vol_at(x))));
     let p = -body.initial_pressure;
@@ -615,6 +631,7 @@ fn spawn_body<D: Dim>(
     Ok(Spawned {
         next_id,
         full_node_mass: model.density() * cell_volume * radius,
+        initial_energy,
     })
 }
 

@@ -231,9 +231,11 @@ impl<D: Dim> System<D> for Convergence {
         } else {
             UNDEFINED
         };
-        // Energy balance: W_ext = E_k + stored + dissipated, so K_E ≤ 1 in a sound run.
-        // Well above that the scheme is creating energy; stop before it turns into NaN.
-        if s.convergence.energy_ratio > UNSTABLE_ENERGY_RATIO && s.convergence.external_work > 0.0 {
+        // Energy balance: W_ext + E_0 = E_k + stored + dissipated (E_0 the strain energy of
+        // an initial stress), so E_k ≤ W_ext + E_0 in a sound run. Well above that the
+        // scheme is creating energy; stop before it turns into NaN.
+        let available = s.convergence.external_work + ctx.settings.initial_energy;
+        if s.convergence.external_work > 0.0 && s.energy.current() > UNSTABLE_ENERGY_RATIO * available {
             return Err(StepError::Unstable {
                 step: s.clock.step,
                 kinetic_energy: s.energy.current(),

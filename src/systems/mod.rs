@@ -731,6 +731,7 @@ mod tests {
             min_node_mass: 0.0,
             motions: Vec::new(),
             bodies: Vec::new(),
+            initial_energy: 0.0,
             water: None,
             friction_faces: Vec::new(),
             stages: Vec::new(),

@@ -71,7 +71,55 @@ fn place<D: Dim, S: Shape>(ctx: &Context<D>, samples: &[Vec<(Sample, usize)>]) -
     let mut slot_of: HashMap<usize, usize> = HashMap::new();
     for (b, body) in samples.iter().enumerate() {
         let state = &ctx.state.control.bodies[b];
-        let (_, adhesion) = st.bodies[b].interface.friction();
+        let spec = &st.bodies[b];
+        let (_, adhesion) = spec.interface.friction();
+        // The nodes inside the body hold their normal velocity too: the soil's field
+        // there is the body's, and a light node that only a point's tail reaches would
+        // otherwise be free to run into it (under a confining stress it does).
+        let (lo, hi) = spec.bounds(D::N);
+        let o = D::vec_to3(grid.origin);
+        let mut inside = ctx.state.active_nodes;
+        for a in 0..D::N {
+            let first = ((lo[a] + state.offset[a] - o[a]) * grid.inv_h).ceil().max(0.0) as usize;
+            let last = ((hi[a] + state.offset[a] - o[a]) * grid.inv_h).floor().max(-1.0) + 1.0;
+            inside.lo[a] = inside.lo[a].max(first);
+            inside.hi[a] = inside.hi[a].min(last as usize).max(inside.lo[a]);
+        }
+        for i in inside.rows(grid).flatten() {
+            let m = nm[i].0;
+            if !grid.carries(i, m, st.min_node_mass) {
+                continue;
+            }
+            let x = D::vec_to3(grid.node_position(grid.node_ijk(i)));
+            let at: [f64; 3] = std::array::from_fn(|a| x[a] - state.offset[a]);
+            let (phi, normal, part) = spec.distance(at, D::N);
+            if phi > 0.0 {
+                continue;
+            }
+            let k = *slot_of.entry(i).or_insert_with(|| {
+                let inertia = grid.inertia(i, m, st.virtual_mass_floor);
+                let v = D::vec_to3(np[i].0 * (1.0 / m) + nf[i].0 * (st.dt / inertia));
+                set.slots.push(Slot {
+                    node: i,
+                    v,
+                    v0: v,
+                    inertia,
+                    free: std::array::from_fn(|a| a < D::N && hold(fix[i], a, drives) == Hold::Free),
+                });
+                set.slots.len() - 1
+            });
+            set.contacts.push(Contact {
+                body: b,
+                part,
+                normal,
+                adhesion: 0.0,
+                surface: false,
+                nodes: vec![(k, 1.0)],
+                weight: 1.0,
+                normal_impulse: 0.0,
+                impulse: [0.0; 3],
+            });
+        }
         for (s, part) in body {
             let x3: [f64; 3] = std::array::from_fn(|a| s.x[a] + state.offset[a]);
             let x = D::vec_from(x3);
@@ -114,6 +162,7 @@ fn place<D: Dim, S: Shape>(ctx: &Context<D>, samples: &[Vec<(Sample, usize)>]) -
                 part: *part,
                 normal: s.normal,
                 adhesion: adhesion * area * st.dt,
+                surface: true,
                 nodes: reach,
                 weight,
                 normal_impulse: 0.0,
@@ -188,11 +237,12 @@ pub fn project<D: Dim>(ctx: &mut Context<D>) {
     let n = nodes(&ctx.world);
     let nm = col::<NodeMass>(n);
     let mut nv = col_mut::<NodeVelocity<D::Vec>>(n);
+    let (grid, floor) = (&ctx.grid, ctx.settings.virtual_mass_floor);
     let control = &mut ctx.state.control;
     for s in &mut control.contacts.slots {
         s.v = D::vec_to3(nv[s.node].0);
         s.v0 = s.v;
-        s.inertia = nm[s.node].0;
+        s.inertia = grid.inertia(s.node, nm[s.node].0, floor);
     }
     let velocities: Vec<[f64; 3]> = control.bodies.iter().map(|b| b.velocity).collect();
     let mu: Vec<f64> = ctx
