@@ -166,47 +166,46 @@ fn a_negative_initial_pressure_is_refused() {
     assert!(e.contains("bodies[0].initial_pressure"), "{e}");
 }
 
-/// `scenes/tbar.ron`, coarser and shorter (h = D/8, 0.25 D of travel): a smooth T-bar in
+/// `scenes/tbar.ron`, coarser and shorter (h = D/8, 0.15 D of travel): a smooth T-bar in
 /// confined Tresca clay. Randolph & Houlsby (1984) and Martin & Randolph (2006) give
 /// N = F/(c_u D) = 9.14 for full flow round a smooth cylinder; the static states here
-/// (9.22, 9.27, 9.63, 9.31, 8.74) average 9.23, +1 %, within 5 % (the swing as the bar
-/// crosses the cells is a few per cent), and the last is pinned.
+/// (9.22, 9.27, 9.63) average 9.37, +2.5 %, within 5 % (the swing as the bar crosses the
+/// cells is a few per cent; over 0.25 D the mean is 9.23), and the last is pinned.
 #[test]
 fn a_smooth_tbar_in_confined_tresca_clay_has_the_flow_round_factor() {
     let coarse = [
         "grid.cell_size=0.125",
         "grid.cells=[20, 56]",
-        "rigid_bodies[0].motion.travel=0.25",
+        "rigid_bodies[0].motion.travel=0.15",
     ];
     let s = run("tbar.ron", &coarse);
     let n: Vec<f64> = s.curve.iter().map(|c| c.pressure.unwrap() / 10.0e3).collect();
-    assert_eq!(n.len(), 5);
+    assert_eq!(n.len(), 3);
     let mean = n.iter().sum::<f64>() / n.len() as f64;
     assert!(rel(mean, 9.14).abs() < 0.05, "N {n:?}, mean {mean} against 9.14");
-    assert_eq!(n[4], 8.74031897020351);
+    assert_eq!(n[2], 9.62594411931283);
 }
 
 /// The same T-bar fully rough (no slip where the clay presses): 11.94 for full flow round
 /// a rough cylinder (Randolph & Houlsby 1984; Martin & Randolph 2006). At h = D/8 the
-/// static states (11.46, 12.30, 12.54, 12.59, 11.93) average 12.16, +1.8 %; the last is
-/// pinned, and the rough bar resists more than the smooth one.
+/// static states (11.46, 12.30, 12.54) average 12.10, +1.3 %; the last is pinned.
 #[test]
 fn a_rough_tbar_has_the_rough_flow_round_factor() {
     let coarse = [
         "grid.cell_size=0.125",
         "grid.cells=[20, 56]",
-        "rigid_bodies[0].motion.travel=0.25",
+        "rigid_bodies[0].motion.travel=0.15",
         "rigid_bodies[0].interface=Rough",
     ];
     let s = run("tbar.ron", &coarse);
     let n: Vec<f64> = s.curve.iter().map(|c| c.pressure.unwrap() / 10.0e3).collect();
-    assert_eq!(n.len(), 5);
+    assert_eq!(n.len(), 3);
     let mean = n.iter().sum::<f64>() / n.len() as f64;
     assert!(
         rel(mean, 11.94).abs() < 0.05,
         "N {n:?}, mean {mean} against 11.94"
     );
-    assert_eq!(n[4], 11.926061861509943);
+    assert_eq!(n[2], 12.541620617580843);
 }
 
 /// `scenes/passive_wall.ron`, coarser and shorter (h = H/10, 3 % of H): a smooth wall pushed
