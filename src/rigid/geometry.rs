@@ -107,17 +107,7 @@ impl Geometry {
                     std::array::from_fn(|a| r(a, 1.0)),
                 )
             }
-            Geometry::Polygon { vertices } => {
-                let mut lo = [f64::INFINITY, f64::INFINITY, 0.0];
-                let mut hi = [f64::NEG_INFINITY, f64::NEG_INFINITY, 0.0];
-                for v in vertices {
-                    for a in 0..2 {
-                        lo[a] = lo[a].min(v[a]);
-                        hi[a] = hi[a].max(v[a]);
-                    }
-                }
-                (lo, hi)
-            }
+            Geometry::Polygon { vertices } => polygon_bounds(vertices),
             Geometry::Box { min, max } => (point(min), point(max)),
             Geometry::Cylinder {
                 base,
@@ -130,18 +120,6 @@ impl Geometry {
                 let hi = std::array::from_fn(|a| if a == *axis { b[a] + length } else { b[a] + radius });
                 (lo, hi)
             }
-        }
-    }
-
-    /// Its area (2D, m²) or volume (3D, m³).
-    pub fn measure(&self, n: usize) -> f64 {
-        use std::f64::consts::PI;
-        match self {
-            Geometry::Circle { radius, .. } => PI * radius * radius,
-            Geometry::Sphere { radius, .. } => 4.0 / 3.0 * PI * radius.powi(3),
-            Geometry::Polygon { vertices } => 0.5 * signed_area(vertices).abs(),
-            Geometry::Box { min, max } => (0..n).map(|a| max[a] - min[a]).product(),
-            Geometry::Cylinder { length, radius, .. } => PI * radius * radius * length,
         }
     }
 }
@@ -412,6 +390,19 @@ impl Geometry {
             }
         }
     }
+}
+
+/// Bounds (m) of a polygon's vertices `[x, y]`, z 0..0.
+pub(crate) fn polygon_bounds(vertices: &[Vec<f64>]) -> ([f64; 3], [f64; 3]) {
+    let mut lo = [f64::INFINITY, f64::INFINITY, 0.0];
+    let mut hi = [f64::NEG_INFINITY, f64::NEG_INFINITY, 0.0];
+    for v in vertices {
+        for a in 0..2 {
+            lo[a] = lo[a].min(v[a]);
+            hi[a] = hi[a].max(v[a]);
+        }
+    }
+    (lo, hi)
 }
 
 /// Twice the signed area of a polygon (positive counter-clockwise).

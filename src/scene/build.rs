@@ -67,14 +67,7 @@ pub(super) fn region_bounds(region: &Region, n: usize) -> ([f64; 3], [f64; 3]) {
     match region {
         Region::Box { min, max } => (pad3(min), pad3(max)),
         Region::Polygon { vertices, z } => {
-            let mut lo = [f64::INFINITY, f64::INFINITY, 0.0];
-            let mut hi = [f64::NEG_INFINITY, f64::NEG_INFINITY, 0.0];
-            for v in vertices {
-                for a in 0..2 {
-                    lo[a] = lo[a].min(v[a]);
-                    hi[a] = hi[a].max(v[a]);
-                }
-            }
+            let (mut lo, mut hi) = crate::rigid::geometry::polygon_bounds(vertices);
             if n == 3 {
                 let z = z.as_ref().expect("validated");
                 (lo[2], hi[2]) = (z[0], z[1]);

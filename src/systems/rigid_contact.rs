@@ -69,6 +69,23 @@ fn place<D: Dim, S: Shape>(ctx: &Context<D>, samples: &[Vec<(Sample, usize)>]) -
     let drives = &ctx.state.control.drives;
     let mut set = Contacts::default();
     let mut slot_of: HashMap<usize, usize> = HashMap::new();
+    // The slot of node `i` (which carries mass), made at its first reach with the node's
+    // trial velocity p/m + f Δt/m̃, inertia and free axes.
+    let slot = |slots: &mut Vec<Slot>, slot_of: &mut HashMap<usize, usize>, i: usize| -> usize {
+        *slot_of.entry(i).or_insert_with(|| {
+            let m = nm[i].0;
+            let inertia = grid.inertia(i, m, st.virtual_mass_floor);
+            let v = D::vec_to3(np[i].0 * (1.0 / m) + nf[i].0 * (st.dt / inertia));
+            slots.push(Slot {
+                node: i,
+                v,
+                v0: v,
+                inertia,
+                free: std::array::from_fn(|a| a < D::N && hold(fix[i], a, drives) == Hold::Free),
+            });
+            slots.len() - 1
+        })
+    };
     for (b, body) in samples.iter().enumerate() {
         let state = &ctx.state.control.bodies[b];
         let spec = &st.bodies[b];
@@ -96,18 +113,7 @@ fn place<D: Dim, S: Shape>(ctx: &Context<D>, samples: &[Vec<(Sample, usize)>]) -
             if phi > 0.0 {
                 continue;
             }
-            let k = *slot_of.entry(i).or_insert_with(|| {
-                let inertia = grid.inertia(i, m, st.virtual_mass_floor);
-                let v = D::vec_to3(np[i].0 * (1.0 / m) + nf[i].0 * (st.dt / inertia));
-                set.slots.push(Slot {
-                    node: i,
-                    v,
-                    v0: v,
-                    inertia,
-                    free: std::array::from_fn(|a| a < D::N && hold(fix[i], a, drives) == Hold::Free),
-                });
-                set.slots.len() - 1
-            });
+            let k = slot(&mut set.slots, &mut slot_of, i);
             set.contacts.push(Contact {
                 body: b,
                 part,
@@ -133,18 +139,7 @@ fn place<D: Dim, S: Shape>(ctx: &Context<D>, samples: &[Vec<(Sample, usize)>]) -
                 if w <= 0.0 || !grid.carries(i, m, st.min_node_mass) {
                     return;
                 }
-                let k = *slot_of.entry(i).or_insert_with(|| {
-                    let inertia = grid.inertia(i, m, st.virtual_mass_floor);
-                    let v = D::vec_to3(np[i].0 * (1.0 / m) + nf[i].0 * (st.dt / inertia));
-                    set.slots.push(Slot {
-                        node: i,
-                        v,
-                        v0: v,
-                        inertia,
-                        free: std::array::from_fn(|a| a < D::N && hold(fix[i], a, drives) == Hold::Free),
-                    });
-                    set.slots.len() - 1
-                });
+                let k = slot(&mut set.slots, &mut slot_of, i);
                 reach.push((k, w));
                 weight += w;
             });
