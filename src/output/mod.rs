@@ -1,6 +1,7 @@
 //! Results on disk: `history.csv` (one row per output step), point snapshots as a
-//! ParaView series (`points.pvd`), `points.vtu` and `summary.json`.
+//! ParaView series (`points.pvd`, with the rigid bodies), `points.vtu` and `summary.json`.
 
+pub mod bodies;
 pub mod dir;
 pub mod history;
 pub mod plots;

@@ -5,6 +5,7 @@
 use crate::context::Context;
 use crate::dim::Dim;
 use crate::error::StepError;
+use crate::output::bodies::write_bodies;
 use crate::output::dir::write_atomic;
 use crate::output::vtk::{write_frame, Frame};
 use crate::schedule::System;
@@ -37,6 +38,8 @@ pub struct SnapshotSpec {
 pub const PVD: &str = "points.pvd";
 /// The folder of the snapshot files.
 pub const FOLDER: &str = "snapshots";
+/// How the rigid bodies' files in it begin (`bodies_<step>.vtu`).
+pub const BODIES: &str = "bodies_";
 /// Frames in flight between the step loop and the writer: a third waits (back-pressure)
 /// rather than holding more copies of the points in memory.
 const IN_FLIGHT: usize = 2;
@@ -98,7 +101,8 @@ impl<D: Dim> Snapshots<D> {
             move || -> std::io::Result<usize> {
                 lower_priority();
                 let mut sorted = Frame::default();
-                for frame in rx {
+                for mut frame in rx {
+                    let bodies = std::mem::take(&mut frame.bodies);
                     frame.sort_into(&mut sorted);
                     // Hand the buffers back for the next snapshot; never blocks (a full
                     // return channel drops them).
@@ -106,6 +110,11 @@ impl<D: Dim> Snapshots<D> {
                     let name = format!("{FOLDER}/points_{:09}.vtu", sorted.step);
                     write_frame(&sorted, &dir.join(&name))?;
                     entries.push((sorted.time, name));
+                    if !bodies.is_empty() {
+                        let name = format!("{FOLDER}/{BODIES}{:09}.vtu", sorted.step);
+                        write_bodies(&dir.join(&name), &bodies)?;
+                        entries.push((sorted.time, name));
+                    }
                     write_pvd(&dir.join(PVD), &entries)?;
                 }
                 Ok(entries.len())
@@ -167,6 +176,11 @@ impl<D: Dim> System<D> for Snapshots<D> {
             ctx.state.clock.time,
             ctx.settings.water.clone(),
         );
+        let spacing = 0.5 * ctx.grid.cell_size;
+        frame.bodies = (0u32..)
+            .zip(ctx.settings.bodies.iter().zip(&ctx.state.control.bodies))
+            .flat_map(|(k, (spec, state))| spec.outlines(k, state.offset, spacing))
+            .collect();
         let start = Instant::now();
         if tx.send(frame).is_err() {
             // The writer stopped on an error; finish() reports it. Stepping goes on.
@@ -217,8 +231,13 @@ fn write_pvd(path: &Path, entries: &[Entry]) -> std::io::Result<()> {
     write_atomic(path, |out| {
         out.write_all(b"<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"1.0\" byte_order=\"LittleEndian\">\n<Collection>\n")?;
         for (t, file) in entries {
-            // Shortest decimal that reads back to the same f64.
-            writeln!(out, "<DataSet timestep=\"{t:?}\" part=\"0\" file=\"{file}\"/>")?;
+            // The points are part 0, the rigid bodies part 1. Shortest decimal that reads
+            // back to the same f64.
+            let part = u8::from(file.starts_with(&format!("{FOLDER}/{BODIES}")));
+            writeln!(
+                out,
+                "<DataSet timestep=\"{t:?}\" part=\"{part}\" file=\"{file}\"/>"
+            )?;
         }
         out.write_all(b"</Collection>\n</VTKFile>\n")
     })
@@ -240,22 +259,23 @@ fn read_pvd(path: &Path) -> Vec<Entry> {
         .collect()
 }
 
-/// The snapshot files of a collection, for readers: (time, path) in time order.
+/// The point snapshot files of a collection, for readers: (time, path) in time order.
 pub fn collection(dir: &Path) -> Vec<(f64, PathBuf)> {
     read_pvd(&dir.join(PVD))
         .into_iter()
+        .filter(|(_, f)| !f.starts_with(&format!("{FOLDER}/{BODIES}")))
         .map(|(t, f)| (t, dir.join(f)))
         .collect()
 }
 
 /// Removes an earlier run's series from output directory `dir`: its `points.pvd` and the
-/// snapshots in its folder (a new run's series is its own).
+/// snapshots (points and bodies) in its folder (a new run's series is its own).
 pub(crate) fn clear(dir: &Path) -> std::io::Result<()> {
     let folder = dir.join(FOLDER);
     if let Ok(entries) = std::fs::read_dir(&folder) {
         for e in entries.flatten() {
             let name = e.file_name().to_string_lossy().into_owned();
-            if name.starts_with("points_") && name.ends_with(".vtu") {
+            if (name.starts_with("points_") || name.starts_with(BODIES)) && name.ends_with(".vtu") {
                 std::fs::remove_file(e.path())?;
             }
         }

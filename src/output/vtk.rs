@@ -334,6 +334,8 @@ pub struct Frame {
     pub plastic_strain: Vec<f64>,
     /// The water table, when the scene has one (the stress is then effective).
     pub water: Option<Water>,
+    /// The rigid bodies where they are (none without).
+    pub bodies: Vec<crate::rigid::Outline>,
 }
 
 impl Frame {

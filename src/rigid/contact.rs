@@ -8,11 +8,20 @@
 //! constraints of their own (without them a node that only a point's tail reaches, inside
 //! the body, runs into it under a confining stress). The constraints are visited in a
 //! fixed order until the largest change of a sweep is a millionth of the first sweep's
-//! (projected Gauss–Seidel: the normal impulse summed per constraint stays ≥ 0, the
-//! tangential one within tan δ times it plus the adhesion cap); with a few sweeps only,
+//! (projected Gauss–Seidel: the normal impulse summed per constraint stays ≥ 0, a surface
+//! sample's tangential one within tan δ times the normal impulse it leans on plus the
+//! adhesion cap); with a few sweeps only,
 //! the overlapping samples of a curved surface leave part of each step's entry, and a
 //! confined soil streams past the body. The order is fixed, so the result is the same on
 //! any thread count.
+//!
+//! Friction acts at a sample that presses itself, and the normal impulse its cap leans on
+//! is its nodes' (each node's share of what every constraint pushed into it, split among
+//! the samples that reach it by weight) when that is more than its own: the inside nodes carry much of a body's normal force, and a cap
+//! of the sample's own impulse held a block on a rigid base with a hundredth of its
+//! friction (docs/performance.md, tried and dropped). Acting wherever its nodes were
+//! pressed (not only where the sample presses) let a rough T-bar drag the soil behind it
+//! and the solve stop converging.
 
 /// Most Gauss–Seidel sweeps over the samples per solve.
 const MAX_SWEEPS: usize = 200;
@@ -56,6 +65,27 @@ pub struct Slot {
     pub inertia: f64,
     /// Axes no boundary condition holds.
     pub free: [bool; 3],
+    /// Impulse the node has taken from every constraint's normal push so far (N s, x y z):
+    /// pushes of two bodies on either side of it cancel.
+    pub pressed: [f64; 3],
+    /// Σ w/W over the surface samples that reach the node: how its pressed impulse is
+    /// shared among their friction caps.
+    pub share: f64,
+}
+
+impl Slot {
+    /// A slot for `node` at velocity `v` (m/s), nothing pressed yet.
+    pub fn new(node: usize, v: [f64; 3], inertia: f64, free: [bool; 3]) -> Self {
+        Slot {
+            node,
+            v,
+            v0: v,
+            inertia,
+            free,
+            pressed: [0.0; 3],
+            share: 0.0,
+        }
+    }
 }
 
 /// This step's contacts and the nodes they reach (rebuilt each step by `rigid_contact`;
@@ -100,7 +130,7 @@ fn coefficient(share: f64, inertia: f64) -> f64 {
 
 /// Changes the soil's velocity at the sample by `delta` (m/s) along the unit `dir`, spread
 /// as [`spread`] says; returns the impulse the soil took (N s, x y z).
-fn push(p: &Contact, slots: &mut [Slot], dir: [f64; 3], delta: f64, s2: f64) -> [f64; 3] {
+fn push(p: &Contact, slots: &mut [Slot], dir: [f64; 3], delta: f64, s2: f64, normal: bool) -> [f64; 3] {
     let mut took = [0.0; 3];
     for &(k, w) in &p.nodes {
         let s = &mut slots[k];
@@ -109,10 +139,30 @@ fn push(p: &Contact, slots: &mut [Slot], dir: [f64; 3], delta: f64, s2: f64) -> 
             if s.free[a] {
                 s.v[a] += dv * dir[a];
                 took[a] += s.inertia * dv * dir[a];
+                if normal {
+                    s.pressed[a] += s.inertia * dv * dir[a];
+                }
             }
         }
     }
     took
+}
+
+/// The normal impulse a surface sample's friction may lean on: its nodes' pressed impulse
+/// along the sample's normal, each node's shared among the samples that reach it by their
+/// weights (so the caps sum to the whole normal impulse, the inside nodes' included).
+fn leaning(p: &Contact, slots: &[Slot]) -> f64 {
+    p.nodes
+        .iter()
+        .map(|&(k, w)| {
+            let s = &slots[k];
+            if s.share > 0.0 {
+                dot(s.pressed, p.normal).max(0.0) * (w / p.weight) / s.share
+            } else {
+                0.0
+            }
+        })
+        .sum()
 }
 
 /// The soil's velocity at the sample (m/s).
@@ -131,9 +181,18 @@ fn velocity(p: &Contact, slots: &[Slot]) -> [f64; 3] {
 /// infinite when rough, 0 with adhesion alone) where a sample presses.
 pub fn solve(set: &mut Contacts, body_velocity: &[[f64; 3]], mu: &[f64]) {
     let slots = &mut set.slots[..];
+    for s in slots.iter_mut() {
+        s.pressed = [0.0; 3];
+        s.share = 0.0;
+    }
     for p in set.contacts.iter_mut() {
         p.normal_impulse = 0.0;
         p.impulse = [0.0; 3];
+        if p.surface {
+            for &(k, w) in &p.nodes {
+                slots[k].share += w / p.weight;
+            }
+        }
     }
     // Until the largest change of a sweep is 1e-6 of the first sweep's largest.
     let mut first = None;
@@ -153,11 +212,11 @@ pub fn solve(set: &mut Contacts, body_velocity: &[[f64; 3]], mu: &[f64]) {
             largest = largest.max(delta.abs());
             if delta != 0.0 {
                 p.normal_impulse += delta * mass;
-                let took = push(p, slots, n, delta, s2);
+                let took = push(p, slots, n, delta, s2, true);
                 (0..3).for_each(|a| p.impulse[a] += took[a]);
             }
             let m = mu[p.body];
-            if !p.surface || p.normal_impulse <= 0.0 || (m == 0.0 && p.adhesion == 0.0) {
+            if !p.surface || (m == 0.0 && p.adhesion == 0.0) {
                 continue;
             }
             let v = velocity(p, slots);
@@ -165,6 +224,14 @@ pub fn solve(set: &mut Contacts, body_velocity: &[[f64; 3]], mu: &[f64]) {
             let slip: [f64; 3] = std::array::from_fn(|a| rel[a] - dot(rel, n) * n[a]);
             let speed = dot(slip, slip).sqrt();
             if speed <= 0.0 {
+                continue;
+            }
+            // Friction acts where the soil is in contact: the sample presses, or its nodes
+            // were pressed and the soil does not leave (a separation slower than a tenth
+            // of the slip). Its cap leans on its nodes' normal impulse.
+            let lean = leaning(p, slots);
+            let touching = p.normal_impulse > 0.0 || (lean > 0.0 && dot(rel, n) <= 0.1 * speed);
+            if !touching {
                 continue;
             }
             let t: [f64; 3] = slip.map(|c| -c / speed);
@@ -177,12 +244,12 @@ pub fn solve(set: &mut Contacts, body_velocity: &[[f64; 3]], mu: &[f64]) {
             let cap = if m.is_infinite() {
                 f64::INFINITY
             } else {
-                m * p.normal_impulse + p.adhesion
+                m * lean.max(p.normal_impulse) + p.adhesion
             };
             let delta = speed.min((cap - sofar).max(0.0) / mass);
             largest = largest.max(delta);
             if delta > 0.0 {
-                let took = push(p, slots, t, delta, s2);
+                let took = push(p, slots, t, delta, s2, false);
                 (0..3).for_each(|a| p.impulse[a] += took[a]);
             }
         }

@@ -503,6 +503,27 @@ fn cylinder(base: [f64; 3], axis: usize, length: f64, radius: f64, x: [f64; 3]) 
     }
 }
 
+impl Geometry {
+    /// The shape to draw (m, at its starting place): in 2D and axisymmetric scenes its
+    /// outline, closed (a polygon's vertices, a circle in 72 pieces, `true`); in 3D the
+    /// surface samples every `spacing` m as a cloud of points (`false`).
+    pub fn outline(&self, spacing: f64) -> (Vec<[f64; 3]>, bool) {
+        match self {
+            Geometry::Polygon { vertices } => (vertices.iter().map(|v| [v[0], v[1], 0.0]).collect(), true),
+            Geometry::Circle { centre, radius } => (
+                (0..72)
+                    .map(|k| {
+                        let t = std::f64::consts::TAU * f64::from(k) / 72.0;
+                        [centre[0] + radius * t.cos(), centre[1] + radius * t.sin(), 0.0]
+                    })
+                    .collect(),
+                true,
+            ),
+            _ => (self.samples(spacing).into_iter().map(|s| s.x).collect(), false),
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

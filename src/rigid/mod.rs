@@ -29,8 +29,10 @@ pub struct RigidBodySpec {
     /// How the soil slides along it.
     #[serde(default)]
     pub interface: Interface,
-    /// How it moves.
-    pub motion: BodyMotion,
+    /// How it moves; without one the body holds its place (a rigid base, a wall at rest)
+    /// and its reaction is recorded at every static state another control reaches.
+    #[serde(default)]
+    pub motion: Option<BodyMotion>,
     /// Loaded area (m²; m per metre of thickness in 2D; m² per radian when axisymmetric),
     /// for the mean pressure in `curve.csv` and `limit_pressure` in summary.json.
     #[serde(default)]
@@ -81,6 +83,10 @@ pub struct BodyMotion {
     /// Distance of one increment (m). Default: the whole travel in one.
     #[serde(default)]
     pub increment: Option<f64>,
+    /// The stage (by name) at whose start the body sets off; until then it holds its
+    /// place (a geostatic stage, then penetration). Default: from the start of the run.
+    #[serde(default)]
+    pub stage: Option<String>,
 }
 
 impl BodyMotion {
@@ -187,7 +193,14 @@ impl RigidBodySpec {
                 return bad("interface", format!("the adhesion is ≥ 0 Pa, found {adhesion}"));
             }
         }
-        let m = &self.motion;
+        if let Some(a) = self.area {
+            if !(a.is_finite() && a > 0.0) {
+                return bad("area", format!("must be above 0, found {a}"));
+            }
+        }
+        let Some(m) = &self.motion else {
+            return Ok(());
+        };
         if m.velocity.len() != n || !finite(&m.velocity) {
             return bad(
                 "motion.velocity",
@@ -211,23 +224,67 @@ impl RigidBodySpec {
                 return bad("motion.increment", "more than a million increments".into());
             }
         }
-        if let Some(a) = self.area {
-            if !(a.is_finite() && a > 0.0) {
-                return bad("area", format!("must be above 0, found {a}"));
-            }
-        }
         Ok(())
     }
 
-    /// The body's state at the start of a run: moving.
-    pub fn state(&self) -> BodyState {
+    /// Its parts drawn at displacement `offset` (m), body index `body`, 3D surfaces sampled
+    /// every `spacing` m (the snapshots' `bodies_*.vtu`).
+    pub fn outlines(&self, body: u32, offset: [f64; 3], spacing: f64) -> Vec<Outline> {
+        (0u32..)
+            .zip(&self.parts)
+            .map(|(part, p)| {
+                let (points, closed) = p.geometry.outline(spacing);
+                Outline {
+                    body,
+                    part,
+                    points: points
+                        .into_iter()
+                        .map(|x| std::array::from_fn(|a| x[a] + offset[a]))
+                        .collect(),
+                    closed,
+                }
+            })
+            .collect()
+    }
+
+    /// True when the body moves during stage `k` of `stages` (by name, in order).
+    pub fn moves_in(&self, k: usize, stages: &[&str]) -> bool {
+        match &self.motion {
+            None => false,
+            Some(BodyMotion { stage: None, .. }) => true,
+            Some(BodyMotion { stage: Some(s), .. }) => stages[..=k.min(stages.len().saturating_sub(1))]
+                .iter()
+                .any(|t| t == s),
+        }
+    }
+
+    /// The body's state at the start of a run (`stages`: the scene's stage names): moving,
+    /// unless it holds its place or waits for a later stage.
+    pub fn state(&self, stages: &[&str]) -> BodyState {
+        let moving = self.motion.is_some() && (stages.is_empty() || self.moves_in(0, stages));
         BodyState {
             name: self.name.clone(),
-            velocity: self.motion.vector(),
+            velocity: match &self.motion {
+                Some(m) if moving => m.vector(),
+                _ => [0.0; 3],
+            },
             parts: vec![[0.0; 3]; self.parts.len()],
             ..BodyState::default()
         }
     }
+}
+
+/// A part of a body as drawn in a snapshot.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Outline {
+    /// Index of the body (scene order).
+    pub body: u32,
+    /// Index of the part in the body.
+    pub part: u32,
+    /// Its points where it is now (m, x y z).
+    pub points: Vec<[f64; 3]>,
+    /// True for a closed outline (2D, axisymmetric), false for a cloud of surface points.
+    pub closed: bool,
 }
 
 /// A body's state during a run (checkpointed).

@@ -363,11 +363,10 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
     let state = SolverState {
         control: Control {
             drives: s.motions.iter().map(MotionSpec::drive).collect(),
-            bodies: s
-                .rigid_bodies
-                .iter()
-                .map(crate::rigid::RigidBodySpec::state)
-                .collect(),
+            bodies: {
+                let stages: Vec<&str> = s.stages.iter().map(|t| t.name.as_str()).collect();
+                s.rigid_bodies.iter().map(|b| b.state(&stages)).collect()
+            },
             ..Control::default()
         },
         ..SolverState::default()

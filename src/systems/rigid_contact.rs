@@ -7,11 +7,17 @@
 //! inertia, as `integrate` takes it). Contact holds (v(x_s) − v_b)·n ≥ 0: the soil may
 //! leave the body but not enter it. A violated sample takes an impulse λ n spread over its
 //! nodes as Δv_i = λ w_i n / m̃_i, with λ = −C / Σ w_i²/m̃_i for the violation C; the
-//! samples are visited in a fixed order a few times over (projected Gauss–Seidel, λ ≥ 0
-//! summed per sample), so that overlapping samples share their nodes' correction. Where a
-//! sample presses (λ > 0), the tangential slip is removed the same way, by at most
-//! tan δ · λ + a·A_s·Δt (Coulomb friction with an adhesion cap a on the sample's surface
-//! A_s; no cap when rough, nothing when smooth).
+//! samples are visited in a fixed order until they agree (projected Gauss–Seidel, λ ≥ 0
+//! summed per sample), so that overlapping samples share their nodes' correction. Where the
+//! soil presses, the tangential slip at a sample is removed the same way, by at most
+//! tan δ · N_s + a·A_s·Δt (Coulomb friction with an adhesion cap a on the sample's surface
+//! A_s; no cap when rough, nothing when smooth), N_s being the normal impulse its nodes
+//! took, from the samples and the inside nodes alike, shared among the samples that reach
+//! them ([`crate::rigid::contact`]).
+//!
+//! It runs before `boundary`, so that a `Friction` face and a motion's nodes feel the
+//! contact's force; the components they hold enter the contact as `boundary` will set
+//! them and are not moved by it.
 //!
 //! The constraint is held where the body's surface is, between nodes, so a body is as big
 //! as its geometry whatever the grid: holding the nodes inside a body instead makes it
@@ -32,12 +38,12 @@ use crate::rigid::contact::{solve, Contact, Contacts, Slot};
 use crate::rigid::Sample;
 use crate::schedule::System;
 use crate::shape::{for_each_node, Shape};
-use crate::systems::boundary::{hold, Hold};
+use crate::systems::boundary::{constrain, hold, Hold};
 use std::collections::HashMap;
 use std::marker::PhantomData;
 
-/// Samples the bodies' surfaces once, then at every step holds the contacts at them (after
-/// `boundary`).
+/// Samples the bodies' surfaces once, then at every step holds the contacts at them
+/// (before `boundary`).
 #[derive(Debug)]
 pub struct RigidContact<D: Dim, S> {
     /// Per body: its samples in its starting frame and the part each belongs to.
@@ -75,14 +81,13 @@ fn place<D: Dim, S: Shape>(ctx: &Context<D>, samples: &[Vec<(Sample, usize)>]) -
         *slot_of.entry(i).or_insert_with(|| {
             let m = nm[i].0;
             let inertia = grid.inertia(i, m, st.virtual_mass_floor);
-            let v = D::vec_to3(np[i].0 * (1.0 / m) + nf[i].0 * (st.dt / inertia));
-            slots.push(Slot {
-                node: i,
-                v,
-                v0: v,
-                inertia,
-                free: std::array::from_fn(|a| a < D::N && hold(fix[i], a, drives) == Hold::Free),
-            });
+            // The held components as `boundary` will hold them (it runs next, so that a
+            // friction face and a motion feel the contact's force).
+            let mut v = np[i].0 * (1.0 / m) + nf[i].0 * (st.dt / inertia);
+            constrain(&mut v, fix[i], D::N, drives);
+            let v = D::vec_to3(v);
+            let free = std::array::from_fn(|a| a < D::N && hold(fix[i], a, drives) == Hold::Free);
+            slots.push(Slot::new(i, v, inertia, free));
             slots.len() - 1
         })
     };
@@ -175,6 +180,10 @@ impl<D: Dim, S: Shape> System<D> for RigidContact<D, S> {
 
     fn prepare(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
         let spacing = 0.5 * ctx.grid.cell_size;
+        let n = D::N;
+        // A sample on a face two parts share (a cone's tip against its shaft) is inside
+        // the body, not on its surface: it is left out.
+        let inner = 1e-9 * ctx.grid.cell_size;
         self.samples = ctx
             .settings
             .bodies
@@ -184,6 +193,12 @@ impl<D: Dim, S: Shape> System<D> for RigidContact<D, S> {
                     .iter()
                     .enumerate()
                     .flat_map(|(k, p)| p.geometry.samples(spacing).into_iter().map(move |s| (s, k)))
+                    .filter(|(s, k)| {
+                        b.parts
+                            .iter()
+                            .enumerate()
+                            .all(|(j, q)| j == *k || q.geometry.distance(s.x, n).0 > inner)
+                    })
                     .collect()
             })
             .collect();

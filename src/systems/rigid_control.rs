@@ -79,10 +79,10 @@ impl<D: Dim> System<D> for RigidControl {
         let s = &mut ctx.state;
         let dt = s.resets.motion_dt(ctx.settings.dt).unwrap_or(0.0);
         for (spec, b) in self.bodies.iter().zip(&mut s.control.bodies) {
+            let Some(m) = &spec.motion else { continue };
             if b.velocity == [0.0; 3] {
                 continue;
             }
-            let m = &spec.motion;
             let speed = b.velocity.iter().map(|v| v * v).sum::<f64>().sqrt();
             b.travel += speed * dt;
             for a in 0..3 {
@@ -105,14 +105,22 @@ impl<D: Dim> System<D> for RigidControl {
             state.deepest_entry = state.deepest_entry.max(depth);
         }
         let s = &mut ctx.state;
-        if s.stop != Some(StopReason::Converged) {
+        // A static state: the run's stop, or one `prescribed_motion` took this step.
+        if s.stop != Some(StopReason::Converged) && !s.control.milestone {
             return Ok(());
         }
+        let stages: Vec<&str> = ctx.settings.stages.iter().map(|t| t.name.as_str()).collect();
         // Every body holds (a moving one blocks convergence): a static state.
         let mut more = false;
         for (spec, b) in self.bodies.iter().zip(&mut s.control.bodies) {
-            let m = &spec.motion;
-            let along = |f: [f64; 3]| -> f64 { (0..3).map(|a| f[a] * m.vector()[a] / m.speed()).sum() };
+            // The mean pressure along the motion, or, for a body that holds its place, of
+            // the whole force.
+            let along = |f: [f64; 3]| -> f64 {
+                match &spec.motion {
+                    Some(m) => (0..3).map(|a| f[a] * m.vector()[a] / m.speed()).sum(),
+                    None => f.iter().map(|c| c * c).sum::<f64>().sqrt(),
+                }
+            };
             s.control.curve.push(CurvePoint {
                 name: spec.name.clone(),
                 step: s.clock.step,
@@ -132,6 +140,10 @@ impl<D: Dim> System<D> for RigidControl {
                         pressure: part.area.map(|a| along(*f) / a),
                     });
                 }
+            }
+            let Some(m) = &spec.motion else { continue };
+            if !stages.is_empty() && !spec.moves_in(s.control.stage, &stages) {
+                continue;
             }
             b.increments += 1;
             s.control.milestone = true;

@@ -134,6 +134,16 @@ impl<D: Dim> System<D> for Stages {
         }
         s.control.stage += 1;
         s.go_on(&ctx.settings);
+        // The rigid bodies that set off with this stage.
+        for (spec, b) in ctx.settings.bodies.iter().zip(&mut s.control.bodies) {
+            if let Some(m) = spec
+                .motion
+                .as_ref()
+                .filter(|m| m.stage.as_ref() == Some(&stages[s.control.stage].name))
+            {
+                b.velocity = m.vector();
+            }
+        }
         s.energy.reset();
         let stage = stages[s.control.stage].clone();
         let start = ctx.state.clock.time;

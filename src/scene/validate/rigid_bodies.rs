@@ -42,12 +42,33 @@ pub(super) fn check_rigid_bodies(r: &Rules) -> Result<(), SceneError> {
                 ),
             );
         }
+        if let Some(stage) = b.motion.as_ref().and_then(|m| m.stage.as_ref()) {
+            if !s.stages.iter().any(|t| &t.name == stage) {
+                let names: Vec<&str> = s.stages.iter().map(|t| t.name.as_str()).collect();
+                return r.bad(
+                    &field("motion.stage"),
+                    format!("\"{stage}\" is not a stage of the scene (its stages: {names:?})"),
+                );
+            }
+        }
         // Its bounds at the start and at the end of its travel, on every axis it moves
         // along; across the others it may reach past the grid (half a T-bar on a
         // symmetry face: the part outside meets no soil).
         let (start_lo, start_hi) = b.bounds(n);
-        let v = b.motion.vector();
-        let step = b.motion.travel / b.motion.speed();
+        if let Some(a) = (0..n).find(|&a| start_hi[a] <= lo[a] || start_lo[a] >= hi[a]) {
+            return r.bad(
+                &field("parts"),
+                format!(
+                    "the body spans {}..{} m on axis {a}, outside the grid's {}..{} m: it would \
+                     never meet the soil",
+                    start_lo[a], start_hi[a], lo[a], hi[a]
+                ),
+            );
+        }
+        let (v, step) = b
+            .motion
+            .as_ref()
+            .map_or(([0.0; 3], 0.0), |m| (m.vector(), m.travel / m.speed()));
         for (when, shift) in [("at the start", 0.0), ("at the end of its travel", step)] {
             for a in (0..n).filter(|&a| v[a] != 0.0) {
                 let (l, h) = (start_lo[a] + v[a] * shift, start_hi[a] + v[a] * shift);
