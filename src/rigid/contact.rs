@@ -194,14 +194,16 @@ pub fn solve(set: &mut Contacts, body_velocity: &[[f64; 3]], mu: &[f64]) {
             }
         }
     }
+    // How each constraint's normal change spreads: the weights, inertias and free axes do
+    // not change during the solve.
+    let normal_spread: Vec<(f64, f64)> = set.contacts.iter().map(|p| spread(p, slots, p.normal)).collect();
     // Until the largest change of a sweep is 1e-6 of the first sweep's largest.
     let mut first = None;
     for _ in 0..MAX_SWEEPS {
         let mut largest: f64 = 0.0;
-        for p in set.contacts.iter_mut() {
+        for (p, &(s2, mass)) in set.contacts.iter_mut().zip(&normal_spread) {
             let vb = body_velocity[p.body];
             let n = p.normal;
-            let (s2, mass) = spread(p, slots, n);
             if s2 <= 0.0 || mass <= 0.0 {
                 continue;
             }
