@@ -208,3 +208,27 @@ fn axisymmetric_scenes_that_cannot_be_are_refused() {
         assert!(e.contains(says), "{to}: {e}");
     }
 }
+
+/// `scenes/cpt.ron` at h = D/4 over its first 0.2 D, in one increment: the cone's tip takes
+/// the whole resistance and its smooth shaft none (the face the tip and the shaft share is
+/// inside the body, not sampled). N_kt = (q_c − σ_v0)/c_u = 9.66 there, pinned; the shipped
+/// scene (h = D/8, 2 D) gives 10.47 over its second diameter (docs/verification.md).
+#[test]
+fn a_smooth_cone_takes_its_resistance_at_the_tip() {
+    let coarse = [
+        "grid.cell_size=0.25",
+        "grid.cells=[20, 50]",
+        "tractions[0].min=[0.5, 9.75]",
+        "rigid_bodies[0].motion.travel=0.2",
+        "rigid_bodies[0].motion.increment=0.2",
+    ];
+    let s = run("cpt.ron", &coarse);
+    assert!(s.converged, "{:?}", s.error);
+    let row = |name: &str| s.curve.iter().find(|c| c.name == name).unwrap().clone();
+    let (cone, tip, shaft) = (row("cone"), row("cone.tip"), row("cone.shaft"));
+    // Along the axis (the radial sums of an axisymmetric body are not a resultant).
+    assert_eq!(cone.force[1], tip.force[1]);
+    assert!(shaft.force[1].abs() < 1e-6 * tip.force[1].abs(), "{shaft:?}");
+    let n_kt = (tip.pressure.unwrap() - 100.0e3) / 10.0e3;
+    assert_eq!(n_kt, 9.657119121703756);
+}

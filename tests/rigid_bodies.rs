@@ -299,6 +299,24 @@ fn a_block_slides_on_a_rigid_base_at_its_weight_times_tan_delta() {
     assert!(rel(last, friction).abs() < 0.03, "{last} against {friction}");
 }
 
+/// `scenes/footing_deep.ron` at h = B/4 over its first 0.5 B: the resistance rises with
+/// depth, N = 6.90 then 7.21 (pinned; the shipped h = B/8 gives 5.94 at 0.1 B rising to
+/// about 6.5 from 1 B, docs/verification.md).
+#[test]
+fn a_strip_footing_pushed_below_the_surface_meets_more_resistance() {
+    let coarse = [
+        "grid.cell_size=0.25",
+        "grid.cells=[12, 38]",
+        "rigid_bodies[0].motion.travel=0.5",
+        "rigid_bodies[0].motion.increment=0.25",
+    ];
+    let s = run("footing_deep.ron", &coarse);
+    let n: Vec<f64> = s.curve.iter().map(|c| c.pressure.unwrap() / 10.0e3).collect();
+    assert_eq!(n.len(), 2);
+    assert!(n[1] > n[0], "{n:?}");
+    assert_eq!(n[1], 7.213652916608727);
+}
+
 /// `scenes/passive_wall.ron` (coarse, 3 % of H) after a geostatic stage: the wall holds
 /// its place through the first stage (`motion.stage`), where the sand comes to rest
 /// against it at K0 = ν/(1 − ν) = 0.43, ½ K0 γ H² = 15.13 kN/m (14.73, −2.7 %), and sets
