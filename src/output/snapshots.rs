@@ -233,7 +233,7 @@ fn write_pvd(path: &Path, entries: &[Entry]) -> std::io::Result<()> {
         for (t, file) in entries {
             // The points are part 0, the rigid bodies part 1. Shortest decimal that reads
             // back to the same f64.
-            let part = u8::from(file.starts_with(&format!("{FOLDER}/{BODIES}")));
+            let part = u8::from(of_bodies(file));
             writeln!(
                 out,
                 "<DataSet timestep=\"{t:?}\" part=\"{part}\" file=\"{file}\"/>"
@@ -241,6 +241,14 @@ fn write_pvd(path: &Path, entries: &[Entry]) -> std::io::Result<()> {
         }
         out.write_all(b"</Collection>\n</VTKFile>\n")
     })
+}
+
+/// True for a collection entry's file (relative to the output directory) that draws the
+/// rigid bodies rather than the points.
+fn of_bodies(file: &str) -> bool {
+    file.strip_prefix(FOLDER)
+        .and_then(|f| f.strip_prefix('/'))
+        .is_some_and(|f| f.starts_with(BODIES))
 }
 
 /// The entries of a collection this module wrote (empty when there is none).
@@ -263,7 +271,7 @@ fn read_pvd(path: &Path) -> Vec<Entry> {
 pub fn collection(dir: &Path) -> Vec<(f64, PathBuf)> {
     read_pvd(&dir.join(PVD))
         .into_iter()
-        .filter(|(_, f)| !f.starts_with(&format!("{FOLDER}/{BODIES}")))
+        .filter(|(_, f)| !of_bodies(f))
         .map(|(t, f)| (t, dir.join(f)))
         .collect()
 }

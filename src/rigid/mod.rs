@@ -99,14 +99,6 @@ impl BodyMotion {
     pub fn speed(&self) -> f64 {
         self.vector().iter().map(|v| v * v).sum::<f64>().sqrt()
     }
-
-    /// Travel at the end of increment `k` (0-based), m.
-    pub fn target(&self, k: u32) -> f64 {
-        match self.increment {
-            Some(inc) => (inc * f64::from(k + 1)).min(self.travel),
-            None => self.travel,
-        }
-    }
 }
 
 impl Interface {
@@ -247,25 +239,24 @@ impl RigidBodySpec {
             .collect()
     }
 
-    /// True when the body moves during stage `k` of `stages` (by name, in order).
+    /// True when the body moves during stage `k` of `stages` (the scene's stage names, in
+    /// order; none for a scene without stages): it has a motion, and no `motion.stage` or
+    /// one among the first k + 1.
     pub fn moves_in(&self, k: usize, stages: &[&str]) -> bool {
         match &self.motion {
             None => false,
             Some(BodyMotion { stage: None, .. }) => true,
-            Some(BodyMotion { stage: Some(s), .. }) => stages[..=k.min(stages.len().saturating_sub(1))]
-                .iter()
-                .any(|t| t == s),
+            Some(BodyMotion { stage: Some(s), .. }) => stages.iter().take(k + 1).any(|t| t == s),
         }
     }
 
     /// The body's state at the start of a run (`stages`: the scene's stage names): moving,
     /// unless it holds its place or waits for a later stage.
     pub fn state(&self, stages: &[&str]) -> BodyState {
-        let moving = self.motion.is_some() && (stages.is_empty() || self.moves_in(0, stages));
         BodyState {
             name: self.name.clone(),
             velocity: match &self.motion {
-                Some(m) if moving => m.vector(),
+                Some(m) if self.moves_in(0, stages) => m.vector(),
                 _ => [0.0; 3],
             },
             parts: vec![[0.0; 3]; self.parts.len()],

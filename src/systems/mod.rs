@@ -20,6 +20,7 @@ pub mod exchange;
 pub mod g2p;
 pub mod gravity;
 pub mod grid_reset;
+mod increments;
 pub mod integrate;
 pub mod kinematics;
 pub mod load_steps;

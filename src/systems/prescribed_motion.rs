@@ -19,6 +19,7 @@ use crate::error::StepError;
 use crate::infra::columns::{col_mut, nodes};
 use crate::schedule::System;
 use crate::state::{CurvePoint, MotionSpec, StopReason};
+use crate::systems::increments::Increments;
 
 /// Drives the scene's motions: marks their nodes before the first step, and after each
 /// step's convergence check advances their travel, holds them at the end of an increment
@@ -63,18 +64,7 @@ impl<D: Dim> System<D> for PrescribedMotion {
             if d.velocity == [0.0; 3] {
                 continue;
             }
-            let speed = d.velocity.iter().map(|v| v * v).sum::<f64>().sqrt();
-            d.travel += speed * dt;
-            let left = target(m, d.increments) - d.travel;
-            let full = m.speed() * ctx.settings.dt;
-            d.velocity = if left <= 1e-12 * m.travel {
-                [0.0; 3]
-            } else if left < full {
-                // The last step of an increment covers what is left, not a whole step.
-                m.vector().map(|v| v * left / full)
-            } else {
-                m.vector()
-            };
+            increments(m).advance(&mut d.velocity, &mut d.travel, d.increments, dt, ctx.settings.dt);
         }
         if s.stop != Some(StopReason::Converged) {
             return Ok(());
@@ -113,10 +103,11 @@ pub(crate) fn in_box(m: &MotionSpec, x: [f64; 3], n: usize, h: f64) -> bool {
     (0..n).all(|a| x[a] >= m.min[a] - slack && x[a] <= m.max[a] + slack)
 }
 
-/// Travel at the end of increment `k` (0-based), m.
-fn target(m: &MotionSpec, k: u32) -> f64 {
-    match m.increment {
-        Some(inc) => (inc * (k + 1) as f64).min(m.travel),
-        None => m.travel,
+/// The increments of motion `m`.
+fn increments(m: &MotionSpec) -> Increments {
+    Increments {
+        vector: m.vector(),
+        travel: m.travel,
+        increment: m.increment,
     }
 }

@@ -22,6 +22,7 @@ use crate::infra::columns::{col_mut, points_with};
 use crate::rigid::RigidBodySpec;
 use crate::schedule::System;
 use crate::state::{CurvePoint, StopReason};
+use crate::systems::increments::Increments;
 
 /// Moves the bodies, holds them at the end of an increment and, at the static state that
 /// follows, records the curve and starts the next increment.
@@ -83,21 +84,15 @@ impl<D: Dim> System<D> for RigidControl {
             if b.velocity == [0.0; 3] {
                 continue;
             }
-            let speed = b.velocity.iter().map(|v| v * v).sum::<f64>().sqrt();
-            b.travel += speed * dt;
-            for a in 0..3 {
-                b.offset[a] += b.velocity[a] * dt;
-            }
-            let left = m.target(b.increments) - b.travel;
-            let full = m.speed() * ctx.settings.dt;
-            b.velocity = if left <= 1e-12 * m.travel {
-                [0.0; 3]
-            } else if left < full {
-                // The last step of an increment covers what is left, not a whole step.
-                m.vector().map(|v| v * left / full)
-            } else {
-                m.vector()
+            let increments = Increments {
+                vector: m.vector(),
+                travel: m.travel,
+                increment: m.increment,
             };
+            let moved = increments.advance(&mut b.velocity, &mut b.travel, b.increments, dt, ctx.settings.dt);
+            for a in 0..3 {
+                b.offset[a] += moved[a];
+            }
         }
         for (b, (count, depth)) in push_out(ctx, &self.bodies).into_iter().enumerate() {
             let state = &mut ctx.state.control.bodies[b];
@@ -142,7 +137,7 @@ impl<D: Dim> System<D> for RigidControl {
                 }
             }
             let Some(m) = &spec.motion else { continue };
-            if !stages.is_empty() && !spec.moves_in(s.control.stage, &stages) {
+            if !spec.moves_in(s.control.stage, &stages) {
                 continue;
             }
             b.increments += 1;
