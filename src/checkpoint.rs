@@ -33,7 +33,7 @@ use thiserror::Error;
 /// The first bytes of a checkpoint file.
 const MAGIC: &[u8; 8] = b"KDMPMCK\0";
 /// Format version; a file of another version is refused.
-const VERSION: u32 = 9;
+const VERSION: u32 = 10;
 /// The build that writes and reads checkpoints: the crate's version and a fingerprint of
 /// its sources (build.rs).
 pub const BUILD_ID: &str = concat!(env!("CARGO_PKG_VERSION"), "+", env!("KDMPM_SOURCE_HASH"));
@@ -430,6 +430,7 @@ fn encode_control(w: &mut Writer, c: &Control) {
         drives,
         bodies,
         contacts: _,
+        contact_memory,
         curve,
         stage,
         stages,
@@ -477,6 +478,11 @@ fn encode_control(w: &mut Writer, c: &Control) {
         parts.iter().flatten().for_each(|&c| w.f64(c));
         w.u64(*entries);
         w.f64(*deepest_entry);
+    }
+    w.u64(contact_memory.len() as u64);
+    for &(k, lambda) in contact_memory {
+        w.u64(k);
+        w.f64(lambda);
     }
     w.u64(curve.len() as u64);
     for c in curve {
@@ -548,6 +554,9 @@ fn decode_control(r: &mut Reader) -> Result<Control, CheckpointError> {
             entries: r.u64()?,
             deepest_entry: r.f64()?,
         });
+    }
+    for _ in 0..r.u64()? {
+        c.contact_memory.push((r.u64()?, r.f64()?));
     }
     for _ in 0..r.u64()? {
         c.curve.push(CurvePoint {

@@ -560,6 +560,9 @@ pub struct Control {
     /// The nodes in contact with a body this step, in node order (rebuilt each step by
     /// `rigid_contact` before anything reads it; not checkpointed).
     pub contacts: crate::rigid::contact::Contacts,
+    /// Each contact's normal impulse at the end of the last step's `rigid_contact` solve,
+    /// by key: the next one's warm start.
+    pub contact_memory: crate::rigid::contact::Memory,
     /// Static states of the load–displacement curve so far.
     pub curve: Vec<CurvePoint>,
     /// The loading stage under way (index in `Settings::stages`).

@@ -7,18 +7,24 @@
 //! soil takes is Σ m̃_i Δv_i. The nodes inside a body hold their normal velocity as
 //! constraints of their own (without them a node that only a point's tail reaches, inside
 //! the body, runs into it under a confining stress). The constraints are visited in a
-//! fixed order until the largest change of a sweep is a millionth of the first sweep's
-//! (projected Gauss–Seidel: the normal impulse summed per constraint stays ≥ 0, a surface
-//! sample's tangential one within tan δ times the normal impulse it leans on plus the
-//! adhesion cap); with a few sweeps only,
-//! the overlapping samples of a curved surface leave part of each step's entry, and a
-//! confined soil streams past the body. The order is fixed, so the result is the same on
-//! any thread count.
+//! fixed order (projected Gauss–Seidel: the normal impulse summed per constraint stays
+//! ≥ 0, a surface sample's tangential one within tan δ times the normal impulse it leans
+//! on plus the adhesion cap) until no sweep changes a contact's velocity by more than
+//! [`TOLERANCE`] of the fastest entry before the solve. The order is fixed, so the result
+//! is the same on any thread count.
+//!
+//! Each solve starts from the normal impulses the last step's ended with ([`Memory`],
+//! kept in checkpoints): the overlapping samples of a curved surface and the inside nodes
+//! hold more constraints than their nodes have velocities, and from zero the sweeps take
+//! hundreds of passes to share a confined soil's push among them (the T-bar's first sweep
+//! changes velocities by 6 m/s, the 200th still by 1e-4 of that); from the last step's
+//! share the first sweep changes them by 1e-4 of it. With a few cold sweeps only, part of
+//! each step's entry is left and a confined soil streams past the body.
 //!
 //! Friction acts at a sample that presses itself, and the normal impulse its cap leans on
 //! is its nodes' (each node's share of what every constraint pushed into it, split among
-//! the samples that reach it by weight) when that is more than its own: the inside nodes carry much of a body's normal force, and a cap
-//! of the sample's own impulse held a block on a rigid base with a hundredth of its
+//! the samples that reach it by weight) when that is more than its own: the inside nodes
+//! carry much of a body's normal force, and a cap of the sample's own impulse held a block on a rigid base with a hundredth of its
 //! friction (docs/performance.md, tried and dropped). Acting wherever its nodes were
 //! pressed (not only where the sample presses) let a rough T-bar drag the soil behind it
 //! and the solve stop converging.
@@ -26,10 +32,17 @@
 /// Most Gauss–Seidel sweeps over the samples per solve.
 const MAX_SWEEPS: usize = 200;
 
+/// A solve ends when no sweep changes a contact's velocity by more than this fraction of
+/// the fastest entry into a body before the solve.
+const TOLERANCE: f64 = 1e-5;
+
 /// A surface sample that meets soil this step: its nodes (slots of [`Contacts::slots`])
 /// and weights, and what it has pushed.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Contact {
+    /// Identity across steps (the body, whether a surface sample or an inside node, and
+    /// its index): the key of its warm start in [`Memory`]. Contacts are made in key order.
+    pub key: u64,
     /// Index of the body.
     pub body: usize,
     /// Index of the part in the body.
@@ -96,6 +109,24 @@ pub struct Contacts {
     pub contacts: Vec<Contact>,
     /// The nodes they reach, in order of first reach.
     pub slots: Vec<Slot>,
+}
+
+/// The normal impulse (N s) each contact ended the last solve with, by key in ascending
+/// order: a solve starts from it (warm start), so that a body pressed by the same soil step
+/// after step does not build its reaction up from zero every step.
+pub type Memory = Vec<(u64, f64)>;
+
+/// The key of a contact: body `body`, a surface sample (`surface`) or an inside node, and
+/// the sample's or the node's index.
+pub fn key(body: usize, surface: bool, index: usize) -> u64 {
+    ((body as u64) << 48) | ((surface as u64) << 47) | index as u64
+}
+
+/// What a solve leaves for the next one to start from: each contact's normal impulse by key.
+pub fn remember(contacts: &[Contact]) -> Memory {
+    let mut memory: Memory = contacts.iter().map(|p| (p.key, p.normal_impulse)).collect();
+    memory.sort_unstable_by_key(|&(k, _)| k);
+    memory
 }
 
 fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
@@ -179,7 +210,7 @@ fn velocity(p: &Contact, slots: &[Slot]) -> [f64; 3] {
 /// Projected Gauss–Seidel over the samples, each impulse starting at zero: no entry into a
 /// body moving at `body_velocity` (m/s, per body), then friction (`mu` = tan δ per body,
 /// infinite when rough, 0 with adhesion alone) where a sample presses.
-pub fn solve(set: &mut Contacts, body_velocity: &[[f64; 3]], mu: &[f64]) {
+pub fn solve(set: &mut Contacts, body_velocity: &[[f64; 3]], mu: &[f64], memory: &Memory) {
     let slots = &mut set.slots[..];
     for s in slots.iter_mut() {
         s.pressed = [0.0; 3];
@@ -197,8 +228,30 @@ pub fn solve(set: &mut Contacts, body_velocity: &[[f64; 3]], mu: &[f64]) {
     // How each constraint's normal change spreads: the weights, inertias and free axes do
     // not change during the solve.
     let normal_spread: Vec<(f64, f64)> = set.contacts.iter().map(|p| spread(p, slots, p.normal)).collect();
-    // Until the largest change of a sweep is 1e-6 of the first sweep's largest.
-    let mut first = None;
+    // The scale of the solve: the fastest entry into a body before any impulse.
+    let mut reference: f64 = 0.0;
+    for p in &set.contacts {
+        let v = velocity(p, slots);
+        let vb = body_velocity[p.body];
+        let rel: [f64; 3] = std::array::from_fn(|a| v[a] - vb[a]);
+        reference = reference.max(-dot(rel, p.normal));
+    }
+    // Warm start: each contact's normal impulse of the last solve, applied at once.
+    if !memory.is_empty() {
+        for (p, &(s2, mass)) in set.contacts.iter_mut().zip(&normal_spread) {
+            if s2 <= 0.0 || mass <= 0.0 {
+                continue;
+            }
+            if let Ok(j) = memory.binary_search_by_key(&p.key, |&(k, _)| k) {
+                let lambda = memory[j].1;
+                if lambda > 0.0 {
+                    p.normal_impulse = lambda;
+                    let took = push(p, slots, p.normal, lambda / mass, s2, true);
+                    (0..3).for_each(|a| p.impulse[a] += took[a]);
+                }
+            }
+        }
+    }
     for _ in 0..MAX_SWEEPS {
         let mut largest: f64 = 0.0;
         for (p, &(s2, mass)) in set.contacts.iter_mut().zip(&normal_spread) {
@@ -255,8 +308,7 @@ pub fn solve(set: &mut Contacts, body_velocity: &[[f64; 3]], mu: &[f64]) {
                 (0..3).for_each(|a| p.impulse[a] += took[a]);
             }
         }
-        let reference = *first.get_or_insert(largest);
-        if largest <= 1e-6 * reference {
+        if largest <= TOLERANCE * reference {
             break;
         }
     }

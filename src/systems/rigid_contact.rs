@@ -34,7 +34,7 @@ use crate::context::Context;
 use crate::dim::Dim;
 use crate::error::StepError;
 use crate::infra::columns::{col, col_mut, nodes};
-use crate::rigid::contact::{solve, Contact, Contacts, Slot};
+use crate::rigid::contact::{key, remember, solve, Contact, Contacts, Memory, Slot};
 use crate::rigid::Sample;
 use crate::schedule::System;
 use crate::shape::{for_each_node, Shape};
@@ -120,6 +120,7 @@ fn place<D: Dim, S: Shape>(ctx: &Context<D>, samples: &[Vec<(Sample, usize)>]) -
             }
             let k = slot(&mut set.slots, &mut slot_of, i);
             set.contacts.push(Contact {
+                key: key(b, false, i),
                 body: b,
                 part,
                 normal,
@@ -131,7 +132,7 @@ fn place<D: Dim, S: Shape>(ctx: &Context<D>, samples: &[Vec<(Sample, usize)>]) -
                 impulse: [0.0; 3],
             });
         }
-        for (s, part) in body {
+        for (index, (s, part)) in body.iter().enumerate() {
             let x3: [f64; 3] = std::array::from_fn(|a| s.x[a] + state.offset[a]);
             let x = D::vec_from(x3);
             if !grid.contains(x) {
@@ -158,6 +159,7 @@ fn place<D: Dim, S: Shape>(ctx: &Context<D>, samples: &[Vec<(Sample, usize)>]) -
                 s.measure
             };
             set.contacts.push(Contact {
+                key: key(b, true, index),
                 body: b,
                 part: *part,
                 normal: s.normal,
@@ -210,7 +212,8 @@ impl<D: Dim, S: Shape> System<D> for RigidContact<D, S> {
         let bodies = &ctx.settings.bodies;
         let velocities: Vec<[f64; 3]> = ctx.state.control.bodies.iter().map(|b| b.velocity).collect();
         let mu: Vec<f64> = bodies.iter().map(|b| b.interface.friction().0).collect();
-        solve(&mut set, &velocities, &mu);
+        solve(&mut set, &velocities, &mu, &ctx.state.control.contact_memory);
+        ctx.state.control.contact_memory = remember(&set.contacts);
         let dt = ctx.settings.dt;
         let n = nodes(&ctx.world);
         let mut nf = col_mut::<NodeForce<D::Vec>>(n);
@@ -261,7 +264,7 @@ pub fn project<D: Dim>(ctx: &mut Context<D>) {
         .iter()
         .map(|b| b.interface.friction().0)
         .collect();
-    solve(&mut control.contacts, &velocities, &mu);
+    solve(&mut control.contacts, &velocities, &mu, &Memory::new());
     for s in &control.contacts.slots {
         nv[s.node].0 = D::vec_from(s.v);
     }
