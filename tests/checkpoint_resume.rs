@@ -133,6 +133,25 @@ fn a_run_resumed_inside_its_static_check_window_has_the_bits_of_the_run_that_nev
     resumes_bit_for_bit::<Dim2>(&loaded, true);
 }
 
+/// A rigid footing pushed into clay (`scenes/footing_rigid.ron`), checkpointed half way
+/// through its travel (inside an increment) and at the first reset after that: the resumed
+/// run ends with the same bits, the body's place, reaction and the contact's warm-start
+/// impulses included.
+#[test]
+fn a_body_resumed_mid_penetration_has_the_bits_of_the_run_that_never_stopped() {
+    let loaded = load("footing_rigid.ron", &[]);
+    let mut whole = sim::<Dim2>(&loaded);
+    let r = pool(2).install(|| reference(&mut whole));
+    let half = r.steps / 2;
+    let reset = *r.resets.iter().find(|&&k| k > half).expect("a reset after half way");
+    for (k, before, after) in [(half, 1, 2), (reset, 2, 1)] {
+        assert!(
+            resumed::<Dim2>(&loaded, k, before, after) == r.end,
+            "resumed at step {k} ({before} → {after} threads) differs from the run that never stopped"
+        );
+    }
+}
+
 #[test]
 fn a_checkpoint_of_another_scene_is_refused() {
     let mut column = sim::<Dim2>(&load("soil_column.ron", &[]));
