@@ -365,7 +365,8 @@ pub struct CurvePoint {
     /// Force on the body (N; N/m in 2D, x y z).
     pub force: [f64; 3],
     /// Mean pressure against the motion over the loaded area (Pa), when the scene gives
-    /// the area.
+    /// the area (left out of summary.json otherwise).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub pressure: Option<f64>,
 }
 

@@ -143,7 +143,11 @@ fn a_body_resumed_mid_penetration_has_the_bits_of_the_run_that_never_stopped() {
     let mut whole = sim::<Dim2>(&loaded);
     let r = pool(2).install(|| reference(&mut whole));
     let half = r.steps / 2;
-    let reset = *r.resets.iter().find(|&&k| k > half).expect("a reset after half way");
+    let reset = *r
+        .resets
+        .iter()
+        .find(|&&k| k > half)
+        .expect("a reset after half way");
     for (k, before, after) in [(half, 1, 2), (reset, 2, 1)] {
         assert!(
             resumed::<Dim2>(&loaded, k, before, after) == r.end,

@@ -181,7 +181,10 @@ pub fn draw(dir: &Path) -> std::io::Result<(Vec<&'static str>, Vec<String>)> {
 fn curve_plot(names: &[String], u: &[f64], y: &[f64], label: &str) -> String {
     svg((960, 600), |root| {
         let hi_u = u.iter().copied().fold(0.0f64, f64::max).max(1e-30);
-        let (lo, hi) = y.iter().fold((0.0f64, 0.0f64), |(a, b), &v| (a.min(v), b.max(v)));
+        let (lo, hi) = y
+            .iter()
+            .filter(|v| v.is_finite())
+            .fold((0.0f64, 0.0f64), |(a, b), &v| (a.min(v), b.max(v)));
         let pad = 0.05 * (hi - lo).max(1e-30);
         let mut c = ChartBuilder::on(&root)
             .caption("Load against displacement (static states)", ("sans-serif", 22))
@@ -208,10 +211,14 @@ fn curve_plot(names: &[String], u: &[f64], y: &[f64], label: &str) -> String {
                     names
                         .iter()
                         .zip(u.iter().zip(y))
-                        .filter(|p| p.0 == name)
+                        .filter(|p| p.0 == name && p.1 .1.is_finite())
                         .map(|(_, (a, b))| (*a, *b)),
                 )
                 .collect();
+            // A part without an area has no pressure: no line.
+            if pts.len() < 2 {
+                continue;
+            }
             c.draw_series(LineSeries::new(pts.clone(), colour.stroke_width(2)))?
                 .label(name.as_str())
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2)));

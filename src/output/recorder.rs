@@ -20,10 +20,11 @@ use std::sync::{Arc, Mutex};
 pub const CURVE: &str = "curve.csv";
 
 /// `curve.csv`: one row a static state of a prescribed motion: name, step, time (s),
-/// displacement along the motion (m), force on the body (N; N/m in 2D) and, when every
-/// motion has a loaded area, the mean pressure (Pa).
+/// displacement along the motion (m), force on the body (N; N/m in 2D) and, when a row has
+/// a loaded area, the mean pressure (Pa; the cell is empty in the rows without one, a
+/// body's part without an `area`).
 fn curve_csv<D: Dim>(curve: &[CurvePoint]) -> String {
-    let pressure = curve.iter().all(|c| c.pressure.is_some());
+    let pressure = curve.iter().any(|c| c.pressure.is_some());
     let axes = &["x", "y", "z"][..D::N];
     let mut t = format!(
         "name,step,time,displacement,{}{}\n",
@@ -38,8 +39,10 @@ fn curve_csv<D: Dim>(curve: &[CurvePoint]) -> String {
         for f in &c.force[..D::N] {
             t += &format!(",{f:.9e}");
         }
-        if let (true, Some(p)) = (pressure, c.pressure) {
-            t += &format!(",{p:.9e}");
+        match (pressure, c.pressure) {
+            (true, Some(p)) => t += &format!(",{p:.9e}"),
+            (true, None) => t += ",",
+            _ => {}
         }
         t += "\n";
     }
@@ -214,5 +217,40 @@ impl Recorder {
         let (_, skipped) = crate::output::plots::draw(dir.path())?;
         notes.0.extend(skipped);
         Ok((summary, notes))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::dim::Dim2;
+
+    fn point(name: &str, pressure: Option<f64>) -> CurvePoint {
+        CurvePoint {
+            name: name.into(),
+            step: 7,
+            time: 1.0,
+            displacement: 0.25,
+            force: [1.0, -2.0, 0.0],
+            pressure,
+        }
+    }
+
+    #[test]
+    fn a_part_without_an_area_leaves_its_pressure_cell_empty() {
+        let csv = curve_csv::<Dim2>(&[point("cone.tip", Some(3.0)), point("cone.shaft", None)]);
+        let lines: Vec<&str> = csv.lines().collect();
+        assert_eq!(lines[0], "name,step,time,displacement,force_x,force_y,pressure");
+        assert!(lines[1].ends_with(",3.000000000e0"), "{}", lines[1]);
+        assert!(lines[2].ends_with("-2.000000000e0,"), "{}", lines[2]);
+        // And summary.json leaves the key out rather than writing null.
+        let json = serde_json::to_string(&point("cone.shaft", None)).unwrap();
+        assert!(!json.contains("pressure"), "{json}");
+    }
+
+    #[test]
+    fn a_curve_without_areas_has_no_pressure_column() {
+        let csv = curve_csv::<Dim2>(&[point("wall", None)]);
+        assert_eq!(csv.lines().next(), Some("name,step,time,displacement,force_x,force_y"));
     }
 }
