@@ -251,6 +251,9 @@ mod tests {
     #[test]
     fn a_curve_without_areas_has_no_pressure_column() {
         let csv = curve_csv::<Dim2>(&[point("wall", None)]);
-        assert_eq!(csv.lines().next(), Some("name,step,time,displacement,force_x,force_y"));
+        assert_eq!(
+            csv.lines().next(),
+            Some("name,step,time,displacement,force_x,force_y")
+        );
     }
 }

@@ -10,7 +10,7 @@
 //! fixed order (projected Gauss–Seidel: the normal impulse summed per constraint stays
 //! ≥ 0, a surface sample's tangential one within tan δ times the normal impulse it leans
 //! on plus the adhesion cap) until no sweep changes a contact's velocity by more than
-//! [`TOLERANCE`] of the fastest entry before the solve. The order is fixed, so the result
+//! `TOLERANCE` (1e-5) of the fastest entry before the solve. The order is fixed, so the result
 //! is the same on any thread count.
 //!
 //! Each solve starts from the normal impulses the last step's ended with ([`Memory`],
