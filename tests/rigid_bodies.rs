@@ -16,6 +16,7 @@ fn a_rigid_strip_footing_pushed_into_tresca_clay_reaches_prandtls_pressure() {
     let s = run("footing_rigid.ron", &[]);
     let limit = s.limit_pressure.expect("the body has an area");
     assert_eq!(limit, 57397.04660732803);
+    assert_eq!(s.rigid_bodies[0].offset, [0.0, -0.1, 0.0]);
     assert!(
         rel(limit, 51.42e3).abs() < 0.12,
         "{limit} against Prandtl's 51.42 kPa"
@@ -232,6 +233,10 @@ fn a_smooth_tbar_in_confined_tresca_clay_has_the_flow_round_factor() {
     let mean = n.iter().sum::<f64>() / n.len() as f64;
     assert!(rel(mean, 9.14).abs() < 0.05, "N {n:?}, mean {mean} against 9.14");
     assert_eq!(n[2], 9.617132670959384);
+    // No point ended a step inside the bar by more than a tenth of a cell.
+    let bar = &s.rigid_bodies[0];
+    assert!((bar.travel - 0.15).abs() < 1e-12, "{bar:?}");
+    assert!(bar.deepest_entry < 0.1 * 0.125, "{bar:?}");
 }
 
 /// The same T-bar fully rough (no slip where the clay presses): 11.94 for full flow round

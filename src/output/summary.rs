@@ -108,6 +108,10 @@ pub struct Summary {
     /// Static states of the load–displacement curve (`curve.csv`).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub curve: Vec<CurvePoint>,
+    /// The scene's rigid bodies where the run left them, with the points their contact
+    /// let in (put back on the surface by `rigid_control`).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub rigid_bodies: Vec<BodyResult>,
     /// The static state that ended each loading stage (`stages.csv`).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub stages: Vec<StageResult>,
@@ -312,10 +316,38 @@ impl Summary {
             limit_pressure: limit_pressure(&displacement_control),
             last_increment_rise: last_increment_rise(&displacement_control),
             curve: s.control.curve.clone(),
+            rigid_bodies: s
+                .control
+                .bodies
+                .iter()
+                .map(|b| BodyResult {
+                    name: b.name.clone(),
+                    offset: b.offset,
+                    travel: b.travel,
+                    entries: b.entries,
+                    deepest_entry: b.deepest_entry,
+                })
+                .collect(),
             stages: s.control.stages.clone(),
             ranks,
         }
     }
+}
+
+/// A rigid body at the end of a run (`rigid_bodies` in summary.json).
+#[derive(Clone, Debug, Serialize)]
+pub struct BodyResult {
+    /// Name given in the scene.
+    pub name: String,
+    /// Displacement from its scene position (m, x y z).
+    pub offset: [f64; 3],
+    /// Distance travelled (m).
+    pub travel: f64,
+    /// Points that ended a step with their centre inside the body, each put back on its
+    /// surface (counted once per step each).
+    pub entries: u64,
+    /// The deepest of those entries (m): compare it with the cell size.
+    pub deepest_entry: f64,
 }
 
 /// The largest pressure over the curve's static states (Pa).
