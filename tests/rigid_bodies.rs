@@ -15,7 +15,7 @@ use common::{refusal, rel, run};
 fn a_rigid_strip_footing_pushed_into_tresca_clay_reaches_prandtls_pressure() {
     let s = run("footing_rigid.ron", &[]);
     let limit = s.limit_pressure.expect("the body has an area");
-    assert_eq!(limit, 57397.04660732803);
+    assert_eq!(limit, 57397.04660732957);
     assert_eq!(s.rigid_bodies[0].offset, [0.0, -0.1, 0.0]);
     assert!(
         rel(limit, 51.42e3).abs() < 0.12,
@@ -258,7 +258,7 @@ fn a_rough_tbar_has_the_rough_flow_round_factor() {
         rel(mean, 11.94).abs() < 0.05,
         "N {n:?}, mean {mean} against 11.94"
     );
-    assert_eq!(n[2], 12.537137217878344);
+    assert_eq!(n[2], 12.543257894351555);
 }
 
 /// `scenes/block_on_rigid_base.ron`: an elastic block on a rigid base with friction
@@ -282,7 +282,7 @@ fn a_block_slides_on_a_rigid_base_at_its_weight_times_tan_delta() {
         assert!(rel(*f, friction).abs() < 0.05, "{wall:?} against {friction}");
     }
     assert!(rel(wall[9], friction).abs() < 0.03, "{wall:?} against {friction}");
-    assert_eq!(wall[9], 14137.795065301014);
+    assert_eq!(wall[9], 14137.79494116595);
     // The base holds its place and carries the block: its row beside the wall's.
     let base: Vec<_> = s.curve.iter().filter(|c| c.name == "base").collect();
     assert_eq!(base.len(), 10);
@@ -350,7 +350,7 @@ fn a_wall_holds_through_a_geostatic_stage_then_is_pushed() {
     );
     assert!((s.curve[3].displacement - 0.06).abs() < 1e-12);
     assert!(thrust[3] > 6.0 * thrust[0], "{thrust:?}");
-    assert_eq!(thrust[3], 103970.57538771207);
+    assert_eq!(thrust[3], 103970.57538605074);
 }
 
 /// `scenes/passive_wall.ron`, coarser and shorter (h = H/10, 3 % of H): a smooth wall pushed
@@ -372,5 +372,5 @@ fn a_smooth_wall_pushed_into_sand_meets_rankines_passive_thrust() {
         rel(thrust[2], rankine).abs() < 0.1,
         "{thrust:?} against {rankine}"
     );
-    assert_eq!(thrust[2], 105109.39838497738);
+    assert_eq!(thrust[2], 105109.39838322405);
 }

@@ -10,8 +10,9 @@
 //! fixed order (projected Gauss–Seidel: the normal impulse summed per constraint stays
 //! ≥ 0, a surface sample's tangential one within tan δ times the normal impulse it leans
 //! on plus the adhesion cap) until no sweep changes a contact's velocity by more than
-//! `TOLERANCE` (1e-5) of the fastest entry before the solve. The order is fixed, so the result
-//! is the same on any thread count.
+//! `TOLERANCE` (1e-5) of the fastest entry before the solve (or of the first sweep's
+//! largest change, when that is larger). The order is fixed, so the result is the same on
+//! any thread count.
 //!
 //! Each solve starts from the normal impulses the last step's ended with ([`Memory`],
 //! kept in checkpoints): the overlapping samples of a curved surface and the inside nodes
@@ -24,8 +25,9 @@
 //! Friction acts at a sample that presses itself, and the normal impulse its cap leans on
 //! is its nodes' (each node's share of what every constraint pushed into it, split among
 //! the samples that reach it by weight) when that is more than its own: the inside nodes
-//! carry much of a body's normal force, and a cap of the sample's own impulse held a block on a rigid base with a hundredth of its
-//! friction (docs/performance.md, tried and dropped). Acting wherever its nodes were
+//! carry much of a body's normal force, and a cap of the sample's own impulse held a
+//! block on a rigid base with a hundredth of its friction (docs/performance.md, tried and
+//! dropped). Acting wherever its nodes were
 //! pressed (not only where the sample presses) let a rough T-bar drag the soil behind it
 //! and the solve stop converging.
 
@@ -33,7 +35,8 @@
 const MAX_SWEEPS: usize = 200;
 
 /// A solve ends when no sweep changes a contact's velocity by more than this fraction of
-/// the fastest entry into a body before the solve.
+/// the fastest entry into a body before the solve, or of the first sweep's largest change
+/// when that is larger (soil at rest against a held body enters it at no speed).
 const TOLERANCE: f64 = 1e-5;
 
 /// A surface sample that meets soil this step: its nodes (slots of [`Contacts::slots`])
@@ -41,7 +44,7 @@ const TOLERANCE: f64 = 1e-5;
 #[derive(Clone, Debug, PartialEq)]
 pub struct Contact {
     /// Identity across steps (the body, whether a surface sample or an inside node, and
-    /// its index): the key of its warm start in [`Memory`]. Contacts are made in key order.
+    /// its index): the key of its warm start in [`Memory`].
     pub key: u64,
     /// Index of the body.
     pub body: usize,
@@ -236,6 +239,7 @@ pub fn solve(set: &mut Contacts, body_velocity: &[[f64; 3]], mu: &[f64], memory:
         let rel: [f64; 3] = std::array::from_fn(|a| v[a] - vb[a]);
         reference = reference.max(-dot(rel, p.normal));
     }
+    let mut first = None;
     // Warm start: each contact's normal impulse of the last solve, applied at once.
     if !memory.is_empty() {
         for (p, &(s2, mass)) in set.contacts.iter_mut().zip(&normal_spread) {
@@ -308,7 +312,8 @@ pub fn solve(set: &mut Contacts, body_velocity: &[[f64; 3]], mu: &[f64], memory:
                 (0..3).for_each(|a| p.impulse[a] += took[a]);
             }
         }
-        if largest <= TOLERANCE * reference {
+        let scale = reference.max(*first.get_or_insert(largest));
+        if largest <= TOLERANCE * scale {
             break;
         }
     }
