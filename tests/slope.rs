@@ -116,29 +116,6 @@ fn failing_slope_comes_to_rest_at_its_repose_angle() {
     assert!(r.moved <= 0.01, "not static: {} m in 10 s", r.moved);
 }
 
-#[test]
-fn a_creeping_slope_is_not_declared_static() {
-    // Without the virtual mass floor, nodes reached only by a point's far tail push that
-    // point with its own stress and the failed slope creeps by decimetres per 10 s, while
-    // K_F and K_E already meet the paper's tolerance (from t ≈ 20 s): the static check must
-    // refuse to stop.
-    let mut sim = scene(
-        "slope.ron",
-        &[
-            "solver.max_time=30",
-            "solver.virtual_mass_floor=0",
-            "solver.node_mass_cutoff=1e-9",
-        ],
-    );
-    with_simulation!(&mut sim, s => {
-        s.run(|_| {}).expect("runs");
-        let st = &s.ctx.state;
-        assert_eq!(st.stop, Some(StopReason::MaxTime));
-        let moved = st.static_window.movement.expect("K_F and K_E were met and a 10 s window closed");
-        assert!(moved > 0.01, "a window moved only {moved} m");
-    });
-}
-
 /// φ = 35° under a 30° face: it stands, settling 0.17 m at most (`kdmpm run
 /// scenes/slope_stable.ron`: 8 937 steps, angle 29.7668°, crest u_x 0.05444 m).
 #[test]
@@ -179,10 +156,13 @@ fn the_fast_preset_comes_to_rest_where_the_paper_settings_do() {
 
 #[test]
 fn the_fast_preset_still_refuses_the_creeping_slope() {
-    // The creeping set-up of `a_creeping_slope_is_not_declared_static` with the preset's
-    // 2 s window. Under the preset itself the creep keeps K_F above the tolerance to the
-    // 30 s limit; under MUSL at Courant 1 K_F and K_E are met and a 2 s window closes with
-    // centimetres of movement (2.4 cm measured): either way the run must not stop.
+    // Without the virtual mass floor, nodes reached only by a point's far tail push that
+    // point with its own stress and the failed slope creeps by centimetres a second while
+    // K_F and K_E may already meet the tolerance: the static check must refuse to stop.
+    // Under the preset itself the creep keeps K_F above the tolerance to the 30 s limit;
+    // under MUSL at Courant 1 K_F and K_E are met and a 2 s window closes with centimetres
+    // of movement (2.4 cm measured): either way the run must not stop. (The paper's slope
+    // with its 10 s window refuses the same creep, 30 s of simulation: docs/verification.md.)
     for extra in [
         &[][..],
         &["solver.scheme=Musl", "solver.time_step=Courant(1.0)"][..],
