@@ -209,6 +209,17 @@ fn axisymmetric_scenes_that_cannot_be_are_refused() {
     }
 }
 
+/// `scenes/cpt.ron` and `scenes/pile_jacking.ron` (the same grid and clay) at h = D/4,
+/// the surcharge on the top layer of points, and `travel`.
+fn at_d4(travel: &str) -> [&str; 4] {
+    [
+        "grid.cell_size=0.25",
+        "grid.cells=[20, 104]",
+        "tractions[0].min=[0.5, 13.75]",
+        travel,
+    ]
+}
+
 /// `scenes/cpt.ron` at h = D/4 over its first D/4 from the surface, in one increment: the
 /// cone's tip takes the whole resistance and its smooth shaft none (the face the tip and
 /// the shaft share is inside the body, not sampled; its corner samples at the shoulder take
@@ -216,13 +227,7 @@ fn axisymmetric_scenes_that_cannot_be_are_refused() {
 /// (h = D/8, 10 D) is in docs/verification.md.
 #[test]
 fn a_smooth_cone_takes_its_resistance_at_the_tip() {
-    let coarse = [
-        "grid.cell_size=0.25",
-        "grid.cells=[20, 104]",
-        "tractions[0].min=[0.5, 13.75]",
-        "rigid_bodies[0].motion.travel=0.25",
-    ];
-    let s = run("cpt.ron", &coarse);
+    let s = run("cpt.ron", &at_d4("rigid_bodies[0].motion.travel=0.25"));
     assert!(s.converged, "{:?}", s.error);
     let row = |name: &str| s.curve.iter().find(|c| c.name == name).unwrap().clone();
     let (cone, tip, shaft) = (row("cone"), row("cone.tip"), row("cone.shaft"));
@@ -242,13 +247,7 @@ fn a_smooth_cone_takes_its_resistance_at_the_tip() {
 /// (h = D/8, 10 D) is in docs/verification.md.
 #[test]
 fn a_jacked_pile_carries_its_base_bearing_and_its_shaft_adhesion() {
-    let coarse = [
-        "grid.cell_size=0.25",
-        "grid.cells=[20, 104]",
-        "tractions[0].min=[0.5, 13.75]",
-        "rigid_bodies[0].motion.travel=0.5",
-    ];
-    let s = run("pile_jacking.ron", &coarse);
+    let s = run("pile_jacking.ron", &at_d4("rigid_bodies[0].motion.travel=0.5"));
     assert!(s.converged, "{:?}", s.error);
     let rows = |name: &str| -> Vec<_> { s.curve.iter().filter(|c| c.name == name).cloned().collect() };
     let (base, shaft) = (rows("pile.base"), rows("pile.shaft"));

@@ -210,8 +210,9 @@ fn velocity(p: &Contact, slots: &[Slot]) -> [f64; 3] {
     v
 }
 
-/// Projected Gauss–Seidel over the samples, each impulse starting at zero: no entry into a
-/// body moving at `body_velocity` (m/s, per body), then friction (`mu` = tan δ per body,
+/// Projected Gauss–Seidel over the samples, each normal impulse starting at its value in
+/// `memory` (zero when it has none; the tangential ones at zero): no entry into a body
+/// moving at `body_velocity` (m/s, per body), then friction (`mu` = tan δ per body,
 /// infinite when rough, 0 with adhesion alone) where a sample presses.
 pub fn solve(set: &mut Contacts, body_velocity: &[[f64; 3]], mu: &[f64], memory: &Memory) {
     let slots = &mut set.slots[..];

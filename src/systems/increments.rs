@@ -2,6 +2,9 @@
 //! (`prescribed_motion`) or a rigid body (`rigid_control`): travel at a constant velocity,
 //! in increments, the last step of each covering only what is left of it.
 
+use crate::rigid::BodyMotion;
+use crate::state::MotionSpec;
+
 /// A displacement control: its velocity, the distance to travel and the increment.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Increments {
@@ -11,6 +14,28 @@ pub(crate) struct Increments {
     pub travel: f64,
     /// Distance of one increment (m); `None`: the whole travel in one.
     pub increment: Option<f64>,
+}
+
+impl From<&MotionSpec> for Increments {
+    /// The increments of a motion of grid nodes.
+    fn from(m: &MotionSpec) -> Self {
+        Increments {
+            vector: m.vector(),
+            travel: m.travel,
+            increment: m.increment,
+        }
+    }
+}
+
+impl From<&BodyMotion> for Increments {
+    /// The increments of a rigid body's motion.
+    fn from(m: &BodyMotion) -> Self {
+        Increments {
+            vector: m.vector(),
+            travel: m.travel,
+            increment: m.increment,
+        }
+    }
 }
 
 impl Increments {

@@ -64,7 +64,7 @@ impl<D: Dim> System<D> for PrescribedMotion {
             if d.velocity == [0.0; 3] {
                 continue;
             }
-            increments(m).advance(&mut d.velocity, &mut d.travel, d.increments, dt, ctx.settings.dt);
+            Increments::from(m).advance(&mut d.velocity, &mut d.travel, d.increments, dt, ctx.settings.dt);
         }
         if s.stop != Some(StopReason::Converged) {
             return Ok(());
@@ -101,13 +101,4 @@ impl<D: Dim> System<D> for PrescribedMotion {
 pub(crate) fn in_box(m: &MotionSpec, x: [f64; 3], n: usize, h: f64) -> bool {
     let slack = 1e-9 * h;
     (0..n).all(|a| x[a] >= m.min[a] - slack && x[a] <= m.max[a] + slack)
-}
-
-/// The increments of motion `m`.
-fn increments(m: &MotionSpec) -> Increments {
-    Increments {
-        vector: m.vector(),
-        travel: m.travel,
-        increment: m.increment,
-    }
 }

@@ -84,12 +84,13 @@ impl<D: Dim> System<D> for RigidControl {
             if b.velocity == [0.0; 3] {
                 continue;
             }
-            let increments = Increments {
-                vector: m.vector(),
-                travel: m.travel,
-                increment: m.increment,
-            };
-            let moved = increments.advance(&mut b.velocity, &mut b.travel, b.increments, dt, ctx.settings.dt);
+            let moved = Increments::from(m).advance(
+                &mut b.velocity,
+                &mut b.travel,
+                b.increments,
+                dt,
+                ctx.settings.dt,
+            );
             for a in 0..3 {
                 b.offset[a] += moved[a];
             }
