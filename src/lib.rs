@@ -54,6 +54,7 @@ pub mod schedule;
 pub mod shape;
 pub mod state;
 pub mod study;
+pub mod surface_pressure;
 pub mod systems;
 pub mod tensor;
 #[cfg(test)]

@@ -165,6 +165,8 @@ pub struct Settings {
     pub stages: Vec<LoadStage>,
     /// Loads applied in increments (load control), each increment to its static stop.
     pub load_steps: Vec<LoadSteps>,
+    /// The points whose traction is a pressure that follows the surface.
+    pub pressures: crate::surface_pressure::SurfacePressures,
 }
 
 /// A load applied in equal increments, each relaxed to its static state and recorded as a

@@ -46,7 +46,7 @@ fn a_pressure_on_a_plane_strain_column_gives_its_stress_and_settlement() {
 }
 
 #[test]
-fn a_pressure_on_a_3d_column_gives_its_stress() {
+fn a_traction_or_a_pressure_on_a_3d_column_gives_its_stress() {
     let text = r#"Scene(
         dimension: 3,
         grid: (origin: [0.0, 0.0, 0.0], cell_size: 0.25, cells: [4, 4, 18]),
@@ -62,16 +62,22 @@ fn a_pressure_on_a_3d_column_gives_its_stress() {
         traced: [(name: "mid", position: [0.375, 0.375, 1.875])],
         solver: (time_step: Courant(0.5), tolerance: 1e-5, max_time: 60.0),
     )"#;
-    let s = run_text("traction.ron", text);
-    assert!(s.converged, "{:?}", s.error);
-    let t = &s.traced[0];
-    assert!(rel(t.stress.zz, -10.0e3).abs() < 0.01, "σ_zz {}", t.stress.zz);
-    let expected = -10.0e3 * t.initial_position[2] / m(1.0e7, 0.3);
-    assert!(
-        rel(t.displacement[2], expected).abs() < 0.01,
-        "u_z {:?}",
-        t.displacement
-    );
+    // The same as a pressure that follows the top (flat here): the same answer.
+    for text in [
+        text.to_string(),
+        text.replace("traction: [0.0, 0.0, -10.0e3]", "pressure: 10.0e3"),
+    ] {
+        let s = run_text("traction.ron", &text);
+        assert!(s.converged, "{:?}", s.error);
+        let t = &s.traced[0];
+        assert!(rel(t.stress.zz, -10.0e3).abs() < 0.01, "σ_zz {}", t.stress.zz);
+        let expected = -10.0e3 * t.initial_position[2] / m(1.0e7, 0.3);
+        assert!(
+            rel(t.displacement[2], expected).abs() < 0.01,
+            "u_z {:?}",
+            t.displacement
+        );
+    }
 }
 
 #[test]
@@ -123,5 +129,74 @@ fn a_stage_that_doubles_the_pressure_doubles_the_stress_and_settlement() {
         rel(mid.displacement[1], expected).abs() < 0.01,
         "u_y {:?}",
         mid.displacement
+    );
+}
+
+/// A `pressure` on the column's flat top is the traction −p n, at the start and as the
+/// column settles (it stays flat, its width held by the rollers): the same stress and
+/// settlement, and a stage that gives it a new value [p] doubles them.
+#[test]
+fn a_pressure_on_a_flat_top_loads_it_as_the_traction_does_and_a_stage_doubles_it() {
+    let pressed = COLUMN_2D.replace("traction: [0.0, -10.0e3]", "pressure: 10.0e3");
+    let s = run_text("pressure.ron", &pressed);
+    assert!(s.converged, "{:?}", s.error);
+    let mid = &s.traced[0];
+    assert!(rel(mid.stress.yy, -10.0e3).abs() < 0.01, "σ_yy {}", mid.stress.yy);
+    let expected = -10.0e3 * mid.initial_position[1] / m(1.0e7, 0.3);
+    assert!(
+        rel(mid.displacement[1], expected).abs() < 0.01,
+        "u_y {:?}",
+        mid.displacement
+    );
+    let staged = pressed.replace(
+        "    traced:",
+        r#"    stages: [(name: "first"), (name: "doubled", tractions: {"p": [20.0e3]})],
+    traced:"#,
+    );
+    let s = run_text("pressure.ron", &staged);
+    assert!(s.converged, "{:?}", s.error);
+    let mid = &s.traced[0];
+    assert!(rel(mid.stress.yy, -20.0e3).abs() < 0.01, "σ_yy {}", mid.stress.yy);
+}
+
+#[test]
+fn a_pressure_is_given_alone_on_points_of_its_own() {
+    let both = COLUMN_2D.replace(
+        "traction: [0.0, -10.0e3]",
+        "traction: [0.0, -10.0e3], pressure: 10.0e3",
+    );
+    let e = refusal(&both);
+    assert!(
+        e.contains("tractions[0].pressure") && e.contains("not both"),
+        "{e}"
+    );
+    let neither = COLUMN_2D.replace(", traction: [0.0, -10.0e3]", "");
+    let e = refusal(&neither);
+    assert!(
+        e.contains("tractions[0].traction") && e.contains("or a pressure"),
+        "{e}"
+    );
+    // A side traction whose box reaches the top row shares its corner point with the
+    // pressure on the top.
+    let shared = COLUMN_2D.replace(
+        r#"traction: [0.0, -10.0e3])],"#,
+        r#"pressure: 10.0e3), (name: "side", surface: XMax, min: [0.5, 3.0], max: [1.0, 4.0], traction: [-1.0e3, 0.0])],"#,
+    );
+    let e = refusal(&shared);
+    assert!(
+        e.contains("tractions[1].min") && e.contains("shares the point") && e.contains("\"p\""),
+        "{e}"
+    );
+    let vector_stage = COLUMN_2D
+        .replace("traction: [0.0, -10.0e3]", "pressure: 10.0e3")
+        .replace(
+            "    traced:",
+            r#"    stages: [(name: "first"), (name: "doubled", tractions: {"p": [0.0, -20.0e3]})],
+    traced:"#,
+        );
+    let e = refusal(&vector_stage);
+    assert!(
+        e.contains("stages[1].tractions.p") && e.contains("one entry [p]"),
+        "{e}"
     );
 }

@@ -25,6 +25,8 @@ pub fn unsupported<D: Dim>(sim: &Simulation<D>) -> Option<&'static str> {
         Some("prescribed motions (their reaction is not yet summed over the ranks)")
     } else if !s.stages.is_empty() {
         Some("stages")
+    } else if !s.pressures.is_empty() {
+        Some("surface pressures (a loaded point's neighbours along its surface may be on another rank)")
     } else if !s.load_steps.is_empty() {
         Some("tractions applied in increments")
     } else if s.volumetric_smoothing {

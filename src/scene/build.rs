@@ -228,7 +228,14 @@ fn stages<D: Dim>(
             .collect();
         for (name, t) in &st.tractions {
             let points = &shares.iter().find(|(n, _)| n == name).expect("validated").1;
-            loads.extend(points.iter().map(|&(id, share)| (id, pad3(t).map(|c| c * share))));
+            let spec = loaded
+                .scene
+                .tractions
+                .iter()
+                .find(|s| s.name == *name)
+                .expect("validated");
+            let t = spec.vector_of(t);
+            loads.extend(points.iter().map(|&(id, share)| (id, t.map(|c| c * share))));
         }
         loads.sort_by_key(|l| l.0);
         let gravity = st.gravity.as_ref().map(|g| Gravity {
@@ -331,6 +338,7 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
             .collect(),
         stages: stages(&grid, loaded, checked_stages, &load_ids, &placed.shares),
         load_steps: placed.steps,
+        pressures: placed.pressures,
         virtual_mass_floor: s.solver.virtual_mass_floor * full_node_mass,
     };
     let needs = Needs {

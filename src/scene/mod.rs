@@ -311,12 +311,44 @@ pub struct TractionSpec {
     /// Upper corner (m).
     pub max: Vec<f64>,
     /// Force per unit area of the surface projected on the plane normal to `surface`
-    /// (Pa), one entry per axis: `[0.0, -50e3]` presses a top surface down.
+    /// (Pa), one entry per axis: `[0.0, -50e3]` presses a top surface down. It keeps its
+    /// direction and size however the surface moves. Give it or `pressure`.
+    #[serde(default)]
     pub traction: Vec<f64>,
+    /// A pressure (Pa, compression positive) that follows the surface: normal to it and in
+    /// proportion to its size as it deforms (a surcharge on ground that heaves, a fluid;
+    /// [`crate::surface_pressure`]). Instead of `traction`.
+    #[serde(default)]
+    pub pressure: Option<f64>,
     /// Apply it in this many equal increments, each to its static stop and a row of
     /// `curve.csv` (load control); default: all at once.
     #[serde(default)]
     pub increments: Option<u32>,
+}
+
+impl TractionSpec {
+    /// The traction at set-up (Pa), x y z: as given, or a pressure's −p n with n the
+    /// outward normal of its face.
+    pub fn vector(&self) -> [f64; 3] {
+        match self.pressure {
+            Some(p) => self.vector_of(&[p]),
+            None => self.vector_of(&self.traction),
+        }
+    }
+
+    /// What a value of this traction (a stage's new one) stands for at set-up (Pa), x y z:
+    /// a traction's entries as given, a pressure's one entry p as −p n.
+    pub fn vector_of(&self, value: &[f64]) -> [f64; 3] {
+        match self.pressure {
+            Some(_) => {
+                let (axis, upper) = self.surface.axis_side();
+                let mut v = [0.0; 3];
+                v[axis] = if upper { -value[0] } else { value[0] };
+                v
+            }
+            None => pad3(value),
+        }
+    }
 }
 
 /// A traced point: the material point nearest to `position`.

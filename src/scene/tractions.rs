@@ -1,17 +1,20 @@
 //! Tractions: a distributed load on a body's surface, carried by the outermost points.
 
-use super::{pad3, LoadedScene};
+use super::LoadedScene;
 use crate::components::*;
 use crate::dim::Dim;
 use crate::error::SceneError;
 use crate::state::LoadSteps;
+use crate::surface_pressure::{SurfacePoint, SurfacePressures, NONE};
 use hecs::{Entity, World};
 use std::collections::BTreeMap;
 
 /// Gives the outermost point of each column of points inside each traction's box (along
 /// the surface's normal) a point load: the traction times the column's share of the
-/// surface, (h/n) per axis across the normal for n points a cell. `body_ids` holds the
-/// point ids of each body.
+/// surface, (h/n) per axis across the normal for n points a cell. A `pressure` gives them
+/// the traction −p n and their neighbours along the surface (the next columns' points), from
+/// which `point_loads` turns the load with the surface ([`crate::surface_pressure`]).
+/// `body_ids` holds the point ids of each body.
 pub(super) fn place<D: Dim>(
     world: &mut World,
     loaded: &LoadedScene,
@@ -20,11 +23,15 @@ pub(super) fn place<D: Dim>(
     let s = &loaded.scene;
     let n = D::N;
     let mut placed = Placed::default();
+    // The points under a pressure, by id: which traction, and their places in its surface.
+    let mut pressed_by: BTreeMap<u32, usize> = BTreeMap::new();
+    let mut followers: Vec<(u32, SurfacePoint)> = Vec::new();
     for (i, t) in s.tractions.iter().enumerate() {
         let (normal, upper) = t.surface.axis_side();
         // Column key: the point's sub-cell coordinates across the normal.
         // Key → (how far out, the point, its share); key order keeps set-up deterministic.
-        let mut outermost: BTreeMap<Vec<i64>, (f64, Entity, f64)> = BTreeMap::new();
+        // (Its sub-cell's edges too, m.)
+        let mut outermost: BTreeMap<Vec<i64>, (f64, Entity, f64, [f64; 3])> = BTreeMap::new();
         for (e, x, id) in world.query::<(Entity, &Position<D::Vec>, &PointId)>().iter() {
             if world.get::<&Stress<D::Stress>>(e).is_err() {
                 continue; // a load carrier
@@ -54,9 +61,10 @@ pub(super) fn place<D: Dim>(
             };
             let share: f64 = (0..n).filter(|&a| a != normal).map(sub).product::<f64>() * radius;
             let out = if upper { x[normal] } else { -x[normal] };
-            let entry = outermost.entry(key).or_insert((out, e, share));
+            let subs = std::array::from_fn(|a| if a < n { sub(a) } else { 0.0 });
+            let entry = outermost.entry(key).or_insert((out, e, share, subs));
             if entry.0 < out {
-                *entry = (out, e, share);
+                *entry = (out, e, share, subs);
             }
         }
         if outermost.is_empty() {
@@ -65,17 +73,69 @@ pub(super) fn place<D: Dim>(
                 format!("traction \"{}\": no point of a body lies in its box", t.name),
             ));
         }
+        let pressed = t.pressure.is_some();
+        let across: Vec<usize> = (0..n).filter(|&a| a != normal).collect();
+        let ids: BTreeMap<&Vec<i64>, u32> = outermost
+            .iter()
+            .map(|(k, v)| (k, world.get::<&PointId>(v.1).expect("a live point").0))
+            .collect();
         let (mut points, mut shares) = (Vec::new(), Vec::new());
-        for (_, (_, e, share)) in outermost {
-            let f = D::vec_from(pad3(&t.traction)) * share;
-            let total = match world.get::<&PointLoad<D::Vec>>(e) {
-                Ok(p) => p.0 + f,
-                Err(_) => f,
+        for (key, &(_, e, share, subs)) in &outermost {
+            let id = ids[key];
+            let at = || {
+                let x = D::vec_to3(world.get::<&Position<D::Vec>>(e).expect("a live point").0);
+                x[..n].to_vec()
             };
-            world.insert_one(e, PointLoad(total)).expect("a live point");
-            let id = world.get::<&PointId>(e).expect("a live point").0;
+            let f = D::vec_from(t.vector()) * share;
+            let earlier = world.get::<&PointLoad<D::Vec>>(e).map(|p| p.0).ok();
+            if let Some(&j) = pressed_by.get(&id) {
+                return Err(shared_point(loaded, i, j, at()));
+            }
+            if let (true, Some(_)) = (pressed, earlier) {
+                let j = (0..i)
+                    .find(|&j| placed.shares[j].1.iter().any(|s| s.0 == id))
+                    .expect("an earlier traction loaded it");
+                return Err(shared_point(loaded, i, j, at()));
+            }
+            world
+                .insert_one(e, PointLoad(earlier.map_or(f, |g| g + f)))
+                .expect("a live point");
             points.push((id, D::vec_to3(f)));
             shares.push((id, share));
+            if pressed {
+                // Neighbours along the surface: the columns one sub-cell before and after
+                // along each axis across the normal.
+                let mut links = [[NONE; 2]; 2];
+                let mut spacing = [0.0; 2];
+                for (j, &a) in across.iter().enumerate() {
+                    for (side, step) in [-1i64, 1].into_iter().enumerate() {
+                        let mut k = key.clone();
+                        k[j] += step;
+                        if let Some(&neighbour) = ids.get(&k) {
+                            links[j][side] = neighbour;
+                        }
+                    }
+                    spacing[j] = subs[a];
+                }
+                let mut outward = [0.0; 3];
+                outward[normal] = if upper { 1.0 } else { -1.0 };
+                let radius_offset = match (D::AXISYMMETRIC, normal) {
+                    (true, 0) => outward[0] * 0.5 * subs[0],
+                    _ => 0.0,
+                };
+                pressed_by.insert(id, i);
+                followers.push((
+                    id,
+                    SurfacePoint {
+                        across: [across[0], *across.get(1).unwrap_or(&across[0])],
+                        links,
+                        spacing,
+                        normal: outward,
+                        share,
+                        radius_offset,
+                    },
+                ));
+            }
         }
         points.sort_by_key(|p| p.0);
         placed.shares.push((t.name.clone(), shares));
@@ -84,11 +144,28 @@ pub(super) fn place<D: Dim>(
                 name: t.name.clone(),
                 points,
                 increments: k,
-                pressure: t.traction.iter().map(|c| c * c).sum::<f64>().sqrt(),
+                pressure: t.vector().iter().map(|c| c * c).sum::<f64>().sqrt(),
             });
         }
     }
+    followers.sort_by_key(|f| f.0);
+    placed.pressures = SurfacePressures {
+        ids: followers.iter().map(|f| f.0).collect(),
+        points: followers.into_iter().map(|f| f.1).collect(),
+    };
     Ok(placed)
+}
+
+/// Traction `i` loads a point that traction `j` loads too, and one of them is a pressure.
+fn shared_point(loaded: &LoadedScene, i: usize, j: usize, x: Vec<f64>) -> SceneError {
+    loaded.invalid(
+        &format!("tractions[{i}].min"),
+        format!(
+            "its surface shares the point at {x:?} with tractions[{j}] (\"{}\"): a point under a \
+             pressure carries no other traction; make the two boxes meet without a common point",
+            loaded.scene.tractions[j].name
+        ),
+    )
 }
 
 /// Where the tractions went.
@@ -98,4 +175,6 @@ pub(super) struct Placed {
     pub steps: Vec<LoadSteps>,
     /// Each traction's points (ids) and their shares of the surface (m²; m in 2D).
     pub shares: Vec<(String, Vec<(u32, f64)>)>,
+    /// The points under pressures and their places in their surfaces.
+    pub pressures: SurfacePressures,
 }

@@ -743,6 +743,7 @@ mod tests {
             friction_faces: Vec::new(),
             stages: Vec::new(),
             load_steps: Vec::new(),
+            pressures: Default::default(),
             virtual_mass_floor: 0.0,
         }
     }

@@ -15,12 +15,22 @@ use std::marker::PhantomData;
 /// A load point at the free end of a bar sits on the last node; once the bar stretches its
 /// support reaches the empty node beyond, where a share of F would be lost (massless nodes
 /// have no degrees of freedom). Renormalising keeps the whole load on the body.
+///
+/// A point under a pressure ([`crate::surface_pressure`]) carries −p times its share's area
+/// vector now, from its neighbours' places, instead of its set-up load.
 #[derive(Debug)]
-pub struct PointLoads<D, S>(PhantomData<fn() -> (D, S)>);
+pub struct PointLoads<D, S> {
+    /// The current place of each point under a pressure, in the order of its ids (scratch).
+    places: Vec<[f64; 3]>,
+    dims: PhantomData<fn() -> (D, S)>,
+}
 
 impl<D, S> Default for PointLoads<D, S> {
     fn default() -> Self {
-        PointLoads(PhantomData)
+        PointLoads {
+            places: Vec::new(),
+            dims: PhantomData,
+        }
     }
 }
 
@@ -35,11 +45,33 @@ impl<D: Dim, S: Shape> System<D> for PointLoads<D, S> {
         let nm = col::<NodeMass>(n);
         let mut nf = col_mut::<NodeForce<D::Vec>>(n);
         let mut ne = col_mut::<NodeExternalForce<D::Vec>>(n);
+        let pressures = &ctx.settings.pressures;
+        if !pressures.is_empty() {
+            self.places.resize(pressures.ids.len(), [0.0; 3]);
+            for arch in points_with::<PointLoad<D::Vec>>(&ctx.world) {
+                let (x, id) = (col::<Position<D::Vec>>(arch), col::<PointId>(arch));
+                for (x, id) in x.iter().zip(id.iter()) {
+                    if let Some(k) = pressures.index(id.0) {
+                        self.places[k] = D::vec_to3(x.0);
+                    }
+                }
+            }
+        }
+        let places = &self.places;
+        let place = |id: u32| {
+            places[pressures
+                .index(id)
+                .expect("a neighbour is under the pressure too")]
+        };
         for arch in points_with::<PointLoad<D::Vec>>(&ctx.world) {
             let x = col::<Position<D::Vec>>(arch);
             let load = col::<PointLoad<D::Vec>>(arch);
             let id = col::<PointId>(arch);
             for p in 0..x.len() {
+                let load = match pressures.index(id[p].0) {
+                    Some(k) => pressures.force::<D>(k, load[p].0, place),
+                    None => load[p].0,
+                };
                 let mut carried = 0.0;
                 for_each_node::<D, S>(grid, x[p].0, |i, w, _| {
                     if grid.carries(i, nm[i].0, min_mass) {
@@ -53,7 +85,7 @@ impl<D: Dim, S: Shape> System<D> for PointLoads<D, S> {
                         position: D::vec_to3(x[p].0),
                     });
                 }
-                let f = load[p].0 * (1.0 / carried);
+                let f = load * (1.0 / carried);
                 for_each_node::<D, S>(grid, x[p].0, |i, w, _| {
                     if grid.carries(i, nm[i].0, min_mass) {
                         nf[i].0 += f * w;

@@ -38,10 +38,27 @@ pub(super) fn check_tractions_and_traced(r: &Rules) -> Result<(), SceneError> {
     for (i, t) in s.tractions.iter().enumerate() {
         r.len(&format!("tractions[{i}].min"), t.min.len())?;
         r.len(&format!("tractions[{i}].max"), t.max.len())?;
-        r.len(&format!("tractions[{i}].traction"), t.traction.len())?;
+        match (t.pressure, t.traction.is_empty()) {
+            (Some(_), false) => {
+                return r.bad(
+                    &format!("tractions[{i}].pressure"),
+                    "give a traction or a pressure, not both".into(),
+                )
+            }
+            (None, true) => {
+                return r.bad(
+                    &format!("tractions[{i}].traction"),
+                    "give the traction (Pa, one entry per axis) or a pressure (Pa)".into(),
+                )
+            }
+            (Some(p), true) => r.finite(&format!("tractions[{i}].pressure"), &[p], "Pa")?,
+            (None, false) => {
+                r.len(&format!("tractions[{i}].traction"), t.traction.len())?;
+                r.finite(&format!("tractions[{i}].traction"), &t.traction, "Pa")?;
+            }
+        }
         r.finite(&format!("tractions[{i}].min"), &t.min, "m")?;
         r.finite(&format!("tractions[{i}].max"), &t.max, "m")?;
-        r.finite(&format!("tractions[{i}].traction"), &t.traction, "Pa")?;
         if t.min.iter().zip(&t.max).any(|(lo, hi)| lo > hi) {
             return r.bad(
                 &format!("tractions[{i}].max"),
@@ -82,7 +99,7 @@ pub(super) fn check_has_load(r: &Rules) -> Result<(), SceneError> {
         .as_ref()
         .is_some_and(|g| g.acceleration.iter().any(|&a| a != 0.0));
     let loads = s.point_loads.iter().any(|l| l.force.iter().any(|&f| f != 0.0))
-        || s.tractions.iter().any(|t| t.traction.iter().any(|&f| f != 0.0));
+        || s.tractions.iter().any(|t| t.vector().iter().any(|&f| f != 0.0));
     if !gravity && !loads && s.motions.is_empty() && s.rigid_bodies.is_empty() {
         return r.bad(
             if s.gravity.is_some() {

@@ -89,9 +89,19 @@ pub(super) fn check_stages(
                         "this traction is applied in increments: a stage cannot set it too".into(),
                     )
                 }
+                Some(t) if t.pressure.is_some() && traction.len() != 1 => {
+                    return r.bad(
+                        &field,
+                        format!(
+                            "\"{name}\" is a pressure: give its new value as one entry [p] (Pa), \
+                             found {}",
+                            traction.len()
+                        ),
+                    )
+                }
+                Some(t) if t.pressure.is_none() => r.len(&field, traction.len())?,
                 Some(_) => {}
             }
-            r.len(&field, traction.len())?;
             r.finite(&field, traction, "Pa")?;
         }
         let faces = match &st.boundaries {

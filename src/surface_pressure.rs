@@ -1,0 +1,270 @@
+//! Surface pressures: tractions that follow the surface as it deforms (follower loads).
+//!
+//! A traction given as a `pressure` p (Pa, compression positive) pushes on the surface
+//! along its current inward normal, in proportion to its current size: F = −p A, with A the
+//! outward area vector of the point's share of the surface (m²; m in plane strain; per
+//! radian in axisymmetry). A fixed traction keeps its set-up direction and size, so on a
+//! surface that heaves or tilts it gains a shear component: under a surcharge many times
+//! the soil's strength (100 kPa on clay of c_u = 10 kPa beside a pushed cone), a tilt of
+//! a few degrees shears the surface beyond c_u and it flows without end. A pressure,
+//! normal wherever the surface turns, adds only a uniform mean stress to a surface it
+//! covers, as a fluid or a surcharge does.
+//!
+//! The loaded points (the outermost point of each column, as for any traction) form a
+//! lattice along the surface: a chain in 2D and axisymmetry, a sheet in 3D. A point's area
+//! vector comes from its neighbours' current places: with the tangents t_a = (x_{+a} −
+//! x_{−a})/2 along each axis across the normal (one-sided at the surface's edge), A = ⟂t in
+//! 2D (times the current radius in axisymmetry) and A = t_a × t_b in 3D. On a flat surface
+//! at set-up this is the point's share of the surface, along the face's normal: the
+//! pressure starts as the traction −p n would.
+
+use crate::dim::Dim;
+
+/// No neighbour on that side: the point is at the edge of its surface.
+pub const NONE: u32 = u32::MAX;
+
+/// The points loaded by pressures, what they need to find their area vector.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SurfacePressures {
+    /// The loaded points' ids, ascending.
+    pub ids: Vec<u32>,
+    /// Each point's place in its surface, in the order of `ids`.
+    pub points: Vec<SurfacePoint>,
+}
+
+/// A point that carries a pressure: its neighbours along the surface and its set-up share.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SurfacePoint {
+    /// The axes across the surface's normal (the second unused in 2D).
+    pub across: [usize; 2],
+    /// The neighbours' ids before and after the point along each axis of `across`
+    /// ([`NONE`] at the surface's edge).
+    pub links: [[u32; 2]; 2],
+    /// The spacing of the lattice along each axis of `across` at set-up (m): the tangent of
+    /// a point that has no neighbour along an axis.
+    pub spacing: [f64; 2],
+    /// The face's outward normal (unit, along a grid axis), x y z.
+    pub normal: [f64; 3],
+    /// The share of the surface at set-up (m², m in plane strain, per radian in
+    /// axisymmetry): the size of the area vector there.
+    pub share: f64,
+    /// In axisymmetry, what is added to the point's radius to give its share's radius (m):
+    /// half a sub-cell on a face normal to r, 0 across the axis.
+    pub radius_offset: f64,
+}
+
+impl SurfacePressures {
+    /// Whether no traction is a pressure.
+    pub fn is_empty(&self) -> bool {
+        self.ids.is_empty()
+    }
+
+    /// The index of point `id` in [`Self::ids`], if it carries a pressure.
+    #[inline]
+    pub fn index(&self, id: u32) -> Option<usize> {
+        self.ids.binary_search(&id).ok()
+    }
+
+    /// The force on point `k` (N; N/m in 2D; N/rad in axisymmetry) from the load `load` it
+    /// carries at set-up (its point load: −p · share · normal, scaled by stages and load
+    /// steps), with `place(id)` giving each loaded point's current place (x y z).
+    pub fn force<D: Dim>(&self, k: usize, load: D::Vec, place: impl Fn(u32) -> [f64; 3]) -> D::Vec {
+        let p = &self.points[k];
+        let l = D::vec_to3(load);
+        // −p: the load's component along the outward normal per unit of set-up share.
+        let minus_p = (0..3).map(|a| l[a] * p.normal[a]).sum::<f64>() / p.share;
+        let a = self.area::<D>(k, &place);
+        D::vec_from(a.map(|c| c * minus_p))
+    }
+
+    /// The outward area vector of point `k`'s share of the surface now (m², m in 2D, per
+    /// radian in axisymmetry), x y z.
+    pub fn area<D: Dim>(&self, k: usize, place: impl Fn(u32) -> [f64; 3]) -> [f64; 3] {
+        let p = &self.points[k];
+        let x = place(self.ids[k]);
+        let tangent = |j: usize| -> [f64; 3] {
+            let [before, after] = p.links[j];
+            let (lo, hi, span) = match (before != NONE, after != NONE) {
+                (true, true) => (place(before), place(after), 2.0),
+                (false, true) => (x, place(after), 1.0),
+                (true, false) => (place(before), x, 1.0),
+                (false, false) => {
+                    let mut t = [0.0; 3];
+                    t[p.across[j]] = p.spacing[j];
+                    return t;
+                }
+            };
+            std::array::from_fn(|a| (hi[a] - lo[a]) / span)
+        };
+        let raw = if D::N == 2 {
+            let t = tangent(0);
+            [-t[1], t[0], 0.0]
+        } else {
+            let (s, t) = (tangent(0), tangent(1));
+            [
+                s[1] * t[2] - s[2] * t[1],
+                s[2] * t[0] - s[0] * t[2],
+                s[0] * t[1] - s[1] * t[0],
+            ]
+        };
+        // The lattice's own orientation against the outward normal at set-up (±1): the
+        // axes across run in increasing order, so ⟂e_a or e_a × e_b is ± the normal.
+        let sign = orientation(D::N, p.across, p.normal);
+        let radius = if D::AXISYMMETRIC {
+            x[0] + p.radius_offset
+        } else {
+            1.0
+        };
+        raw.map(|c| c * sign * radius)
+    }
+}
+
+/// +1 when the area vector of an undeformed lattice along `across` (⟂e_a in 2D, e_a × e_b
+/// in 3D) points along `normal`, −1 when against it.
+fn orientation(n: usize, across: [usize; 2], normal: [f64; 3]) -> f64 {
+    let mut raw = [0.0; 3];
+    if n == 2 {
+        // ⟂(x, y) = (−y, x).
+        match across[0] {
+            0 => raw[1] = 1.0,
+            _ => raw[0] = -1.0,
+        }
+    } else {
+        // e_a × e_b for a < b: +e_c for (0,1)→2 and (1,2)→0, −e_c for (0,2)→1.
+        let c = 3 - across[0] - across[1];
+        raw[c] = if (across[0], across[1]) == (0, 2) {
+            -1.0
+        } else {
+            1.0
+        };
+    }
+    if (0..3).map(|a| raw[a] * normal[a]).sum::<f64>() >= 0.0 {
+        1.0
+    } else {
+        -1.0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::dim::{Dim2, Dim3, DimAxi};
+    use glam::{DVec2, DVec3};
+
+    /// A chain of three points along x at height 1, loaded on a top face (outward +y).
+    fn top_chain(spacing: f64, radius_offset: f64, x0: f64) -> (SurfacePressures, Vec<[f64; 3]>) {
+        let places = (0..3).map(|i| [x0 + i as f64 * spacing, 1.0, 0.0]).collect();
+        let point = |i: u32| SurfacePoint {
+            across: [0, 0],
+            links: [
+                [
+                    if i == 0 { NONE } else { i - 1 },
+                    if i == 2 { NONE } else { i + 1 },
+                ],
+                [NONE; 2],
+            ],
+            spacing: [spacing, 0.0],
+            normal: [0.0, 1.0, 0.0],
+            share: spacing,
+            radius_offset,
+        };
+        let sp = SurfacePressures {
+            ids: vec![0, 1, 2],
+            points: (0..3).map(point).collect(),
+        };
+        (sp, places)
+    }
+
+    #[test]
+    fn a_flat_surface_carries_the_traction_of_its_pressure() {
+        let (sp, x) = top_chain(0.25, 0.0, 0.125);
+        let load = DVec2::new(0.0, -100.0e3 * 0.25);
+        for k in 0..3 {
+            let f = sp.force::<Dim2>(k, load, |id| x[id as usize]);
+            assert_eq!(f, load, "point {k}");
+        }
+    }
+
+    #[test]
+    fn a_pressure_turns_with_its_surface_and_grows_with_its_length() {
+        // The chain turned by 30° and stretched by half: the force turns with it, its size
+        // grows by half, and it stays normal to the chain.
+        let (sp, x) = top_chain(0.25, 0.0, 0.125);
+        let (c, s) = (30f64.to_radians().cos(), 30f64.to_radians().sin());
+        let moved: Vec<[f64; 3]> = x
+            .iter()
+            .map(|p| {
+                let (u, v) = (1.5 * p[0], 1.5 * (p[1] - 1.0));
+                [c * u - s * v, s * u + c * v, 0.0]
+            })
+            .collect();
+        let f = sp.force::<Dim2>(1, DVec2::new(0.0, -100.0e3 * 0.25), |id| moved[id as usize]);
+        let expected = DVec2::new(s, -c) * (100.0e3 * 0.25 * 1.5);
+        assert!(
+            (f - expected).length() < 1e-9 * expected.length(),
+            "{f} against {expected}"
+        );
+    }
+
+    #[test]
+    fn an_axisymmetric_share_grows_with_its_radius() {
+        // A point on a top face at r = 2 m carries p · spacing · r per radian; moved out to
+        // r = 3 m it carries half as much again.
+        let (mut sp, x) = top_chain(0.25, 0.0, 1.75);
+        for p in &mut sp.points {
+            p.share = 0.25 * 2.0;
+        }
+        let load = DVec2::new(0.0, -100.0e3 * 0.25 * 2.0);
+        assert_eq!(sp.force::<DimAxi>(1, load, |id| x[id as usize]), load);
+        let out: Vec<[f64; 3]> = x.iter().map(|p| [p[0] + 1.0, p[1], 0.0]).collect();
+        let f = sp.force::<DimAxi>(1, load, |id| out[id as usize]);
+        assert_eq!(f, load * 1.5);
+    }
+
+    #[test]
+    fn every_face_of_a_box_starts_with_its_outward_normal() {
+        for axis in 0..2 {
+            for outward in [-1.0, 1.0] {
+                let mut normal = [0.0; 3];
+                normal[axis] = outward;
+                let point = SurfacePoint {
+                    across: [1 - axis, 1 - axis],
+                    links: [[NONE; 2]; 2],
+                    spacing: [0.5, 0.0],
+                    normal,
+                    share: 0.5,
+                    radius_offset: 0.0,
+                };
+                let sp = SurfacePressures {
+                    ids: vec![7],
+                    points: vec![point],
+                };
+                let load = DVec2::new(normal[0], normal[1]) * (-2.0e3 * 0.5);
+                let f = sp.force::<Dim2>(0, load, |_| [1.0, 1.0, 0.0]);
+                assert_eq!(f, load, "2D face {axis} {outward}");
+            }
+        }
+        for axis in 0..3 {
+            for outward in [-1.0, 1.0] {
+                let across: Vec<usize> = (0..3).filter(|&a| a != axis).collect();
+                let mut normal = [0.0; 3];
+                normal[axis] = outward;
+                let point = SurfacePoint {
+                    across: [across[0], across[1]],
+                    links: [[NONE; 2]; 2],
+                    spacing: [0.5, 0.25],
+                    normal,
+                    share: 0.125,
+                    radius_offset: 0.0,
+                };
+                let sp = SurfacePressures {
+                    ids: vec![7],
+                    points: vec![point],
+                };
+                let load = DVec3::from_array(normal) * (-2.0e3 * 0.125);
+                let f = sp.force::<Dim3>(0, load, |_| [1.0, 1.0, 1.0]);
+                assert_eq!(f, load, "face {axis} {outward}");
+            }
+        }
+    }
+}
