@@ -12,11 +12,14 @@
 //!
 //! The loaded points (the outermost point of each column, as for any traction) form a
 //! lattice along the surface: a chain in 2D and axisymmetry, a sheet in 3D. A point's area
-//! vector comes from its neighbours' current places: with the tangents t_a = (x_{+a} −
-//! x_{−a})/2 along each axis across the normal (one-sided at the surface's edge), A = ⟂t in
-//! 2D (times the current radius in axisymmetry) and A = t_a × t_b in 3D. On a flat surface
-//! at set-up this is the point's share of the surface, along the face's normal: the
-//! pressure starts as the traction −p n would.
+//! vector comes from its neighbours' current places: with the tangents t_a = (x_{+k} −
+//! x_{−k})/2k along each axis across the normal, k points each way (a cell's worth, the
+//! body's points per cell along that axis; fewer at the surface's edge), A = ⟂t in 2D
+//! (times the current radius in axisymmetry) and A = t_a × t_b in 3D. On a flat surface at
+//! set-up this is the point's share of the surface, along the face's normal: the pressure
+//! starts as the traction −p n would. Reaching a cell each way, the normal is the surface's
+//! at the grid's resolution: two neighbouring points that cross each other in a flow that
+//! the grid cannot resolve (the surface beside a pile that drags it down) do not turn it.
 
 use crate::dim::Dim;
 
@@ -43,6 +46,9 @@ pub struct SurfacePoint {
     /// The spacing of the lattice along each axis of `across` at set-up (m): the tangent of
     /// a point that has no neighbour along an axis.
     pub spacing: [f64; 2],
+    /// How many neighbours each way a tangent reaches along each axis of `across` (≥ 1: the
+    /// points a cell along it).
+    pub reach: [u32; 2],
     /// The face's outward normal (unit, along a grid axis), x y z.
     pub normal: [f64; 3],
     /// The share of the surface at set-up (m², m in plane strain, per radian in
@@ -82,19 +88,31 @@ impl SurfacePressures {
     pub fn area<D: Dim>(&self, k: usize, place: impl Fn(u32) -> [f64; 3]) -> [f64; 3] {
         let p = &self.points[k];
         let x = place(self.ids[k]);
-        let tangent = |j: usize| -> [f64; 3] {
-            let [before, after] = p.links[j];
-            let (lo, hi, span) = match (before != NONE, after != NONE) {
-                (true, true) => (place(before), place(after), 2.0),
-                (false, true) => (x, place(after), 1.0),
-                (true, false) => (place(before), x, 1.0),
-                (false, false) => {
-                    let mut t = [0.0; 3];
-                    t[p.across[j]] = p.spacing[j];
-                    return t;
+        // The point `reach` links away along axis j on `side` (or the last before the
+        // edge) and how many links that is.
+        let walk = |j: usize, side: usize| -> (u32, u32) {
+            let (mut at, mut steps) = (self.ids[k], 0);
+            while steps < p.reach[j] {
+                let next = match self.index(at) {
+                    Some(i) => self.points[i].links[j][side],
+                    None => NONE,
+                };
+                if next == NONE {
+                    break;
                 }
-            };
-            std::array::from_fn(|a| (hi[a] - lo[a]) / span)
+                (at, steps) = (next, steps + 1);
+            }
+            (at, steps)
+        };
+        let tangent = |j: usize| -> [f64; 3] {
+            let ((before, b), (after, a)) = (walk(j, 0), walk(j, 1));
+            if a + b == 0 {
+                let mut t = [0.0; 3];
+                t[p.across[j]] = p.spacing[j];
+                return t;
+            }
+            let (lo, hi) = (place(before), place(after));
+            std::array::from_fn(|c| (hi[c] - lo[c]) / (a + b) as f64)
         };
         let raw = if D::N == 2 {
             let t = tangent(0);
@@ -153,26 +171,52 @@ mod tests {
 
     /// A chain of three points along x at height 1, loaded on a top face (outward +y).
     fn top_chain(spacing: f64, radius_offset: f64, x0: f64) -> (SurfacePressures, Vec<[f64; 3]>) {
-        let places = (0..3).map(|i| [x0 + i as f64 * spacing, 1.0, 0.0]).collect();
+        chain(3, 1, spacing, radius_offset, x0)
+    }
+
+    /// A chain of `n` points along x at height 1 whose tangents reach `reach` points each
+    /// way, loaded on a top face (outward +y).
+    fn chain(
+        n: u32,
+        reach: u32,
+        spacing: f64,
+        radius_offset: f64,
+        x0: f64,
+    ) -> (SurfacePressures, Vec<[f64; 3]>) {
+        let places = (0..n).map(|i| [x0 + i as f64 * spacing, 1.0, 0.0]).collect();
         let point = |i: u32| SurfacePoint {
             across: [0, 0],
             links: [
                 [
                     if i == 0 { NONE } else { i - 1 },
-                    if i == 2 { NONE } else { i + 1 },
+                    if i == n - 1 { NONE } else { i + 1 },
                 ],
                 [NONE; 2],
             ],
             spacing: [spacing, 0.0],
+            reach: [reach, reach],
             normal: [0.0, 1.0, 0.0],
             share: spacing,
             radius_offset,
         };
         let sp = SurfacePressures {
-            ids: vec![0, 1, 2],
-            points: (0..3).map(point).collect(),
+            ids: (0..n).collect(),
+            points: (0..n).map(point).collect(),
         };
         (sp, places)
+    }
+
+    #[test]
+    fn two_points_that_cross_do_not_turn_a_pressure_that_reaches_a_cell() {
+        // Five points, two a cell; the second moved past the fourth. Reaching one point
+        // each way the middle point's surface would face down and the pressure pull it
+        // out; reaching a cell (two points) it faces up as the chain does.
+        for (reach, up) in [(1, false), (2, true)] {
+            let (sp, mut x) = chain(5, reach, 0.25, 0.0, 0.125);
+            x[1][0] = 0.125 + 3.5 * 0.25;
+            let f = sp.force::<Dim2>(2, DVec2::new(0.0, -100.0e3 * 0.25), |id| x[id as usize]);
+            assert_eq!(f.y < 0.0, up, "reach {reach}: {f}");
+        }
     }
 
     #[test]
@@ -231,6 +275,7 @@ mod tests {
                     across: [1 - axis, 1 - axis],
                     links: [[NONE; 2]; 2],
                     spacing: [0.5, 0.0],
+                    reach: [2, 2],
                     normal,
                     share: 0.5,
                     radius_offset: 0.0,
@@ -253,6 +298,7 @@ mod tests {
                     across: [across[0], across[1]],
                     links: [[NONE; 2]; 2],
                     spacing: [0.5, 0.25],
+                    reach: [2, 2],
                     normal,
                     share: 0.125,
                     radius_offset: 0.0,

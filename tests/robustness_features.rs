@@ -478,16 +478,21 @@ fn a_study_refuses_a_reference_run_that_did_not_converge() {
 }
 
 /// `LimitPressure` reads a run's `limit_pressure` (the footing at h = 0.25 m: 50.33 kPa,
-/// −2.1 % on Prandtl's 51.42 kPa), and is refused on a scene without a loaded motion.
+/// −2.1 % on Prandtl's 51.42 kPa), and is refused on a scene without a loaded motion;
+/// `MeanPressure` reads the mean of a curve row's pressures, and is refused for a row the
+/// scene does not have.
 #[test]
-fn a_study_measures_a_limit_pressure_and_refuses_one_without_a_loaded_motion() {
+fn a_study_measures_a_limit_and_a_mean_pressure_and_refuses_what_the_scene_lacks() {
     let dir = common::scratch("features", "study-limit-pressure");
     let quantity = r#"quantities: [(name: "p", of: LimitPressure, compare: Analytic(51415.93))]"#;
+    let steady =
+        r#"(name: "mean", of: MeanPressure(name: "footing", from: 0.05), compare: Analytic(51415.93))"#;
     let study = study_file(
         &dir,
         "footing.ron",
         &format!(
-            r#"Study(scene: "SCENES/footing.ron", axes: [Set(path: "solver.tolerance", values: ["0.01"])], {quantity})"#
+            r#"Study(scene: "SCENES/footing.ron", axes: [Set(path: "solver.tolerance", values: ["0.01"])], {})"#,
+            quantity.replace(")]", &format!("), {steady}]"))
         ),
     );
     let out = dir.join("out");
@@ -513,6 +518,33 @@ fn a_study_measures_a_limit_pressure_and_refuses_one_without_a_loaded_motion() {
     assert!(
         common::rel(col("error p"), 50328.638082202015 / 51415.93 - 1.0).abs() < 1e-6,
         "{table}"
+    );
+    // `MeanPressure`: the mean of the static pressures from 5 cm on (the six of
+    // docs/verification.md's table, 48.71 to 50.33 kPa).
+    assert!(
+        common::rel(col("mean"), 49660.135411108095).abs() < 1e-6,
+        "{table}"
+    );
+    let unknown = study_file(
+        &dir,
+        "unknown.ron",
+        &format!(
+            r#"Study(scene: "SCENES/footing.ron", axes: [Set(path: "solver.tolerance", values: ["0.01"])], quantities: [{}])"#,
+            steady.replace("\"footing\"", "\"cone\"")
+        ),
+    );
+    let o = common::kdmpm(&[
+        "study",
+        unknown.to_str().unwrap(),
+        "--quiet",
+        "--out",
+        dir.join("out3").to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("no curve row `cone`") && err.contains("are footing"),
+        "{err}"
     );
     let column = study_file(
         &dir,

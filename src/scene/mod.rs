@@ -588,6 +588,26 @@ impl Scene {
     pub fn has_limit_pressure(&self) -> bool {
         self.motions.iter().any(|m| m.area.is_some()) || self.rigid_bodies.iter().any(|b| b.area.is_some())
     }
+
+    /// The names of `curve.csv`'s rows that carry a pressure: motions and rigid bodies with
+    /// an `area`, and parts with one (`body.part`).
+    pub fn pressure_rows(&self) -> Vec<String> {
+        let motions = self
+            .motions
+            .iter()
+            .filter(|m| m.area.is_some())
+            .map(|m| m.name.clone());
+        let bodies = self.rigid_bodies.iter().flat_map(|b| {
+            let whole = b.area.map(|_| b.name.clone());
+            let parts = b
+                .parts
+                .iter()
+                .filter(|p| p.area.is_some())
+                .map(move |p| format!("{}.{}", b.name, p.name));
+            whole.into_iter().chain(parts)
+        });
+        motions.chain(bodies).collect()
+    }
 }
 
 impl LoadedScene {

@@ -106,7 +106,7 @@ pub(super) fn place<D: Dim>(
                 // Neighbours along the surface: the columns one sub-cell before and after
                 // along each axis across the normal.
                 let mut links = [[NONE; 2]; 2];
-                let mut spacing = [0.0; 2];
+                let (mut spacing, mut reach) = ([0.0; 2], [1; 2]);
                 for (j, &a) in across.iter().enumerate() {
                     for (side, step) in [-1i64, 1].into_iter().enumerate() {
                         let mut k = key.clone();
@@ -116,6 +116,7 @@ pub(super) fn place<D: Dim>(
                         }
                     }
                     spacing[j] = subs[a];
+                    reach[j] = (s.grid.cell_size / subs[a]).round().max(1.0) as u32;
                 }
                 let mut outward = [0.0; 3];
                 outward[normal] = if upper { 1.0 } else { -1.0 };
@@ -130,6 +131,7 @@ pub(super) fn place<D: Dim>(
                         across: [across[0], *across.get(1).unwrap_or(&across[0])],
                         links,
                         spacing,
+                        reach,
                         normal: outward,
                         share,
                         radius_offset,

@@ -113,6 +113,16 @@ pub enum Quantity {
     StopTime,
     /// The limit pressure of the scene's motions (Pa; needs a motion with a loaded `area`).
     LimitPressure,
+    /// The mean pressure of `curve.csv`'s rows named `name` (a motion, a rigid body, or a
+    /// body's part as `body.part`, with an `area`) whose displacement is at least `from`
+    /// (m): a penetrometer's steady resistance, where the largest would be one state's
+    /// swing.
+    MeanPressure {
+        /// The rows' name.
+        name: String,
+        /// The displacement from which rows count (m, ≥ 0).
+        from: f64,
+    },
     /// The factor of safety by strength reduction (needs `strength_reduction`): each run
     /// is a `kdmpm fos` analysis, so a study of it measures nothing else.
     FactorOfSafety,
@@ -435,6 +445,23 @@ fn check_quantities(
                     "the scene has no `strength_reduction`: no factor of safety".into(),
                 ));
             }
+            Quantity::MeanPressure { name, from } => {
+                if !(from.is_finite() && *from >= 0.0) {
+                    return Err(at.invalid(
+                        &field,
+                        format!("`from` must be a displacement ≥ 0 m, found {from}"),
+                    ));
+                }
+                if !base.scene.pressure_rows().iter().any(|n| n == name) {
+                    return Err(at.invalid(
+                        &field,
+                        format!(
+                            "no curve row `{name}` has a pressure: the rows with an `area` are {}",
+                            base.scene.pressure_rows().join(", ")
+                        ),
+                    ));
+                }
+            }
             Quantity::LimitPressure if !base.scene.has_limit_pressure() => {
                 return Err(at.invalid(
                     &field,
@@ -530,6 +557,17 @@ pub fn read(q: &Quantity, summary: &serde_json::Value) -> Option<(f64, Option<[f
         Quantity::MaxDisplacement => Some((summary["max_displacement"].as_f64()?, None)),
         Quantity::StopTime => Some((summary["time"].as_f64()?, None)),
         Quantity::LimitPressure => Some((summary["limit_pressure"].as_f64()?, None)),
+        Quantity::MeanPressure { name, from } => {
+            let rows: Vec<f64> = summary["curve"]
+                .as_array()?
+                .iter()
+                .filter(|r| {
+                    r["name"] == name.as_str() && r["displacement"].as_f64().is_some_and(|d| d >= *from)
+                })
+                .filter_map(|r| r["pressure"].as_f64())
+                .collect();
+            (!rows.is_empty()).then(|| (rows.iter().sum::<f64>() / rows.len() as f64, None))
+        }
         Quantity::FactorOfSafety => Some((summary["factor_of_safety"].as_f64()?, None)),
     }
 }
