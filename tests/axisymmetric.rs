@@ -67,7 +67,7 @@ fn a_pressure_on_the_bore_acts_on_the_bore_as_it_has_grown() {
         summary["traced"][0]["displacement"][0].as_f64().unwrap()
     };
     let (with_traction, with_pressure) = (traced_u(&[], "lame_traction"), traced_u(&[bore], "lame_pressure"));
-    assert_eq!(with_pressure, 0.0014200017735020612);
+    assert_eq!(with_pressure, 0.0014200017735020607);
     let (a, b, p, nu, e) = (1.0f64, 2.0f64, 100.0e3, 0.3, 100.0e6);
     let (big_a, big_b) = (p * a * a / (b * b - a * a), p * a * a * b * b / (b * b - a * a));
     let growth = (1.0 + nu) / e * ((1.0 - 2.0 * nu) * big_a + big_b / (a * a));
@@ -251,7 +251,7 @@ fn at_d4(travel: &str) -> [&str; 4] {
 /// `scenes/cpt.ron` at h = D/4 over its first D/4 from the surface, in one increment: the
 /// cone's tip takes the whole resistance and its smooth shaft none (the face the tip and
 /// the shaft share is inside the body, not sampled; its corner samples at the shoulder take
-/// a little). N_kt = (q_c − σ_v0)/c_u = 8.48 there, still rising, pinned; the shipped scene
+/// a little). N_kt = (q_c − σ_v0)/c_u = 7.79 there, still rising, pinned; the shipped scene
 /// (h = D/8, 10 D) is in docs/verification.md.
 #[test]
 fn a_smooth_cone_takes_its_resistance_at_the_tip() {
@@ -265,14 +265,16 @@ fn a_smooth_cone_takes_its_resistance_at_the_tip() {
     assert!(shaft.force[1].abs() < 0.01 * tip.force[1].abs(), "{shaft:?}");
     assert_eq!(shaft.pressure, None);
     let n_kt = (tip.pressure.unwrap() - 100.0e3) / 10.0e3;
-    assert_eq!(n_kt, 8.479736396353196);
+    assert_eq!(n_kt, 7.792174954797936);
 }
 
 /// `scenes/pile_jacking.ron` at h = D/4 over its first D/2: the base's N_c = (q_b − σ_v0)/c_u
-/// rises (15.99, 17.98: at R = 2 cells the base's corner samples reach far beyond it) and
-/// the shaft's stress, its force per radian over R times its length in the clay, is near
-/// the interface's adhesion α c_u = 5 kPa (2.92, 3.69 kPa). Pinned; the shipped scene
-/// (h = D/8, 10 D) is in docs/verification.md.
+/// rises (13.61, 15.23: at R = 2 cells the base's corner samples reach far beyond it) and
+/// the shaft's stress, its force per radian over R times its length in the clay, is above
+/// the interface's adhesion α c_u = 5 kPa (5.78, 5.61 kPa): the shaft's samples next to the
+/// base's corner take some of the base's bearing, a force that does not grow with the
+/// length, so the stress falls towards the cap as the pile goes in (5.14 kPa over the first
+/// 2 D at h = D/8, docs/verification.md). Pinned.
 #[test]
 fn a_jacked_pile_carries_its_base_bearing_and_its_shaft_adhesion() {
     let s = run("pile_jacking.ron", &at_d4("rigid_bodies[0].motion.travel=0.5"));
@@ -291,10 +293,10 @@ fn a_jacked_pile_carries_its_base_bearing_and_its_shaft_adhesion() {
         .map(|c| c.force[1] / (0.5 * (1.0 - 0.0625 + c.displacement)))
         .collect();
     assert!(n_c[1] > n_c[0], "{n_c:?}");
-    // The soil's drag on the shaft is upward: the force on the soil is downward. Within
-    // 10 % of the cap (at 0.05 m/s the first state's is 5.17 kPa: the clay heaves a little
-    // up the shaft, beyond the length counted).
-    assert!(stress.iter().all(|&t| t < 0.0 && t > -5.5e3), "{stress:?}");
-    assert_eq!(n_c[1], 17.984046637944168);
-    assert_eq!(stress[1], -3689.007888529283);
+    // The soil's drag on the shaft is upward: the force on the soil is downward; above the
+    // cap by the corner's share, which the longer shaft spreads thinner.
+    assert!(stress.iter().all(|&t| t < -5.0e3), "{stress:?}");
+    assert!(stress[1] > stress[0], "{stress:?}");
+    assert_eq!(n_c[1], 15.233695473738946);
+    assert_eq!(stress[1], -5612.4899128568495);
 }
