@@ -440,6 +440,21 @@ fn study_file(dir: &Path, name: &str, text: &str) -> PathBuf {
     path
 }
 
+/// Runs `kdmpm study` on `study` into `out`, which must refuse it as bad input (exit 2),
+/// and returns its message.
+fn study_refusal(study: &Path, out: &Path) -> String {
+    let o = common::kdmpm(&[
+        "study",
+        study.to_str().unwrap(),
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr).into_owned();
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    err
+}
+
 /// A reference that ended at max_steps once gave every run an error against a state that
 /// is not static (52 %, all on the Pareto front); the study now stops and says so.
 #[test]
@@ -533,15 +548,7 @@ fn a_study_measures_a_limit_and_a_mean_pressure_and_refuses_what_the_scene_lacks
             steady.replace("\"footing\"", "\"cone\"")
         ),
     );
-    let o = common::kdmpm(&[
-        "study",
-        unknown.to_str().unwrap(),
-        "--quiet",
-        "--out",
-        dir.join("out3").to_str().unwrap(),
-    ]);
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(2), "{err}");
+    let err = study_refusal(&unknown, &dir.join("out3"));
     assert!(
         err.contains("no curve row `cone`") && err.contains("are footing"),
         "{err}"
@@ -553,15 +560,7 @@ fn a_study_measures_a_limit_and_a_mean_pressure_and_refuses_what_the_scene_lacks
             r#"Study(scene: "SCENES/soil_column.ron", axes: [Set(path: "solver.tolerance", values: ["1e-3"])], {quantity})"#
         ),
     );
-    let o = common::kdmpm(&[
-        "study",
-        column.to_str().unwrap(),
-        "--quiet",
-        "--out",
-        dir.join("out2").to_str().unwrap(),
-    ]);
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(2), "{err}");
+    let err = study_refusal(&column, &dir.join("out2"));
     assert!(err.contains("no motion with a loaded `area`"), "{err}");
     let _ = std::fs::remove_dir_all(&dir);
 }

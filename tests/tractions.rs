@@ -23,6 +23,20 @@ fn m(e: f64, nu: f64) -> f64 {
     e * (1.0 - nu) / ((1.0 + nu) * (1.0 - 2.0 * nu))
 }
 
+/// The plane strain column's traced point `mid` under a top pressure `p` (Pa): σ_yy = −p
+/// and a settlement of p y/M, each within 1 %.
+fn assert_mid_under(s: &kdmpm::Summary, p: f64) {
+    assert!(s.converged, "{:?}", s.error);
+    let mid = &s.traced[0];
+    assert!(rel(mid.stress.yy, -p).abs() < 0.01, "σ_yy {}", mid.stress.yy);
+    let expected = -p * mid.initial_position[1] / m(1.0e7, 0.3);
+    assert!(
+        rel(mid.displacement[1], expected).abs() < 0.01,
+        "u_y {:?}",
+        mid.displacement
+    );
+}
+
 #[test]
 fn a_pressure_on_a_plane_strain_column_gives_its_stress_and_settlement() {
     let s = run_text("traction.ron", COLUMN_2D);
@@ -120,16 +134,8 @@ fn a_stage_that_doubles_the_pressure_doubles_the_stress_and_settlement() {
     traced:"#,
     );
     let s = run_text("traction.ron", &staged);
-    assert!(s.converged, "{:?}", s.error);
     assert_eq!(s.stages.len(), 2);
-    let mid = &s.traced[0];
-    assert!(rel(mid.stress.yy, -20.0e3).abs() < 0.01, "σ_yy {}", mid.stress.yy);
-    let expected = -20.0e3 * mid.initial_position[1] / m(1.0e7, 0.3);
-    assert!(
-        rel(mid.displacement[1], expected).abs() < 0.01,
-        "u_y {:?}",
-        mid.displacement
-    );
+    assert_mid_under(&s, 20.0e3);
 }
 
 /// A `pressure` on the column's flat top is the traction −p n, at the start and as the
@@ -138,25 +144,13 @@ fn a_stage_that_doubles_the_pressure_doubles_the_stress_and_settlement() {
 #[test]
 fn a_pressure_on_a_flat_top_loads_it_as_the_traction_does_and_a_stage_doubles_it() {
     let pressed = COLUMN_2D.replace("traction: [0.0, -10.0e3]", "pressure: 10.0e3");
-    let s = run_text("pressure.ron", &pressed);
-    assert!(s.converged, "{:?}", s.error);
-    let mid = &s.traced[0];
-    assert!(rel(mid.stress.yy, -10.0e3).abs() < 0.01, "σ_yy {}", mid.stress.yy);
-    let expected = -10.0e3 * mid.initial_position[1] / m(1.0e7, 0.3);
-    assert!(
-        rel(mid.displacement[1], expected).abs() < 0.01,
-        "u_y {:?}",
-        mid.displacement
-    );
+    assert_mid_under(&run_text("pressure.ron", &pressed), 10.0e3);
     let staged = pressed.replace(
         "    traced:",
         r#"    stages: [(name: "first"), (name: "doubled", tractions: {"p": [20.0e3]})],
     traced:"#,
     );
-    let s = run_text("pressure.ron", &staged);
-    assert!(s.converged, "{:?}", s.error);
-    let mid = &s.traced[0];
-    assert!(rel(mid.stress.yy, -20.0e3).abs() < 0.01, "σ_yy {}", mid.stress.yy);
+    assert_mid_under(&run_text("pressure.ron", &staged), 20.0e3);
 }
 
 #[test]

@@ -23,8 +23,9 @@ pub(super) fn place<D: Dim>(
     let s = &loaded.scene;
     let n = D::N;
     let mut placed = Placed::default();
-    // The points under a pressure, by id: which traction, and their places in its surface.
-    let mut pressed_by: BTreeMap<u32, usize> = BTreeMap::new();
+    // Every loaded point, by id: the traction that loaded it and whether it is a pressure.
+    let mut loaded_by: BTreeMap<u32, (usize, bool)> = BTreeMap::new();
+    // The points under a pressure and their places in its surface.
     let mut followers: Vec<(u32, SurfacePoint)> = Vec::new();
     for (i, t) in s.tractions.iter().enumerate() {
         let (normal, upper) = t.surface.axis_side();
@@ -86,17 +87,14 @@ pub(super) fn place<D: Dim>(
                 let x = D::vec_to3(world.get::<&Position<D::Vec>>(e).expect("a live point").0);
                 x[..n].to_vec()
             };
+            if let Some(&(j, earlier_pressed)) = loaded_by.get(&id) {
+                if pressed || earlier_pressed {
+                    return Err(shared_point(loaded, i, j, at()));
+                }
+            }
+            loaded_by.entry(id).or_insert((i, pressed));
             let f = D::vec_from(t.vector()) * share;
             let earlier = world.get::<&PointLoad<D::Vec>>(e).map(|p| p.0).ok();
-            if let Some(&j) = pressed_by.get(&id) {
-                return Err(shared_point(loaded, i, j, at()));
-            }
-            if let (true, Some(_)) = (pressed, earlier) {
-                let j = (0..i)
-                    .find(|&j| placed.shares[j].1.iter().any(|s| s.0 == id))
-                    .expect("an earlier traction loaded it");
-                return Err(shared_point(loaded, i, j, at()));
-            }
             world
                 .insert_one(e, PointLoad(earlier.map_or(f, |g| g + f)))
                 .expect("a live point");
@@ -124,7 +122,6 @@ pub(super) fn place<D: Dim>(
                     (true, 0) => outward[0] * 0.5 * subs[0],
                     _ => 0.0,
                 };
-                pressed_by.insert(id, i);
                 followers.push((
                     id,
                     SurfacePoint {

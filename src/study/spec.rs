@@ -452,12 +452,13 @@ fn check_quantities(
                         format!("`from` must be a displacement ≥ 0 m, found {from}"),
                     ));
                 }
-                if !base.scene.pressure_rows().iter().any(|n| n == name) {
+                let rows = base.scene.pressure_rows();
+                if !rows.contains(name) {
                     return Err(at.invalid(
                         &field,
                         format!(
                             "no curve row `{name}` has a pressure: the rows with an `area` are {}",
-                            base.scene.pressure_rows().join(", ")
+                            rows.join(", ")
                         ),
                     ));
                 }
