@@ -33,7 +33,7 @@ use thiserror::Error;
 /// The first bytes of a checkpoint file.
 const MAGIC: &[u8; 8] = b"KDMPMCK\0";
 /// Format version; a file of another version is refused.
-const VERSION: u32 = 10;
+const VERSION: u32 = 11;
 /// The build that writes and reads checkpoints: the crate's version and a fingerprint of
 /// its sources (build.rs).
 pub const BUILD_ID: &str = concat!(env!("CARGO_PKG_VERSION"), "+", env!("KDMPM_SOURCE_HASH"));
@@ -458,6 +458,8 @@ fn encode_control(w: &mut Writer, c: &Control) {
         let BodyState {
             name,
             velocity,
+            load,
+            contact_mass: _,
             offset,
             travel,
             increments,
@@ -469,6 +471,7 @@ fn encode_control(w: &mut Writer, c: &Control) {
         w.str(name);
         velocity
             .iter()
+            .chain(load)
             .chain(offset)
             .chain(reaction)
             .for_each(|&c| w.f64(c));
@@ -540,6 +543,8 @@ fn decode_control(r: &mut Reader) -> Result<Control, CheckpointError> {
         c.bodies.push(BodyState {
             name: r.str()?,
             velocity: [r.f64()?, r.f64()?, r.f64()?],
+            load: [r.f64()?, r.f64()?, r.f64()?],
+            contact_mass: 0.0,
             offset: [r.f64()?, r.f64()?, r.f64()?],
             reaction: [r.f64()?, r.f64()?, r.f64()?],
             travel: r.f64()?,

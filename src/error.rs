@@ -141,6 +141,43 @@ pub enum StepError {
         /// Step number.
         step: u64,
     },
+    /// A rigid body's increment found no static state before the run's `max_time`.
+    #[error(
+        "step {step}, t = {time:.4} s: rigid body \"{body}\" found no static state in increment {increment} \
+         before solver.max_time (K_F {force_ratio:.3e}, the body's load out of balance by {unbalanced:.3e} of it): \
+         the soil cannot carry it there, or the run needs more time; the curve so far is kept"
+    )]
+    NoStaticState {
+        /// Step number.
+        step: u64,
+        /// Time (s).
+        time: f64,
+        /// The body's name.
+        body: String,
+        /// The increment (1-based).
+        increment: u32,
+        /// K_F at the stop.
+        force_ratio: f64,
+        /// The body's out-of-balance force over its load (0 under displacement control).
+        unbalanced: f64,
+    },
+    /// A rigid body under load control moved out of the grid.
+    #[error(
+        "step {step}: rigid body \"{body}\" under load control left the grid in increment {increment} \
+         (it spans {lo:?}..{hi:?} m): the soil does not carry its load; the curve so far is kept"
+    )]
+    BodyLeftGrid {
+        /// Step number.
+        step: u64,
+        /// The body's name.
+        body: String,
+        /// The increment (1-based).
+        increment: u32,
+        /// Its bounds now (m).
+        lo: [f64; 3],
+        /// Its bounds now (m).
+        hi: [f64; 3],
+    },
     /// Writing output failed.
     #[error("writing output: {0}")]
     Io(#[from] std::io::Error),

@@ -580,11 +580,31 @@ pub struct Control {
 }
 
 impl Control {
-    /// True while a prescribed motion or a rigid body moves: not a static state, however
-    /// balanced.
+    /// True while a prescribed motion or a rigid body under displacement control moves: not
+    /// a static state, however balanced (a body under load control moves until it is
+    /// balanced: [`Control::unbalanced`]).
     pub fn driving(&self) -> bool {
         self.drives.iter().any(|d| d.velocity != [0.0; 3])
-            || self.bodies.iter().any(|b| b.velocity != [0.0; 3])
+            || self
+                .bodies
+                .iter()
+                .any(|b| b.velocity != [0.0; 3] && b.load == [0.0; 3])
+    }
+
+    /// The largest out-of-balance force along its load of a body under load control, over
+    /// the load (0 when no body carries one): a static state needs it within the
+    /// tolerance as K_F is.
+    pub fn unbalanced(&self) -> f64 {
+        self.bodies
+            .iter()
+            .filter(|b| b.load != [0.0; 3])
+            .map(|b| {
+                let f2: f64 = b.load.iter().map(|c| c * c).sum();
+                // The load plus the soil's resistance (−reaction), along the load.
+                let net: f64 = (0..3).map(|a| (b.load[a] - b.reaction[a]) * b.load[a]).sum();
+                net.abs() / f2
+            })
+            .fold(0.0, f64::max)
     }
 }
 

@@ -372,3 +372,10 @@ fn a_new_run_into_a_directory_drops_the_checkpoint_of_the_run_before() {
     assert_eq!(o.status.code(), Some(2), "{}", String::from_utf8_lossy(&o.stderr));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The rigid footing under load control, checkpointed in its ninth increment (step 1 500
+/// of 2 151): the body's load, velocity and settlement come back with the points.
+#[test]
+fn a_rigid_body_under_load_control_resumed_mid_increment_writes_the_same_curve() {
+    resume_from_last_checkpoint("footing_rigid_load.ron", 1_500, &[]);
+}

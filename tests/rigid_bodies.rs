@@ -377,3 +377,114 @@ fn a_smooth_wall_pushed_into_sand_meets_rankines_passive_thrust() {
     );
     assert_eq!(thrust[2], 105109.39838322405);
 }
+
+/// `scenes/footing_rigid_load.ron`: the rigid footing under load control, 5 kPa a time to
+/// 55 kPa. The footing settles until the soil carries each load, and the curve it traces
+/// is the displacement-controlled one of `footing_rigid.ron` (54.98 kPa at 3 cm there;
+/// 55.03 kPa at 3.17 cm here). Its pressure is the load it was given, no limit.
+#[test]
+fn a_footing_under_load_control_settles_along_the_displacement_controlled_curve() {
+    let s = run("footing_rigid_load.ron", &[]);
+    assert_eq!(s.curve.len(), 11);
+    assert_eq!(s.limit_pressure, None);
+    let last = &s.curve[10];
+    assert_eq!(last.displacement, 0.0316885482571908);
+    assert_eq!(s.rigid_bodies[0].travel, last.displacement);
+    // Each static state carries its load within the tolerance (1 %).
+    for (k, c) in s.curve.iter().enumerate() {
+        let load = 5.0e3 * (k + 1) as f64;
+        assert!(rel(-c.force[1], load).abs() < 0.01, "{k}: {:?}", c.force);
+    }
+    // Settlements grow faster than the load towards the limit.
+    let step = |k: usize| s.curve[k].displacement - if k > 0 { s.curve[k - 1].displacement } else { 0.0 };
+    assert!(step(10) > 5.0 * step(0), "{} against {}", step(10), step(0));
+    let d = run("footing_rigid.ron", &["rigid_bodies[0].motion.travel=0.03"]);
+    assert!(
+        rel(-d.curve[2].force[1], -last.force[1]).abs() < 0.01 && (last.displacement - 0.03).abs() < 0.002,
+        "{:?} at 3 cm against {:?} at {}",
+        d.curve[2].force,
+        last.force,
+        last.displacement
+    );
+}
+
+/// In an elastic soil (c = 1 GPa) the static answer does not depend on the path: the
+/// force that holds the footing 1 mm down under slow displacement control (0.001 m/s,
+/// K_F and K_E ≤ 1e-4: 5.609 kN) settles it 1 mm under load control, within 1 %.
+#[test]
+fn a_load_settles_an_elastic_footing_as_far_as_that_force_pushed_it() {
+    let elastic = ["materials.clay.cohesion=1.0e9", "solver.tolerance=0.0001"];
+    let mut pushed = elastic.to_vec();
+    pushed.extend([
+        "rigid_bodies[0].motion.travel=0.001",
+        "rigid_bodies[0].motion.velocity=[0.0, -0.001]",
+    ]);
+    let d = run("footing_rigid.ron", &pushed);
+    let force = d.curve[0].force[1];
+    assert_eq!(force, -5608.552142772661);
+    let set = format!("rigid_bodies[0].load.force=[0.0, {force:?}]");
+    let mut loaded = elastic.to_vec();
+    loaded.push(&set);
+    let l = run(
+        "footing_rigid_load.ron",
+        &loaded
+            .iter()
+            .copied()
+            .chain(["rigid_bodies[0].load.increments=1"])
+            .collect::<Vec<_>>(),
+    );
+    let settlement = l.curve[0].displacement;
+    assert_eq!(settlement, 0.0009928618617841393);
+    assert!(rel(settlement, 0.001).abs() < 0.01, "{settlement} m");
+}
+
+/// A load the soil cannot carry (80 kPa, above the 57.4 kPa the footing reaches): the
+/// first increment (40 kPa) rests, the second finds no static state and the run stops
+/// naming it, with the first increment's row kept.
+#[test]
+fn a_load_above_the_limit_stops_the_run_naming_its_increment() {
+    let s = run(
+        "footing_rigid_load.ron",
+        &[
+            "rigid_bodies[0].load=(force: [0.0, -80.0e3], increments: 2)",
+            "solver.max_time=0.8",
+        ],
+    );
+    let e = s.error.expect("the run stops");
+    assert!(
+        e.contains("rigid body \"footing\" found no static state in increment 2"),
+        "{e}"
+    );
+    assert_eq!(s.curve.len(), 1);
+    assert!(rel(-s.curve[0].force[1], 40.0e3).abs() < 0.01);
+}
+
+#[test]
+fn a_body_driven_by_both_a_motion_and_a_load_or_by_a_zero_load_is_refused() {
+    let e = refused(
+        "increment: 0.05),",
+        "increment: 0.05), load: (force: [0.0, -1.0e3]),",
+    );
+    assert!(
+        e.contains("rigid_bodies[0].load") && e.contains("not both"),
+        "{e}"
+    );
+    let e = refused(
+        "motion: (velocity: [0.0, -0.01], travel: 0.1, increment: 0.05),",
+        "load: (force: [0.0, 0.0]),",
+    );
+    assert!(
+        e.contains("rigid_bodies[0].load.force") && e.contains("zero"),
+        "{e}"
+    );
+    let e = refused(
+        "motion: (velocity: [0.0, -0.01], travel: 0.1, increment: 0.05),",
+        "load: (force: [0.0, -1.0e3], increments: 0),",
+    );
+    assert!(e.contains("rigid_bodies[0].load.increments"), "{e}");
+    let e = refused(
+        "motion: (velocity: [0.0, -0.01], travel: 0.1, increment: 0.05),",
+        "load: (force: [0.0, -1.0e3], mass: -1.0),",
+    );
+    assert!(e.contains("rigid_bodies[0].load.mass"), "{e}");
+}

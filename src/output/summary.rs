@@ -258,9 +258,11 @@ impl Summary {
             .control
             .curve
             .iter()
-            // Motions' and whole bodies' rows (a part's row has its own name).
+            // Motions' and whole bodies' rows (a part's row has its own name), not a body's
+            // under load control: its pressure is the load it was given.
             .filter(|c| {
-                st.motions.iter().any(|m| m.name == c.name) || st.bodies.iter().any(|b| b.name == c.name)
+                st.motions.iter().any(|m| m.name == c.name)
+                    || st.bodies.iter().any(|b| b.name == c.name && b.load.is_none())
             })
             .cloned()
             .collect();

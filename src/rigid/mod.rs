@@ -5,9 +5,14 @@
 //! the grid (`systems::rigid_contact`): at each node the soil touches it, the soil may not
 //! move into the body along the geometry's normal, and the tangential motion is free
 //! (smooth), the body's (rough), or limited by Coulomb friction and an adhesion cap. The
-//! force this takes is summed per body in node order (its reaction is the opposite). The body travels in
-//! increments (`systems::rigid_control`), each relaxed to a static state and recorded as
-//! a row of `curve.csv`, as `motions` do; kinetic damping never stops the body.
+//! force this takes is summed per body in node order (its reaction is the opposite).
+//!
+//! A body is driven one of two ways (`systems::rigid_control`), in increments each relaxed
+//! to a static state and recorded as a row of `curve.csv`: under displacement control
+//! (`motion`) it travels at a velocity, as `motions` do, and kinetic damping never stops
+//! it; under load control (`load`) a force acts on it and it finds its own place along
+//! the force, moving as a mass the soil's resistance decelerates, its velocity zeroed with
+//! the soil's at each kinetic-energy peak.
 
 pub mod contact;
 pub mod geometry;
@@ -33,6 +38,9 @@ pub struct RigidBodySpec {
     /// and its reaction is recorded at every static state another control reaches.
     #[serde(default)]
     pub motion: Option<BodyMotion>,
+    /// Load control instead of `motion`: a force on the body, in increments.
+    #[serde(default)]
+    pub load: Option<BodyLoad>,
     /// Loaded area (m²; m per metre of thickness in 2D; m² per radian when axisymmetric),
     /// for the mean pressure in `curve.csv` and `limit_pressure` in summary.json.
     #[serde(default)]
@@ -87,6 +95,51 @@ pub struct BodyMotion {
     /// place (a geostatic stage, then penetration). Default: from the start of the run.
     #[serde(default)]
     pub stage: Option<String>,
+}
+
+/// Load control: a force on the body applied in equal increments; the body moves along it
+/// (guided: across it and in rotation it holds) until the soil's resistance balances it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BodyLoad {
+    /// The force on the body at the last increment (N; N/m in 2D; N/rad when
+    /// axisymmetric), one entry per axis.
+    pub force: Vec<f64>,
+    /// Equal increments it is applied in, each relaxed to a static state (default 1).
+    #[serde(default = "one")]
+    pub increments: u32,
+    /// The stage (by name) at whose start the load comes on. Default: from the start.
+    #[serde(default)]
+    pub stage: Option<String>,
+    /// The body's mass (kg; kg/m in 2D; kg/rad when axisymmetric), which sets how fast it
+    /// moves as the soil relaxes, not where it ends. Default: the mass of the soil it
+    /// displaces, its volume in the grid times the densest material's density.
+    #[serde(default)]
+    pub mass: Option<f64>,
+}
+
+fn one() -> u32 {
+    1
+}
+
+impl BodyLoad {
+    /// The force as x y z (N).
+    pub fn vector(&self) -> [f64; 3] {
+        std::array::from_fn(|a| self.force.get(a).copied().unwrap_or(0.0))
+    }
+
+    /// The force during increment `k` (0-based): its (k + 1)/increments share (N, x y z).
+    pub fn at(&self, k: u32) -> [f64; 3] {
+        let share = f64::from(k.min(self.increments - 1) + 1) / f64::from(self.increments);
+        self.vector().map(|f| f * share)
+    }
+
+    /// The unit vector along the force.
+    pub fn direction(&self) -> [f64; 3] {
+        let f = self.vector();
+        let l = f.iter().map(|c| c * c).sum::<f64>().sqrt();
+        f.map(|c| c / l)
+    }
 }
 
 impl BodyMotion {
@@ -190,6 +243,34 @@ impl RigidBodySpec {
                 return bad("area", format!("must be above 0, found {a}"));
             }
         }
+        if let Some(l) = &self.load {
+            if self.motion.is_some() {
+                return bad(
+                    "load",
+                    "a body is driven by a motion or by a load, not both: drop one".into(),
+                );
+            }
+            if l.force.len() != n || !finite(&l.force) {
+                return bad(
+                    "load.force",
+                    format!("needs {n} finite entries (N), found {:?}", l.force),
+                );
+            }
+            if l.vector() == [0.0; 3] {
+                return bad("load.force", "the load is zero: give it a force".into());
+            }
+            if !(1..=1_000_000).contains(&l.increments) {
+                return bad(
+                    "load.increments",
+                    format!("must be 1 to a million, found {}", l.increments),
+                );
+            }
+            if let Some(m) = l.mass {
+                if !(m.is_finite() && m > 0.0) {
+                    return bad("load.mass", format!("must be above 0 kg, found {m}"));
+                }
+            }
+        }
         let Some(m) = &self.motion else {
             return Ok(());
         };
@@ -239,15 +320,75 @@ impl RigidBodySpec {
             .collect()
     }
 
-    /// True when the body moves during stage `k` of `stages` (the scene's stage names, in
-    /// order; none for a scene without stages): it has a motion, and no `motion.stage` or
-    /// one among the first k + 1.
-    pub fn moves_in(&self, k: usize, stages: &[&str]) -> bool {
-        match &self.motion {
-            None => false,
-            Some(BodyMotion { stage: None, .. }) => true,
-            Some(BodyMotion { stage: Some(s), .. }) => stages.iter().take(k + 1).any(|t| t == s),
+    /// The increments its control drives it in (0 for a body that holds its place).
+    pub fn increments(&self) -> u32 {
+        match (&self.motion, &self.load) {
+            (Some(m), _) => match m.increment {
+                Some(inc) => ((m.travel / inc) * (1.0 - 1e-9)).ceil().max(1.0) as u32,
+                None => 1,
+            },
+            (_, Some(l)) => l.increments,
+            _ => 0,
         }
+    }
+
+    /// The stage its control waits for (`motion.stage` or `load.stage`), if any.
+    pub fn stage(&self) -> Option<&String> {
+        match (&self.motion, &self.load) {
+            (Some(m), _) => m.stage.as_ref(),
+            (_, Some(l)) => l.stage.as_ref(),
+            _ => None,
+        }
+    }
+
+    /// True when the body is driven during stage `k` of `stages` (the scene's stage names,
+    /// in order; none for a scene without stages): it has a motion or a load, and no stage
+    /// to wait for or one among the first k + 1.
+    pub fn moves_in(&self, k: usize, stages: &[&str]) -> bool {
+        if self.motion.is_none() && self.load.is_none() {
+            return false;
+        }
+        match self.stage() {
+            None => true,
+            Some(s) => stages.iter().take(k + 1).any(|t| t == s),
+        }
+    }
+
+    /// Its volume inside the grid (m³; m² in 2D; m² per radian when axisymmetric, ∫ r dA),
+    /// by the midpoint rule over the grid's cells (`origin`, `cell` size, `cells` per axis):
+    /// the default mass of a body under load control.
+    pub fn volume(
+        &self,
+        n: usize,
+        axisymmetric: bool,
+        origin: [f64; 3],
+        cell: f64,
+        cells: [usize; 3],
+    ) -> f64 {
+        let (lo, hi) = self.bounds(n);
+        let range = |a: usize| -> (usize, usize) {
+            if a >= n {
+                return (0, 1);
+            }
+            let first = ((lo[a] - origin[a]) / cell).floor().max(0.0) as usize;
+            let last = (((hi[a] - origin[a]) / cell).ceil().max(0.0) as usize).min(cells[a]);
+            (first.min(last), last)
+        };
+        let (rx, ry, rz) = (range(0), range(1), range(2));
+        let mut volume = 0.0;
+        for k in rz.0..rz.1 {
+            for j in ry.0..ry.1 {
+                for i in rx.0..rx.1 {
+                    let c = [i, j, k].map(|c| c as f64 + 0.5);
+                    let x: [f64; 3] =
+                        std::array::from_fn(|a| if a < n { origin[a] + c[a] * cell } else { 0.0 });
+                    if self.distance(x, n).0 < 0.0 {
+                        volume += if axisymmetric { x[0] } else { 1.0 };
+                    }
+                }
+            }
+        }
+        volume * cell.powi(n as i32)
     }
 
     /// The body's state at the start of a run (`stages`: the scene's stage names): moving,
@@ -257,6 +398,10 @@ impl RigidBodySpec {
             name: self.name.clone(),
             velocity: match &self.motion {
                 Some(m) if self.moves_in(0, stages) => m.vector(),
+                _ => [0.0; 3],
+            },
+            load: match &self.load {
+                Some(l) if self.moves_in(0, stages) => l.at(0),
                 _ => [0.0; 3],
             },
             parts: vec![[0.0; 3]; self.parts.len()],
@@ -285,6 +430,13 @@ pub struct BodyState {
     pub name: String,
     /// Velocity this step (m/s, x y z; zero while holding).
     pub velocity: [f64; 3],
+    /// Under load control, the force on the body this increment (N, x y z); zero while it
+    /// waits for its stage, and always for a body without a load.
+    pub load: [f64; 3],
+    /// Σ m̃ over the nodes its contacts reached this step (kg): under load control, the
+    /// soil that moves with the body, added to its mass in its equation of motion (set by
+    /// `rigid_contact` each step, not kept in checkpoints).
+    pub contact_mass: f64,
     /// Displacement from its scene position (m, x y z).
     pub offset: [f64; 3],
     /// Distance travelled (m).

@@ -12,6 +12,7 @@ use crate::infra::columns::{col, points_with};
 use crate::infra::decomposition::Decomposition;
 use crate::materials::{MaterialModel, MaterialState, StateVisitor};
 use crate::parallel::SlabCache;
+use crate::rigid::RigidBodySpec;
 use crate::shape::{for_each_node, Linear, QuadraticBSpline, ShapeKind, UniformGimp};
 use crate::simulation::{AnySimulation, Simulation, TracedPoint};
 use crate::state::{Control, Gravity, LoadStage, MotionSpec, Settings, SolverState};
@@ -256,6 +257,25 @@ fn stages<D: Dim>(
     out
 }
 
+/// The scene's rigid bodies as the run takes them: a body under load control without a
+/// mass of its own gets the mass of the soil it displaces (its volume in the grid times
+/// the densest material's density, at least one cell's worth).
+fn loaded_bodies<D: Dim>(s: &Scene, grid: &Grid<D>, table: &[(String, MaterialModel)]) -> Vec<RigidBodySpec> {
+    let density = table.iter().map(|(_, m)| m.density()).fold(0.0, f64::max);
+    let h = grid.cell_size;
+    let origin = D::vec_to3(grid.origin);
+    let cells = std::array::from_fn(|a| grid.axes[a].cells);
+    let mut bodies = s.rigid_bodies.clone();
+    for b in &mut bodies {
+        let volume = b.volume(D::N, D::AXISYMMETRIC, origin, h, cells);
+        if let Some(l) = b.load.as_mut().filter(|l| l.mass.is_none()) {
+            let cell = h.powi(D::N as i32) * if D::AXISYMMETRIC { h } else { 1.0 };
+            l.mass = Some(density * volume.max(cell));
+        }
+    }
+    bodies
+}
+
 fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulation<D>, Derived), SceneError> {
     let Checked {
         grid: checked_grid,
@@ -328,7 +348,7 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         }),
         min_node_mass: s.solver.node_mass_cutoff * full_node_mass,
         motions: s.motions.clone(),
-        bodies: s.rigid_bodies.clone(),
+        bodies: loaded_bodies::<D>(s, &grid, &table),
         initial_energy,
         water,
         friction_faces: checked_grid

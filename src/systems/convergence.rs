@@ -246,7 +246,8 @@ impl<D: Dim> System<D> for Convergence {
         let tol = ctx.settings.tolerance;
         let time = s.clock.time;
         // A load still ramping up, or a prescribed motion still moving, is not a static
-        // state, however balanced this step is.
+        // state, however balanced this step is; nor is a body whose load the soil does not
+        // yet balance.
         let loading = ctx
             .settings
             .gravity
@@ -255,6 +256,7 @@ impl<D: Dim> System<D> for Convergence {
         // An undefined ratio (NaN) compares false: it never meets the tolerance.
         let met = !loading
             && s.convergence.force_ratio(ctx.settings.force_norm) <= tol
+            && s.control.unbalanced() <= tol
             && s.convergence.energy_ratio <= tol;
         let converged = match ctx.settings.static_check {
             None => met,

@@ -235,6 +235,19 @@ impl<D: Dim, S: Shape> System<D> for RigidContact<D, S> {
                 state.parts[p.part][a] += p.impulse[a] / dt;
             }
         }
+        // The soil that moves with each body: every node its contacts reach, once.
+        let mut seen = vec![u32::MAX; set.slots.len()];
+        for state in &mut control.bodies {
+            state.contact_mass = 0.0;
+        }
+        for p in &set.contacts {
+            for &(k, _) in &p.nodes {
+                if seen[k] != p.body as u32 {
+                    seen[k] = p.body as u32;
+                    control.bodies[p.body].contact_mass += set.slots[k].inertia;
+                }
+            }
+        }
         control.contacts = set;
         Ok(())
     }

@@ -1,12 +1,30 @@
-//! Displacement control of the rigid bodies: each travels its distance in increments, and
-//! the static state that ends an increment is a row of the curve.
+//! Control of the rigid bodies: each is driven in increments, and the static state that
+//! ends an increment is a row of the curve.
 //!
-//! A body moves one increment at its velocity, then holds still while kinetic damping
-//! relaxes the soil to a static state (the run's own stopping rule); the state is recorded
-//! (`curve.csv`: travel, the soil's resistance on the body, the mean pressure over its
-//! `area`, and a row per part for a body of several) and the next increment starts. A
-//! kinetic-damping reset zeroes the soil's velocities, never the body's: a plain reset
-//! step moves nothing, and the body travels nothing in it.
+//! Under displacement control (`motion`) a body moves one increment at its velocity, then
+//! holds still while kinetic damping relaxes the soil to a static state (the run's own
+//! stopping rule); the state is recorded (`curve.csv`: travel, the soil's resistance on
+//! the body, the mean pressure over its `area`, and a row per part for a body of several)
+//! and the next increment starts. A kinetic-damping reset zeroes the soil's velocities,
+//! never the body's: a plain reset step moves nothing, and the body travels nothing in it.
+//!
+//! Under load control (`load`) the force F_k of increment k acts on the body, which moves
+//! along the load's direction e only (guided), as a mass M with the soil its contacts
+//! reach (m_c, `BodyState::contact_mass`):
+//!
+//!   V ← V + Δt ((F_k − R)·e) / (M + m_c),
+//!
+//! R the force it exerts on the soil this step (`rigid_contact`). Counting m_c makes the
+//! update the momentum balance of the body and the soil held to it, which is stable at
+//! the soil's own time step for any M; where the body rests (F_k = R·e) neither mass
+//! matters. The body's kinetic energy ½ M V² is part of the energy the peak watch follows,
+//! and a reset zeroes V with the soil's velocities. The static state needs |F_k − R|·e
+//! within the tolerance of |F_k| as well as the run's K_F and K_E (`convergence`); its
+//! travel is the displacement along e.
+//!
+//! A body whose increment finds no static state before `max_time` stops the run with
+//! [`StepError::NoStaticState`] naming the increment; a loaded body that leaves the grid
+//! stops it with [`StepError::BodyLeftGrid`]. The curve so far is kept.
 //!
 //! Grid contact holds the soil's velocity at the nodes inside a body, so the points near
 //! its surface move with a field that does not enter it; a point whose centre still ends a
@@ -18,10 +36,12 @@ use crate::components::{Displacement, Position};
 use crate::context::Context;
 use crate::dim::Dim;
 use crate::error::StepError;
+use crate::grid::Grid;
 use crate::infra::columns::{col_mut, points_with};
-use crate::rigid::RigidBodySpec;
+use crate::rigid::{BodyLoad, BodyState, RigidBodySpec};
 use crate::schedule::System;
 use crate::state::{CurvePoint, StopReason};
+use crate::state::{Settings, SolverState};
 use crate::systems::increments::Increments;
 
 /// Moves the bodies, holds them at the end of an increment and, at the static state that
@@ -71,6 +91,74 @@ fn push_out<D: Dim>(ctx: &mut Context<D>, bodies: &[RigidBodySpec]) -> Vec<(u64,
     out
 }
 
+/// One step of a body under load `l`: it moves `moved` seconds (0 in a reset) at its
+/// velocity, which the unbalanced load then changes over `full` seconds (zeroed instead at
+/// a kinetic-damping `reset`).
+fn carry(l: &BodyLoad, b: &mut BodyState, moved: f64, full: f64, reset: bool) {
+    let e = l.direction();
+    for a in 0..3 {
+        b.offset[a] += b.velocity[a] * moved;
+    }
+    b.travel = (0..3).map(|a| b.offset[a] * e[a]).sum();
+    if reset {
+        b.velocity = [0.0; 3];
+        return;
+    }
+    // The mass is set at set-up (`scene::build`): the scene's or the displaced soil's.
+    let mass = l.mass.unwrap_or(0.0) + b.contact_mass;
+    let net: f64 = (0..3).map(|a| (b.load[a] - b.reaction[a]) * e[a]).sum();
+    let speed: f64 = (0..3).map(|a| b.velocity[a] * e[a]).sum::<f64>() + full * net / mass;
+    b.velocity = e.map(|c| c * speed);
+}
+
+/// Stops the run when a loaded body has left the grid on an axis its load acts along.
+fn check_in_grid<D: Dim>(
+    spec: &RigidBodySpec,
+    b: &BodyState,
+    grid: &Grid<D>,
+    step: u64,
+) -> Result<(), StepError> {
+    let (lo, hi) = spec.bounds(D::N);
+    let (lo, hi) = (
+        std::array::from_fn(|a| lo[a] + b.offset[a]),
+        std::array::from_fn(|a| hi[a] + b.offset[a]),
+    );
+    let o = D::vec_to3(grid.origin);
+    let out = (0..D::N).any(|a| {
+        let end = o[a] + grid.axes[a].cells as f64 * grid.cell_size;
+        b.load[a] != 0.0 && (lo[a] < o[a] || hi[a] > end)
+    });
+    if out {
+        return Err(StepError::BodyLeftGrid {
+            step,
+            body: spec.name.clone(),
+            increment: b.increments + 1,
+            lo,
+            hi,
+        });
+    }
+    Ok(())
+}
+
+/// At the run's `max_time`: the first body still in an increment of this stage found no
+/// static state.
+fn stuck(bodies: &[RigidBodySpec], s: &SolverState, settings: &Settings) -> Result<(), StepError> {
+    let stages: Vec<&str> = settings.stages.iter().map(|t| t.name.as_str()).collect();
+    for (spec, b) in bodies.iter().zip(&s.control.bodies) {
+        if spec.moves_in(s.control.stage, &stages) && b.increments < spec.increments() {
+            return Err(StepError::NoStaticState {
+                step: s.clock.step,
+                time: s.clock.time,
+                body: spec.name.clone(),
+                increment: b.increments + 1,
+                force_ratio: s.convergence.force_ratio(settings.force_norm),
+                unbalanced: s.control.unbalanced(),
+            });
+        }
+    }
+    Ok(())
+}
+
 impl<D: Dim> System<D> for RigidControl {
     fn name(&self) -> &str {
         "rigid_control"
@@ -80,6 +168,11 @@ impl<D: Dim> System<D> for RigidControl {
         let s = &mut ctx.state;
         let dt = s.resets.motion_dt(ctx.settings.dt).unwrap_or(0.0);
         for (spec, b) in self.bodies.iter().zip(&mut s.control.bodies) {
+            if let (Some(l), true) = (&spec.load, b.load != [0.0; 3]) {
+                carry(l, b, dt, ctx.settings.dt, s.resets.this_step);
+                check_in_grid(spec, b, &ctx.grid, s.clock.step)?;
+                continue;
+            }
             let Some(m) = &spec.motion else { continue };
             if b.velocity == [0.0; 3] {
                 continue;
@@ -101,6 +194,9 @@ impl<D: Dim> System<D> for RigidControl {
             state.deepest_entry = state.deepest_entry.max(depth);
         }
         let s = &mut ctx.state;
+        if s.stop == Some(StopReason::MaxTime) {
+            stuck(&self.bodies, s, &ctx.settings)?;
+        }
         // A static state: the run's stop, or one `prescribed_motion` took this step.
         if s.stop != Some(StopReason::Converged) && !s.control.milestone {
             return Ok(());
@@ -112,9 +208,10 @@ impl<D: Dim> System<D> for RigidControl {
             // The mean pressure along the motion, or, for a body that holds its place, of
             // the whole force.
             let along = |f: [f64; 3]| -> f64 {
-                match &spec.motion {
-                    Some(m) => (0..3).map(|a| f[a] * m.vector()[a] / m.speed()).sum(),
-                    None => f.iter().map(|c| c * c).sum::<f64>().sqrt(),
+                match (&spec.motion, &spec.load) {
+                    (Some(m), _) => (0..3).map(|a| f[a] * m.vector()[a] / m.speed()).sum(),
+                    (_, Some(l)) => (0..3).map(|a| f[a] * l.direction()[a]).sum(),
+                    _ => f.iter().map(|c| c * c).sum::<f64>().sqrt(),
                 }
             };
             s.control.curve.push(CurvePoint {
@@ -137,15 +234,22 @@ impl<D: Dim> System<D> for RigidControl {
                     });
                 }
             }
-            let Some(m) = &spec.motion else { continue };
-            if !spec.moves_in(s.control.stage, &stages) {
+            if !spec.moves_in(s.control.stage, &stages) || b.increments >= spec.increments() {
                 continue;
             }
             b.increments += 1;
             s.control.milestone = true;
-            if b.travel < m.travel * (1.0 - 1e-9) {
-                b.velocity = m.vector();
-                more = true;
+            if let Some(m) = &spec.motion {
+                if b.travel < m.travel * (1.0 - 1e-9) {
+                    b.velocity = m.vector();
+                    more = true;
+                }
+            }
+            if let Some(l) = &spec.load {
+                if b.increments < l.increments {
+                    b.load = l.at(b.increments);
+                    more = true;
+                }
             }
         }
         if more {

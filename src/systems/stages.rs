@@ -136,12 +136,14 @@ impl<D: Dim> System<D> for Stages {
         s.go_on(&ctx.settings);
         // The rigid bodies that set off with this stage.
         for (spec, b) in ctx.settings.bodies.iter().zip(&mut s.control.bodies) {
-            if let Some(m) = spec
-                .motion
-                .as_ref()
-                .filter(|m| m.stage.as_ref() == Some(&stages[s.control.stage].name))
-            {
+            if spec.stage() != Some(&stages[s.control.stage].name) {
+                continue;
+            }
+            if let Some(m) = &spec.motion {
                 b.velocity = m.vector();
+            }
+            if let Some(l) = &spec.load {
+                b.load = l.at(0);
             }
         }
         s.energy.reset();

@@ -1,6 +1,7 @@
 //! Rigid bodies: each checks itself ([`crate::rigid::RigidBodySpec::check`]); here, their
 //! names beside the motions' (they share `curve.csv`), their place in the grid over the
-//! whole travel along the axes they move on, and that no two overlap.
+//! whole travel along the axes they move on (a body under load control finds its own
+//! travel: it is stopped if it leaves the grid), and that no two overlap.
 
 use super::*;
 use crate::error::SceneError;
@@ -42,11 +43,12 @@ pub(super) fn check_rigid_bodies(r: &Rules) -> Result<(), SceneError> {
                 ),
             );
         }
-        if let Some(stage) = b.motion.as_ref().and_then(|m| m.stage.as_ref()) {
+        if let Some(stage) = b.stage() {
             if !s.stages.iter().any(|t| &t.name == stage) {
                 let names: Vec<&str> = s.stages.iter().map(|t| t.name.as_str()).collect();
+                let control = if b.load.is_some() { "load" } else { "motion" };
                 return r.bad(
-                    &field("motion.stage"),
+                    &field(&format!("{control}.stage")),
                     format!("\"{stage}\" is not a stage of the scene (its stages: {names:?})"),
                 );
             }
