@@ -5,7 +5,9 @@
 //! surface at the closest point. Contact reads the normal from the geometry, not from the
 //! soil's mass gradient, so a flat face pushes straight and a circle pushes radially.
 
+use super::mesh::TriangleMesh;
 use serde::{Deserialize, Serialize};
+use std::sync::Arc;
 
 /// A body's shape at its starting position, in scene coordinates (m).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -46,6 +48,15 @@ pub enum Geometry {
         length: f64,
         /// Radius (m).
         radius: f64,
+    },
+    /// 3D: a closed triangle mesh read from an STL file (ASCII or binary, coordinates in
+    /// m), its path relative to the scene file.
+    Mesh {
+        /// The STL file.
+        file: String,
+        /// The mesh as read when the scene was loaded.
+        #[serde(skip)]
+        mesh: Option<Arc<TriangleMesh>>,
     },
 }
 
@@ -93,6 +104,7 @@ impl Geometry {
                 length,
                 radius,
             } => cylinder(point(base), *axis, *length, *radius, x),
+            Geometry::Mesh { mesh, .. } => loaded(mesh).distance(x),
         }
     }
 
@@ -120,8 +132,24 @@ impl Geometry {
                 let hi = std::array::from_fn(|a| if a == *axis { b[a] + length } else { b[a] + radius });
                 (lo, hi)
             }
+            Geometry::Mesh { mesh, .. } => loaded(mesh).bounds(),
         }
     }
+
+    /// Reads a mesh's STL file, `dir` the scene file's directory; other shapes have nothing
+    /// to read. An error names the field and what is wrong with the file.
+    pub fn read(&mut self, dir: &std::path::Path) -> Result<(), (String, String)> {
+        if let Geometry::Mesh { file, mesh } = self {
+            let m = TriangleMesh::read(&dir.join(&*file)).map_err(|e| ("geometry.file".to_string(), e))?;
+            *mesh = Some(Arc::new(m));
+        }
+        Ok(())
+    }
+}
+
+/// The mesh a scene's loading read ([`Geometry::read`]); a scene checks that it did.
+fn loaded(mesh: &Option<Arc<TriangleMesh>>) -> &TriangleMesh {
+    mesh.as_deref().expect("meshes are read as the scene loads")
 }
 
 impl Geometry {
@@ -135,7 +163,7 @@ impl Geometry {
             return bad(
                 "geometry",
                 "an axisymmetric scene takes a Polygon or a Circle in (r, z), turned about the \
-                 axis; a box, sphere or cylinder is a 3D shape"
+                 axis; a box, sphere, cylinder or mesh is a 3D shape"
                     .into(),
             );
         }
@@ -203,6 +231,17 @@ impl Geometry {
                 }
                 if !(length.is_finite() && *length > 0.0 && radius.is_finite() && *radius > 0.0) {
                     return bad("geometry.radius", "length and radius must be above 0 m".into());
+                }
+            }
+            Geometry::Mesh { mesh, .. } => {
+                if n != 3 {
+                    return bad(
+                        "geometry",
+                        format!("an STL mesh is a 3D shape; the scene is {n}D"),
+                    );
+                }
+                if mesh.is_none() {
+                    return bad("geometry.file", "the mesh was not read with the scene".into());
                 }
             }
         }
@@ -388,6 +427,11 @@ impl Geometry {
                 }
                 out
             }
+            Geometry::Mesh { mesh, .. } => loaded(mesh)
+                .samples(spacing)
+                .into_iter()
+                .map(|(x, normal, measure)| Sample { x, normal, measure })
+                .collect(),
         }
     }
 }

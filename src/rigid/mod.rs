@@ -16,6 +16,7 @@
 
 pub mod contact;
 pub mod geometry;
+pub mod mesh;
 
 pub use contact::Contact;
 pub use geometry::{Geometry, Sample};
@@ -318,6 +319,17 @@ impl RigidBodySpec {
                 }
             })
             .collect()
+    }
+
+    /// Reads its parts' STL meshes (`dir`: the scene file's directory), as (field, rule) on
+    /// failure.
+    pub fn read_meshes(&mut self, dir: &std::path::Path) -> Result<(), (String, String)> {
+        for (k, p) in self.parts.iter_mut().enumerate() {
+            p.geometry
+                .read(dir)
+                .map_err(|(f, r)| (format!("parts[{k}].{f}"), r))?;
+        }
+        Ok(())
     }
 
     /// The increments its control drives it in (0 for a body that holds its place).

@@ -676,13 +676,21 @@ impl LoadedScene {
                 message,
             }
         })?;
-        Ok(LoadedScene {
+        let mut loaded = LoadedScene {
             scene,
             path: path.to_path_buf(),
             text,
             source: original.to_string(),
             edits,
-        })
+        };
+        // The rigid bodies' STL meshes, beside the scene file.
+        let dir = path.parent().unwrap_or(Path::new("."));
+        for i in 0..loaded.scene.rigid_bodies.len() {
+            if let Err((f, rule)) = loaded.scene.rigid_bodies[i].read_meshes(dir) {
+                return Err(loaded.invalid(&format!("rigid_bodies[{i}].{f}"), rule));
+            }
+        }
+        Ok(loaded)
     }
 
     /// 1-based (line, column) in the file as written of byte offset `at` of the edited

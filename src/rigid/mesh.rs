@@ -1,0 +1,438 @@
+//! A closed triangle mesh read from an STL file (ASCII or binary, by `stl_io`): a rigid
+//! body of any shape in 3D.
+//!
+//! The signed distance of a point is the distance to the nearest triangle, found through a
+//! bounding-volume tree, with the sign of the angle-weighted pseudonormal of the feature
+//! (face, edge or vertex) the closest point lies on (Bærentzen & Aanæs 2005, IEEE TVCG
+//! 11(3)): exact for a closed, consistently oriented mesh, which `stl_io` checks (every
+//! edge shared by two faces of opposite senses). A mesh wound inwards (negative volume)
+//! is turned outwards.
+
+use std::collections::HashMap;
+use std::path::Path;
+
+type V3 = [f64; 3];
+
+fn sub(a: V3, b: V3) -> V3 {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+fn add(a: V3, b: V3) -> V3 {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
+fn mul(a: V3, s: f64) -> V3 {
+    [a[0] * s, a[1] * s, a[2] * s]
+}
+fn dot(a: V3, b: V3) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+fn cross(a: V3, b: V3) -> V3 {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+fn unit(a: V3) -> V3 {
+    let l = dot(a, a).sqrt();
+    if l > 0.0 {
+        mul(a, 1.0 / l)
+    } else {
+        a
+    }
+}
+
+/// Where on a triangle its closest point to a query lies.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Feature {
+    Face,
+    /// The edge between the triangle's corners k and (k + 1) % 3.
+    Edge(usize),
+    /// Corner k.
+    Vertex(usize),
+}
+
+/// A node of the bounding-volume tree: its box and either two children or a run of faces.
+#[derive(Clone, Debug, PartialEq)]
+struct Node {
+    lo: V3,
+    hi: V3,
+    /// Children (inner node) or `usize::MAX`.
+    children: [usize; 2],
+    /// The node's faces: `order[first..first + count]` (a leaf).
+    first: usize,
+    count: usize,
+}
+
+/// A closed, outward-wound triangle mesh (m), ready for distance queries.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TriangleMesh {
+    vertices: Vec<V3>,
+    faces: Vec<[usize; 3]>,
+    /// Unit outward normal of each face.
+    normals: Vec<V3>,
+    /// Each face's area (m²).
+    areas: Vec<f64>,
+    /// Pseudonormal of each edge (sum of its two faces' normals), by (low, high) vertex.
+    edges: HashMap<(usize, usize), V3>,
+    /// Angle-weighted pseudonormal of each vertex.
+    corners: Vec<V3>,
+    /// Faces in tree order.
+    order: Vec<usize>,
+    tree: Vec<Node>,
+}
+
+/// Faces per leaf of the tree.
+const LEAF: usize = 4;
+
+impl TriangleMesh {
+    /// Reads and checks the STL file at `path`: an error says what is wrong with it.
+    pub fn read(path: &Path) -> Result<Self, String> {
+        let mut file =
+            std::fs::File::open(path).map_err(|e| format!("cannot open {}: {e}", path.display()))?;
+        let mesh =
+            stl_io::read_stl(&mut file).map_err(|e| format!("{} is not an STL file: {e}", path.display()))?;
+        if mesh.faces.is_empty() {
+            return Err(format!("{} holds no triangles", path.display()));
+        }
+        mesh.validate().map_err(|e| {
+            format!(
+                "{} is not a closed surface ({e}): a body needs a watertight mesh, every edge \
+                 shared by two triangles",
+                path.display()
+            )
+        })?;
+        let vertices: Vec<V3> = mesh.vertices.iter().map(|v| v.0.map(f64::from)).collect();
+        let faces: Vec<[usize; 3]> = mesh.faces.iter().map(|f| f.vertices).collect();
+        Self::new(vertices, faces)
+    }
+
+    /// The mesh of these vertices (m) and faces (corner indices); it must be closed.
+    pub fn new(vertices: Vec<V3>, mut faces: Vec<[usize; 3]>) -> Result<Self, String> {
+        if vertices.iter().flatten().any(|c| !c.is_finite()) {
+            return Err("a vertex has a coordinate that is not a finite number".into());
+        }
+        let volume: f64 = faces
+            .iter()
+            .map(|f| dot(vertices[f[0]], cross(vertices[f[1]], vertices[f[2]])) / 6.0)
+            .sum();
+        if volume.abs() <= 0.0 {
+            return Err("the mesh encloses no volume".into());
+        }
+        if volume < 0.0 {
+            for f in &mut faces {
+                f.swap(1, 2);
+            }
+        }
+        let mut normals = Vec::with_capacity(faces.len());
+        let mut areas = Vec::with_capacity(faces.len());
+        let mut edges: HashMap<(usize, usize), V3> = HashMap::new();
+        let mut corners = vec![[0.0; 3]; vertices.len()];
+        for f in &faces {
+            let [a, b, c] = f.map(|i| vertices[i]);
+            let n = cross(sub(b, a), sub(c, a));
+            let area = 0.5 * dot(n, n).sqrt();
+            let n = unit(n);
+            normals.push(n);
+            areas.push(area);
+            for k in 0..3 {
+                let (i, j) = (f[k], f[(k + 1) % 3]);
+                let e = edges.entry((i.min(j), i.max(j))).or_insert([0.0; 3]);
+                *e = add(*e, n);
+                // The angle at corner k weighs the face's normal there.
+                let (p, q, r) = (vertices[f[k]], vertices[f[(k + 1) % 3]], vertices[f[(k + 2) % 3]]);
+                let (u, w) = (unit(sub(q, p)), unit(sub(r, p)));
+                let angle = dot(u, w).clamp(-1.0, 1.0).acos();
+                corners[f[k]] = add(corners[f[k]], mul(n, angle));
+            }
+        }
+        let mut mesh = TriangleMesh {
+            vertices,
+            faces,
+            normals,
+            areas,
+            edges,
+            corners,
+            order: Vec::new(),
+            tree: Vec::new(),
+        };
+        mesh.order = (0..mesh.faces.len()).collect();
+        let n = mesh.order.len();
+        mesh.build(0, n);
+        Ok(mesh)
+    }
+
+    fn face_box(&self, f: usize) -> (V3, V3) {
+        let [a, b, c] = self.faces[f].map(|i| self.vertices[i]);
+        (
+            std::array::from_fn(|k| a[k].min(b[k]).min(c[k])),
+            std::array::from_fn(|k| a[k].max(b[k]).max(c[k])),
+        )
+    }
+
+    /// Builds the node over `order[first..first + count]`, splitting at the median centre
+    /// along the longest side; returns its index.
+    fn build(&mut self, first: usize, count: usize) -> usize {
+        let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+        for &f in &self.order[first..first + count] {
+            let (l, h) = self.face_box(f);
+            for k in 0..3 {
+                lo[k] = lo[k].min(l[k]);
+                hi[k] = hi[k].max(h[k]);
+            }
+        }
+        let index = self.tree.len();
+        self.tree.push(Node {
+            lo,
+            hi,
+            children: [usize::MAX; 2],
+            first,
+            count,
+        });
+        if count <= LEAF {
+            return index;
+        }
+        let axis = (0..3).fold(0, |m, k| if hi[k] - lo[k] > hi[m] - lo[m] { k } else { m });
+        let centre =
+            |f: usize, mesh: &Self| -> f64 { mesh.faces[f].iter().map(|&i| mesh.vertices[i][axis]).sum() };
+        let half = count / 2;
+        let mut run = self.order[first..first + count].to_vec();
+        run.select_nth_unstable_by(half, |&p, &q| centre(p, self).total_cmp(&centre(q, self)));
+        self.order[first..first + count].copy_from_slice(&run);
+        let left = self.build(first, half);
+        let right = self.build(first + half, count - half);
+        self.tree[index].children = [left, right];
+        index
+    }
+
+    /// Axis-aligned bounds (m).
+    pub fn bounds(&self) -> (V3, V3) {
+        (self.tree[0].lo, self.tree[0].hi)
+    }
+
+    /// Signed distance φ (m, negative inside) from `x` to the surface and the unit outward
+    /// normal there: from the closest point to `x` outside, from `x` to it inside, the
+    /// feature's pseudonormal on the surface itself.
+    pub fn distance(&self, x: V3) -> (f64, V3) {
+        let (mut best, mut at) = (f64::INFINITY, (0, [0.0; 3], Feature::Face));
+        let mut stack = vec![0usize];
+        while let Some(k) = stack.pop() {
+            let node = &self.tree[k];
+            if box_distance2(node.lo, node.hi, x) >= best {
+                continue;
+            }
+            if node.children[0] == usize::MAX {
+                for &f in &self.order[node.first..node.first + node.count] {
+                    let (c, feature) = self.closest(f, x);
+                    let d = sub(x, c);
+                    let d2 = dot(d, d);
+                    if d2 < best {
+                        best = d2;
+                        at = (f, c, feature);
+                    }
+                }
+                continue;
+            }
+            let [l, r] = node.children;
+            let (dl, dr) = (
+                box_distance2(self.tree[l].lo, self.tree[l].hi, x),
+                box_distance2(self.tree[r].lo, self.tree[r].hi, x),
+            );
+            // The nearer child last, so that it is searched first.
+            if dl < dr {
+                stack.extend([r, l]);
+            } else {
+                stack.extend([l, r]);
+            }
+        }
+        let (f, c, feature) = at;
+        let pseudo = match feature {
+            Feature::Face => self.normals[f],
+            Feature::Edge(k) => {
+                let (i, j) = (self.faces[f][k], self.faces[f][(k + 1) % 3]);
+                self.edges[&(i.min(j), i.max(j))]
+            }
+            Feature::Vertex(k) => self.corners[self.faces[f][k]],
+        };
+        let d = sub(x, c);
+        let length = best.sqrt();
+        let inside = dot(d, pseudo) < 0.0;
+        let normal = if length > 1e-12 {
+            mul(d, if inside { -1.0 / length } else { 1.0 / length })
+        } else {
+            unit(pseudo)
+        };
+        (if inside { -length } else { length }, normal)
+    }
+
+    /// The closest point of face `f` to `x` and the feature it lies on (Ericson 2005,
+    /// Real-Time Collision Detection, §5.1.5).
+    fn closest(&self, f: usize, x: V3) -> (V3, Feature) {
+        let [a, b, c] = self.faces[f].map(|i| self.vertices[i]);
+        let (ab, ac, ap) = (sub(b, a), sub(c, a), sub(x, a));
+        let (d1, d2) = (dot(ab, ap), dot(ac, ap));
+        if d1 <= 0.0 && d2 <= 0.0 {
+            return (a, Feature::Vertex(0));
+        }
+        let bp = sub(x, b);
+        let (d3, d4) = (dot(ab, bp), dot(ac, bp));
+        if d3 >= 0.0 && d4 <= d3 {
+            return (b, Feature::Vertex(1));
+        }
+        let vc = d1 * d4 - d3 * d2;
+        if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+            return (add(a, mul(ab, d1 / (d1 - d3))), Feature::Edge(0));
+        }
+        let cp = sub(x, c);
+        let (d5, d6) = (dot(ab, cp), dot(ac, cp));
+        if d6 >= 0.0 && d5 <= d6 {
+            return (c, Feature::Vertex(2));
+        }
+        let vb = d5 * d2 - d1 * d6;
+        if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+            return (add(a, mul(ac, d2 / (d2 - d6))), Feature::Edge(2));
+        }
+        let va = d3 * d6 - d5 * d4;
+        if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+            let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+            return (add(b, mul(sub(c, b), w)), Feature::Edge(1));
+        }
+        let denom = 1.0 / (va + vb + vc);
+        let (v, w) = (vb * denom, vc * denom);
+        (add(a, add(mul(ab, v), mul(ac, w))), Feature::Face)
+    }
+
+    /// Surface points about `spacing` (m) apart: each face cut into k² equal triangles (k
+    /// the larger of √(2 area) and half the longest side, over `spacing`, rounded up: a
+    /// right triangle of legs L in pieces of legs `spacing`), one point at each one's
+    /// centre, with the face's normal and the piece's area (m²).
+    pub fn samples(&self, spacing: f64) -> Vec<(V3, V3, f64)> {
+        let mut out = Vec::new();
+        for (f, face) in self.faces.iter().enumerate() {
+            let [a, b, c] = face.map(|i| self.vertices[i]);
+            let longest = [sub(b, a), sub(c, b), sub(a, c)]
+                .iter()
+                .map(|e| dot(*e, *e).sqrt())
+                .fold(0.0, f64::max);
+            // Pieces of about `spacing` on a side (as a box's faces are cut), and no sample
+            // farther than `spacing` from the next along a long side.
+            let k = ((2.0 * self.areas[f]).sqrt().max(0.5 * longest) / spacing)
+                .ceil()
+                .max(1.0) as usize;
+            let (u, v) = (mul(sub(b, a), 1.0 / k as f64), mul(sub(c, a), 1.0 / k as f64));
+            let at = |i: f64, j: f64| add(a, add(mul(u, i), mul(v, j)));
+            let piece = self.areas[f] / (k * k) as f64;
+            for i in 0..k {
+                for j in 0..k - i {
+                    let (fi, fj) = (i as f64, j as f64);
+                    out.push((at(fi + 1.0 / 3.0, fj + 1.0 / 3.0), self.normals[f], piece));
+                    if i + j + 1 < k {
+                        out.push((at(fi + 2.0 / 3.0, fj + 2.0 / 3.0), self.normals[f], piece));
+                    }
+                }
+            }
+        }
+        out
+    }
+}
+
+/// Squared distance from `x` to the box `lo..hi` (0 inside).
+fn box_distance2(lo: V3, hi: V3, x: V3) -> f64 {
+    (0..3)
+        .map(|k| {
+            let d = (lo[k] - x[k]).max(x[k] - hi[k]).max(0.0);
+            d * d
+        })
+        .sum()
+}
+
+/// The twelve triangles of the box `lo`..`hi` (m), two a face, wound outwards: an STL
+/// file's content for a box, to set beside the `Box` shape.
+pub fn box_triangles(lo: V3, hi: V3) -> Vec<[V3; 3]> {
+    let corner = |i: usize| -> V3 { std::array::from_fn(|a| if (i >> a) & 1 == 1 { hi[a] } else { lo[a] }) };
+    // Each face's corners in order, seen from outside.
+    let quads = [
+        [0, 2, 3, 1],
+        [4, 5, 7, 6],
+        [0, 1, 5, 4],
+        [2, 6, 7, 3],
+        [0, 4, 6, 2],
+        [1, 3, 7, 5],
+    ];
+    quads
+        .iter()
+        .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
+        .map(|t| t.map(corner))
+        .collect()
+}
+
+/// The mesh of a cube of side `side` at the origin, its corners shared (a test shape).
+#[cfg(test)]
+fn cube(side: f64) -> (Vec<V3>, Vec<[usize; 3]>) {
+    let mut vertices: Vec<V3> = Vec::new();
+    let faces = box_triangles([0.0; 3], [side; 3])
+        .into_iter()
+        .map(|t| {
+            t.map(|v| match vertices.iter().position(|w| *w == v) {
+                Some(i) => i,
+                None => {
+                    vertices.push(v);
+                    vertices.len() - 1
+                }
+            })
+        })
+        .collect();
+    (vertices, faces)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_cube_mesh_measures_to_its_faces_edges_and_corners_with_the_sign_of_inside() {
+        let (v, f) = cube(2.0);
+        let m = TriangleMesh::new(v, f).unwrap();
+        let (phi, n) = m.distance([1.0, 1.0, 2.5]);
+        assert!(
+            (phi - 0.5).abs() < 1e-12 && (n[2] - 1.0).abs() < 1e-12,
+            "{phi} {n:?}"
+        );
+        let (phi, n) = m.distance([1.0, 0.5, 1.0]);
+        assert!(
+            (phi + 0.5).abs() < 1e-12 && (n[1] + 1.0).abs() < 1e-12,
+            "{phi} {n:?}"
+        );
+        // Beyond an edge and beyond a corner.
+        let (phi, _) = m.distance([3.0, 1.0, 3.0]);
+        assert!((phi - 2f64.sqrt()).abs() < 1e-12, "{phi}");
+        let (phi, n) = m.distance([-1.0, -1.0, -1.0]);
+        assert!((phi - 3f64.sqrt()).abs() < 1e-12 && n[0] < 0.0, "{phi} {n:?}");
+        // The centre is a side's half deep.
+        assert!((m.distance([1.0, 1.0, 1.0]).0 + 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_mesh_wound_inwards_is_turned_outwards_and_an_open_one_has_no_volume_to_turn() {
+        let (v, f) = cube(1.0);
+        let inwards: Vec<[usize; 3]> = f.iter().map(|t| [t[0], t[2], t[1]]).collect();
+        let m = TriangleMesh::new(v.clone(), inwards).unwrap();
+        assert!(m.distance([0.5, 0.5, 0.5]).0 < 0.0);
+        assert!(m.distance([0.5, 0.5, 1.5]).0 > 0.0);
+        assert!(TriangleMesh::new(v, vec![[0, 1, 2], [1, 2, 3]]).is_err());
+    }
+
+    #[test]
+    fn a_cube_mesh_samples_its_whole_surface() {
+        let (v, f) = cube(1.0);
+        let m = TriangleMesh::new(v, f).unwrap();
+        let s = m.samples(0.1);
+        let area: f64 = s.iter().map(|p| p.2).sum();
+        assert!((area - 6.0).abs() < 1e-9, "{area}");
+        // Every sample on the surface, its normal the face's.
+        for (x, n, _) in &s {
+            let (phi, normal) = m.distance(*x);
+            assert!(phi.abs() < 1e-12, "{x:?} {phi}");
+            assert!(dot(*n, normal) > 0.999, "{x:?} {n:?} {normal:?}");
+        }
+    }
+}
