@@ -144,8 +144,9 @@ pub enum StepError {
     /// A rigid body's increment found no static state before the run's `max_time`.
     #[error(
         "step {step}, t = {time:.4} s: rigid body \"{body}\" found no static state in increment {increment} \
-         before solver.max_time (K_F {force_ratio:.3e}, the body's load out of balance by {unbalanced:.3e} of it): \
-         the soil cannot carry it there, or the run needs more time; the curve so far is kept"
+         before solver.max_time (K_F {force_ratio:.3e}{}): the soil did not come to rest \
+         (a load it cannot carry, or a run that needs more time); the curve so far is kept",
+        unbalanced.map_or(String::new(), |u| format!(", its load out of balance by {u:.3e} of it"))
     )]
     NoStaticState {
         /// Step number.
@@ -158,8 +159,8 @@ pub enum StepError {
         increment: u32,
         /// K_F at the stop.
         force_ratio: f64,
-        /// The body's out-of-balance force over its load (0 under displacement control).
-        unbalanced: f64,
+        /// Under load control, the body's out-of-balance force over its load.
+        unbalanced: Option<f64>,
     },
     /// A rigid body under load control moved out of the grid.
     #[error(

@@ -621,3 +621,24 @@ fn a_smooth_ball_in_confined_tresca_clay_has_the_flow_round_factor() {
     let ball = &s.rigid_bodies[0];
     assert!(ball.deepest_entry < 0.1 * 0.25, "{ball:?}");
 }
+
+/// A body whose increment finds no static state before `max_time` (the footing's third
+/// centimetre, cut short at 2.5 s): the binary stops with exit 1, naming the body and the
+/// increment, and `curve.csv` keeps the two static states before it.
+#[test]
+fn a_body_stuck_in_an_increment_stops_the_run_with_the_curve_so_far() {
+    let dir = common::scratch("rigid_bodies", "stuck");
+    let o = common::run_into(
+        &common::scene("footing_rigid.ron"),
+        &dir,
+        &["rigid_bodies[0].motion.travel=0.03", "solver.max_time=2.5"],
+    );
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("rigid body \"footing\" found no static state in increment 3"),
+        "{err}"
+    );
+    let curve = std::fs::read_to_string(dir.join("curve.csv")).unwrap();
+    assert_eq!(curve.lines().count(), 3, "{curve}");
+}

@@ -152,7 +152,7 @@ fn stuck(bodies: &[RigidBodySpec], s: &SolverState, settings: &Settings) -> Resu
                 body: spec.name.clone(),
                 increment: b.increments + 1,
                 force_ratio: s.convergence.force_ratio(settings.force_norm),
-                unbalanced: s.control.unbalanced(),
+                unbalanced: spec.load.as_ref().map(|_| s.control.unbalanced()),
             });
         }
     }
