@@ -502,7 +502,7 @@ fn relaxing<D: Dim, S: Shape>() -> Vec<Entry<D>> {
                 ("convergence", "it acts on the step's static state"),
                 ("prescribed_motion", "the bodies' rows follow the motions'"),
             ],
-            "rigid bodies: travel, hold, curve of static states",
+            "rigid bodies: travel or carry a load, hold, curve of static states",
             |s| Box::new(RigidControl::new(s.bodies.clone())),
         ),
         e(
