@@ -642,3 +642,14 @@ fn a_body_stuck_in_an_increment_stops_the_run_with_the_curve_so_far() {
     let curve = std::fs::read_to_string(dir.join("curve.csv")).unwrap();
     assert_eq!(curve.lines().count(), 3, "{curve}");
 }
+
+/// An increment shorter than one step's travel v Δt: its first step, at the full velocity,
+/// would overshoot it (a 1 mm increment at 1 m/s moved the footing 1.52 mm). Refused.
+#[test]
+fn an_increment_shorter_than_one_steps_travel_is_refused() {
+    let e = refused("increment: 0.05),", "increment: 0.00001),");
+    assert!(
+        e.contains("rigid_bodies[0].motion.increment") && e.contains("overshoot"),
+        "{e}"
+    );
+}

@@ -197,6 +197,45 @@ impl Rules<'_> {
     }
 }
 
+/// A displacement control's first step of an increment moves at its full velocity: an
+/// increment (or a whole travel) shorter than one step's travel v Δt would be overshot, a
+/// silently wrong curve. Refused, motions and rigid bodies alike.
+fn check_increments_span_a_step(r: &Rules, dt: f64) -> Result<(), SceneError> {
+    let s = &r.loaded.scene;
+    let controls = s
+        .motions
+        .iter()
+        .enumerate()
+        .map(|(i, m)| (format!("motions[{i}]"), m.speed(), m.travel, m.increment))
+        .chain(s.rigid_bodies.iter().enumerate().filter_map(|(i, b)| {
+            let m = b.motion.as_ref()?;
+            Some((
+                format!("rigid_bodies[{i}].motion"),
+                m.speed(),
+                m.travel,
+                m.increment,
+            ))
+        }));
+    for (field, speed, travel, increment) in controls {
+        let (name, length) = match increment {
+            Some(inc) if inc < travel => ("increment", inc),
+            _ => ("travel", travel),
+        };
+        let step = speed * dt;
+        if length < step * (1.0 - 1e-9) {
+            return r.bad(
+                &format!("{field}.{name}"),
+                format!(
+                    "{length} m is shorter than one step's travel, v Δt = {step:.4e} m (Δt = \
+                     {dt:.4e} s): its first step would overshoot it; lower the velocity or \
+                     lengthen the {name}"
+                ),
+            );
+        }
+    }
+    Ok(())
+}
+
 /// Checks every rule that does not need the points, part by part.
 pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
     let s = &loaded.scene;
@@ -214,6 +253,7 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
     check_tractions_and_traced(&r)?;
     check_has_load(&r)?;
     let step = time_step(&r, &table)?;
+    check_increments_span_a_step(&r, step.dt)?;
     let stages = check_stages(&r, &table, step.p_wave_speed)?;
     let estimate = check_memory(&r, &table)?;
     let (water, stage_waters) = check_water(&r, &grid, &table)?;
