@@ -104,8 +104,13 @@ fn carry(l: &BodyLoad, b: &mut BodyState, moved: f64, full: f64, reset: bool) {
         b.velocity = [0.0; 3];
         return;
     }
-    // The mass is set at set-up (`scene::build`): the scene's or the displaced soil's.
+    // The mass is set at set-up (`scene::build`): the scene's or the displaced soil's. A
+    // body built without one that touches no soil has nothing to move: it waits (and a
+    // run that never balances it stops at `max_time` naming the increment).
     let mass = l.mass.unwrap_or(0.0) + b.contact_mass;
+    if mass <= 0.0 {
+        return;
+    }
     let net: f64 = (0..3).map(|a| (b.load[a] - b.reaction[a]) * e[a]).sum();
     let speed: f64 = (0..3).map(|a| b.velocity[a] * e[a]).sum::<f64>() + full * net / mass;
     b.velocity = e.map(|c| c * speed);
