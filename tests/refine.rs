@@ -147,13 +147,7 @@ fn a_study_of_the_factor_of_safety_refines_as_refine_does() {
     );
     std::fs::write(&study, text).unwrap();
     let out = dir.join("out");
-    let o = common::kdmpm(&[
-        "study",
-        study.to_str().unwrap(),
-        "--quiet",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let o = common::study_into(&study, &out);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let table = std::fs::read_to_string(out.join("study.csv")).unwrap();
     let header: Vec<&str> = table.lines().next().unwrap().split(',').collect();
@@ -196,13 +190,7 @@ fn a_study_of_the_factor_of_safety_is_refused_beside_another_quantity_or_without
             scenes.display()
         );
         std::fs::write(&study, text).unwrap();
-        let o = common::kdmpm(&[
-            "study",
-            study.to_str().unwrap(),
-            "--quiet",
-            "--out",
-            dir.join("out").to_str().unwrap(),
-        ]);
+        let o = common::study_into(&study, &dir.join("out"));
         let err = String::from_utf8_lossy(&o.stderr);
         assert_eq!(o.status.code(), Some(2), "{err}");
         assert!(err.contains("quantities[") && err.contains(says), "{err}");

@@ -443,13 +443,7 @@ fn study_file(dir: &Path, name: &str, text: &str) -> PathBuf {
 /// Runs `kdmpm study` on `study` into `out`, which must refuse it as bad input (exit 2),
 /// and returns its message.
 fn study_refusal(study: &Path, out: &Path) -> String {
-    let o = common::kdmpm(&[
-        "study",
-        study.to_str().unwrap(),
-        "--quiet",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let o = common::study_into(study, out);
     let err = String::from_utf8_lossy(&o.stderr).into_owned();
     assert_eq!(o.status.code(), Some(2), "{err}");
     err

@@ -281,7 +281,7 @@ impl Geometry {
     /// (a polygon's corners stand between the samples of its two edges).
     pub fn samples(&self, spacing: f64) -> Vec<Sample> {
         use std::f64::consts::PI;
-        let pieces = |length: f64| (length / spacing).ceil().max(1.0) as usize;
+        let pieces = |length: f64| pieces(length, spacing);
         match self {
             Geometry::Circle { centre, radius } => {
                 let c = point(centre);
@@ -344,89 +344,13 @@ impl Geometry {
                 }
                 out
             }
-            Geometry::Box { min, max } => {
-                let (lo, hi) = (point(min), point(max));
-                let n = min.len();
-                let mut out = Vec::new();
-                for axis in 0..n {
-                    for (side, at) in [(-1.0, lo[axis]), (1.0, hi[axis])] {
-                        let others: Vec<usize> = (0..n).filter(|&a| a != axis).collect();
-                        let counts: Vec<usize> = others.iter().map(|&a| pieces(hi[a] - lo[a])).collect();
-                        let total: usize = counts.iter().product();
-                        let measure: f64 =
-                            others.iter().map(|&a| hi[a] - lo[a]).product::<f64>() / total as f64;
-                        for q in 0..total {
-                            let mut x = [0.0; 3];
-                            x[axis] = at;
-                            let mut rest = q;
-                            for (&a, &k) in others.iter().zip(&counts) {
-                                let j = rest % k;
-                                rest /= k;
-                                x[a] = lo[a] + (hi[a] - lo[a]) * (j as f64 + 0.5) / k as f64;
-                            }
-                            let mut normal = [0.0; 3];
-                            normal[axis] = side;
-                            out.push(Sample { x, normal, measure });
-                        }
-                    }
-                }
-                out
-            }
+            Geometry::Box { min, max } => box_samples(min, max, spacing),
             Geometry::Cylinder {
                 base,
                 axis,
                 length,
                 radius,
-            } => {
-                let b = point(base);
-                let (u, w) = ((axis + 1) % 3, (axis + 2) % 3);
-                let mut out = Vec::new();
-                let (around, along) = (pieces(2.0 * PI * radius), pieces(*length));
-                for i in 0..around {
-                    let f = 2.0 * PI * (i as f64 + 0.5) / around as f64;
-                    for j in 0..along {
-                        let mut x = b;
-                        x[*axis] += length * (j as f64 + 0.5) / along as f64;
-                        x[u] += radius * f.cos();
-                        x[w] += radius * f.sin();
-                        let mut normal = [0.0; 3];
-                        normal[u] = f.cos();
-                        normal[w] = f.sin();
-                        out.push(Sample {
-                            x,
-                            normal,
-                            measure: 2.0 * PI * radius * length / (around * along) as f64,
-                        });
-                    }
-                }
-                // The end caps: rings of equal radial steps.
-                let rings = pieces(*radius);
-                for (side, at) in [(-1.0, b[*axis]), (1.0, b[*axis] + length)] {
-                    for i in 0..rings {
-                        let (r0, r1) = (
-                            radius * i as f64 / rings as f64,
-                            radius * (i + 1) as f64 / rings as f64,
-                        );
-                        let r = 0.5 * (r0 + r1);
-                        let k = pieces(2.0 * PI * r);
-                        for j in 0..k {
-                            let f = 2.0 * PI * (j as f64 + 0.5) / k as f64;
-                            let mut x = b;
-                            x[*axis] = at;
-                            x[u] += r * f.cos();
-                            x[w] += r * f.sin();
-                            let mut normal = [0.0; 3];
-                            normal[*axis] = side;
-                            out.push(Sample {
-                                x,
-                                normal,
-                                measure: PI * (r1 * r1 - r0 * r0) / k as f64,
-                            });
-                        }
-                    }
-                }
-                out
-            }
+            } => cylinder_samples(base, *axis, *length, *radius, spacing),
             Geometry::Mesh { mesh, .. } => loaded(mesh)
                 .samples(spacing)
                 .into_iter()
@@ -434,6 +358,95 @@ impl Geometry {
                 .collect(),
         }
     }
+}
+
+/// The number of equal pieces of at most `spacing` that cut `length` (at least one).
+fn pieces(length: f64, spacing: f64) -> usize {
+    (length / spacing).ceil().max(1.0) as usize
+}
+
+/// A box's samples: each face cut into pieces of at most `spacing` a side.
+fn box_samples(min: &[f64], max: &[f64], spacing: f64) -> Vec<Sample> {
+    let pieces = |length: f64| pieces(length, spacing);
+    let (lo, hi) = (point(min), point(max));
+    let n = min.len();
+    let mut out = Vec::new();
+    for axis in 0..n {
+        for (side, at) in [(-1.0, lo[axis]), (1.0, hi[axis])] {
+            let others: Vec<usize> = (0..n).filter(|&a| a != axis).collect();
+            let counts: Vec<usize> = others.iter().map(|&a| pieces(hi[a] - lo[a])).collect();
+            let total: usize = counts.iter().product();
+            let measure: f64 = others.iter().map(|&a| hi[a] - lo[a]).product::<f64>() / total as f64;
+            for q in 0..total {
+                let mut x = [0.0; 3];
+                x[axis] = at;
+                let mut rest = q;
+                for (&a, &k) in others.iter().zip(&counts) {
+                    let j = rest % k;
+                    rest /= k;
+                    x[a] = lo[a] + (hi[a] - lo[a]) * (j as f64 + 0.5) / k as f64;
+                }
+                let mut normal = [0.0; 3];
+                normal[axis] = side;
+                out.push(Sample { x, normal, measure });
+            }
+        }
+    }
+    out
+}
+
+/// A cylinder's samples: its side in pieces of at most `spacing`, its end caps in rings.
+fn cylinder_samples(base: &[f64], axis: usize, length: f64, radius: f64, spacing: f64) -> Vec<Sample> {
+    use std::f64::consts::PI;
+    let pieces = |length: f64| pieces(length, spacing);
+    let b = point(base);
+    let (u, w) = ((axis + 1) % 3, (axis + 2) % 3);
+    let mut out = Vec::new();
+    let (around, along) = (pieces(2.0 * PI * radius), pieces(length));
+    for i in 0..around {
+        let f = 2.0 * PI * (i as f64 + 0.5) / around as f64;
+        for j in 0..along {
+            let mut x = b;
+            x[axis] += length * (j as f64 + 0.5) / along as f64;
+            x[u] += radius * f.cos();
+            x[w] += radius * f.sin();
+            let mut normal = [0.0; 3];
+            normal[u] = f.cos();
+            normal[w] = f.sin();
+            out.push(Sample {
+                x,
+                normal,
+                measure: 2.0 * PI * radius * length / (around * along) as f64,
+            });
+        }
+    }
+    // The end caps: rings of equal radial steps.
+    let rings = pieces(radius);
+    for (side, at) in [(-1.0, b[axis]), (1.0, b[axis] + length)] {
+        for i in 0..rings {
+            let (r0, r1) = (
+                radius * i as f64 / rings as f64,
+                radius * (i + 1) as f64 / rings as f64,
+            );
+            let r = 0.5 * (r0 + r1);
+            let k = pieces(2.0 * PI * r);
+            for j in 0..k {
+                let f = 2.0 * PI * (j as f64 + 0.5) / k as f64;
+                let mut x = b;
+                x[axis] = at;
+                x[u] += r * f.cos();
+                x[w] += r * f.sin();
+                let mut normal = [0.0; 3];
+                normal[axis] = side;
+                out.push(Sample {
+                    x,
+                    normal,
+                    measure: PI * (r1 * r1 - r0 * r0) / k as f64,
+                });
+            }
+        }
+    }
+    out
 }
 
 /// Bounds (m) of a polygon's vertices `[x, y]`, z 0..0.

@@ -445,7 +445,7 @@ pub struct BodyState {
     /// Under load control, the force on the body this increment (N, x y z); zero while it
     /// waits for its stage, and always for a body without a load.
     pub load: [f64; 3],
-    /// Σ m̃ over the nodes its contacts reached this step (kg): under load control, the
+    /// Σ m̃ over the nodes its contacts reached this step (kg; 0 without a load): under load control, the
     /// soil that moves with the body, added to its mass in its equation of motion (set by
     /// `rigid_contact` each step, not kept in checkpoints).
     pub contact_mass: f64,

@@ -267,10 +267,12 @@ fn loaded_bodies<D: Dim>(s: &Scene, grid: &Grid<D>, table: &[(String, MaterialMo
     let cells = std::array::from_fn(|a| grid.axes[a].cells);
     let mut bodies = s.rigid_bodies.clone();
     for b in &mut bodies {
-        let volume = b.volume(D::N, D::AXISYMMETRIC, origin, h, cells);
-        if let Some(l) = b.load.as_mut().filter(|l| l.mass.is_none()) {
+        if b.load.as_ref().is_some_and(|l| l.mass.is_none()) {
+            let volume = b.volume(D::N, D::AXISYMMETRIC, origin, h, cells);
             let cell = h.powi(D::N as i32) * if D::AXISYMMETRIC { h } else { 1.0 };
-            l.mass = Some(density * volume.max(cell));
+            if let Some(l) = b.load.as_mut() {
+                l.mass = Some(density * volume.max(cell));
+            }
         }
     }
     bodies

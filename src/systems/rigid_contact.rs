@@ -235,12 +235,14 @@ impl<D: Dim, S: Shape> System<D> for RigidContact<D, S> {
                 state.parts[p.part][a] += p.impulse[a] / dt;
             }
         }
-        // The soil that moves with each body: every node its contacts reach, once.
-        let mut seen = vec![u32::MAX; set.slots.len()];
+        // The soil that moves with each body under load control: every node its contacts
+        // reach, once (a body under displacement control does not need it).
+        let loaded = bodies.iter().any(|b| b.load.is_some());
+        let mut seen = vec![u32::MAX; if loaded { set.slots.len() } else { 0 }];
         for state in &mut control.bodies {
             state.contact_mass = 0.0;
         }
-        for p in &set.contacts {
+        for p in set.contacts.iter().filter(|p| bodies[p.body].load.is_some()) {
             for &(k, _) in &p.nodes {
                 if seen[k] != p.body as u32 {
                     seen[k] = p.body as u32;

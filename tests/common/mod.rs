@@ -61,6 +61,17 @@ pub fn run_into(scene: &Path, out: &Path, sets: &[&str]) -> std::process::Output
     kdmpm(&args)
 }
 
+/// Runs `kdmpm study` on the study file `study`, writing into `out`, and waits for it.
+pub fn study_into(study: &Path, out: &Path) -> std::process::Output {
+    kdmpm(&[
+        "study",
+        study.to_str().unwrap(),
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ])
+}
+
 /// Waits until the run writing into `dir` has written rows beyond the header of its
 /// history: the run is under way.
 pub fn wait_until_running(dir: &Path) {
