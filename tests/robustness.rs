@@ -400,3 +400,22 @@ fn a_failed_run_writes_neither_null_nor_nan() {
     assert!(leftovers.is_empty(), "temporary files left: {leftovers:?}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `kdmpm check scene.ron | head -3`: the reader closes the pipe after three lines and the
+/// command ends quietly, as other command-line tools do, instead of panicking on the write.
+#[test]
+fn a_reader_that_closes_the_pipe_ends_the_command_without_a_panic() {
+    use std::process::Stdio;
+    let mut child = Command::new(env!("CARGO_BIN_EXE_kdmpm"))
+        .args(["check", common::scene("tbar.ron").to_str().unwrap()])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("kdmpm starts");
+    // The read end closes before kdmpm writes its report.
+    drop(child.stdout.take());
+    let out = child.wait_with_output().expect("kdmpm ends");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert_ne!(out.status.code(), Some(101), "{stderr}");
+}

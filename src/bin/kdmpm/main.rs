@@ -24,6 +24,15 @@ static ALLOCATOR: kdmpm::infra::alloc::Coloured = kdmpm::infra::alloc::Coloured;
 mod cli;
 
 fn main() -> ExitCode {
+    // Writing to a closed pipe (`kdmpm check scene.ron | head -3`) ends the process quietly,
+    // as it ends other command-line tools, instead of panicking in `println!`. Rust starts a
+    // program with SIGPIPE ignored; this puts back the default.
+    // SAFETY: `signal` only sets the process's disposition of SIGPIPE; it runs first, before
+    // any thread is started, and replaces no handler of ours.
+    #[cfg(unix)]
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
     let cli = Cli::parse();
     // MPI starts before any thread pool; without `mpirun` (or the `mpi` feature) this is
     // one rank.
