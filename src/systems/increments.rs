@@ -2,9 +2,6 @@
 //! (`prescribed_motion`) or a rigid body (`rigid_control`): travel at a constant velocity,
 //! in increments, the last step of each covering only what is left of it.
 
-use crate::rigid::BodyMotion;
-use crate::state::MotionSpec;
-
 /// A displacement control: its velocity, the distance to travel and the increment.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Increments {
@@ -16,29 +13,16 @@ pub(crate) struct Increments {
     pub increment: Option<f64>,
 }
 
-impl From<&MotionSpec> for Increments {
-    /// The increments of a motion of grid nodes.
-    fn from(m: &MotionSpec) -> Self {
-        Increments {
-            vector: m.vector(),
-            travel: m.travel,
-            increment: m.increment,
-        }
-    }
-}
-
-impl From<&BodyMotion> for Increments {
-    /// The increments of a rigid body's motion.
-    fn from(m: &BodyMotion) -> Self {
-        Increments {
-            vector: m.vector(),
-            travel: m.travel,
-            increment: m.increment,
-        }
-    }
-}
-
 impl Increments {
+    /// A control at `vector` (m/s) over `travel` (m), in increments of `increment` (m).
+    pub fn new(vector: [f64; 3], travel: f64, increment: Option<f64>) -> Self {
+        Increments {
+            vector,
+            travel,
+            increment,
+        }
+    }
+
     /// Travel at the end of increment `k` (0-based), m.
     pub fn target(&self, k: u32) -> f64 {
         match self.increment {

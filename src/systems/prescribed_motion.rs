@@ -64,7 +64,13 @@ impl<D: Dim> System<D> for PrescribedMotion {
             if d.velocity == [0.0; 3] {
                 continue;
             }
-            Increments::from(m).advance(&mut d.velocity, &mut d.travel, d.increments, dt, ctx.settings.dt);
+            Increments::new(m.vector(), m.travel, m.increment).advance(
+                &mut d.velocity,
+                &mut d.travel,
+                d.increments,
+                dt,
+                ctx.settings.dt,
+            );
         }
         if s.stop != Some(StopReason::Converged) {
             return Ok(());

@@ -182,7 +182,7 @@ impl<D: Dim> System<D> for RigidControl {
             if b.velocity == [0.0; 3] {
                 continue;
             }
-            let moved = Increments::from(m).advance(
+            let moved = Increments::new(m.vector(), m.travel, m.increment).advance(
                 &mut b.velocity,
                 &mut b.travel,
                 b.increments,
