@@ -378,6 +378,51 @@ fn a_smooth_wall_pushed_into_sand_meets_rankines_passive_thrust() {
     assert_eq!(thrust[2], 105109.39838322405);
 }
 
+/// `scenes/passive_wall_rough.ron`, coarser and shorter (h = H/10, 3 % of H): a rough wall
+/// (δ = φ = 30°) pushed into sand that goes on below its toe. Lancellotta's lower bound
+/// (2002, Géotechnique 52(8), eq. 1) for the wall's normal stress, K_p = 5.03, gives
+/// 177.5 kN/m; Coulomb's planar wedge 308.8 kN/m. The rough wall's static thrusts 120.1,
+/// 150.2 and 170.4 kN/m (the last −4.0 %, pinned) rise above the same wall's smooth ones
+/// (116.4, 127.8, 129.3 kN/m, pinned: at this cell the smooth wall reads 22 % over
+/// Rankine's 105.9, its contact reaching a cell below the toe; 7 % at h = H/40), its shear
+/// held under tan δ times the thrust.
+#[test]
+fn a_rough_wall_pushed_into_sand_carries_more_than_the_smooth_one() {
+    let coarse = [
+        "grid.cell_size=0.2",
+        "grid.cells=[65, 25]",
+        "rigid_bodies[0].motion.travel=0.06",
+    ];
+    let rough = run("passive_wall_rough.ron", &coarse);
+    let mut smooth_sets = coarse.to_vec();
+    smooth_sets.push("rigid_bodies[0].interface=Smooth");
+    let smooth = run("passive_wall_rough.ron", &smooth_sets);
+    let thrust =
+        |s: &kdmpm::output::summary::Summary| -> Vec<f64> { s.curve.iter().map(|c| c.force[0]).collect() };
+    let (r, sm) = (thrust(&rough), thrust(&smooth));
+    assert_eq!((r.len(), sm.len()), (3, 3), "{r:?} {sm:?}");
+    let (phi, delta) = (30f64.to_radians(), 30f64.to_radians());
+    let two_theta = (delta.sin() / phi.sin()).asin() + delta;
+    let kp = delta.cos() / (1.0 - phi.sin())
+        * (delta.cos() + (phi.sin().powi(2) - delta.sin().powi(2)).max(0.0).sqrt())
+        * (two_theta * phi.tan()).exp();
+    let weight = 0.5 * 1800.0 * 9.81 * 2.0 * 2.0;
+    let lancellotta = kp * weight;
+    let coulomb_kp = phi.cos().powi(2)
+        / (delta.cos() * (1.0 - ((phi + delta).sin() * phi.sin() / delta.cos()).sqrt()).powi(2));
+    let coulomb = coulomb_kp * delta.cos() * weight;
+    assert!(
+        (kp - 5.026).abs() < 1e-3 && (coulomb - 308.76e3).abs() < 10.0,
+        "{kp} {coulomb}"
+    );
+    assert!(r[2] > 1.2 * sm[2] && r[2] < coulomb, "{r:?} {sm:?}");
+    assert!(rel(r[2], lancellotta).abs() < 0.05, "{r:?} against {lancellotta}");
+    let shear = rough.curve[2].force[1].abs();
+    assert!(shear > 0.1 * r[2] && shear <= delta.tan() * r[2], "{shear} {r:?}");
+    assert_eq!(r[2], 170434.49179852247);
+    assert_eq!(sm[2], 129290.75556154626);
+}
+
 /// `scenes/footing_rigid_load.ron`: the rigid footing under load control, 5 kPa a time to
 /// 55 kPa. The footing settles until the soil carries each load, and the curve it traces
 /// is the displacement-controlled one of `footing_rigid.ron` (54.98 kPa at 3 cm there;
