@@ -206,6 +206,32 @@ fn a_sphere_in_a_plane_scene_and_a_box_in_an_axisymmetric_one_are_refused() {
     assert!(e.contains("r < 0"), "{e}");
 }
 
+/// An axisymmetric body is a solid of revolution: moved or loaded along r its section would
+/// open into a ring. Both are refused with the field (the axial control checks).
+#[test]
+fn an_axisymmetric_body_driven_across_the_axis_is_refused() {
+    let axi = BODY.replacen("dimension: 2", "dimension: Axisymmetric", 1);
+    // Along the axis it builds.
+    let along = kdmpm::scene::LoadedScene::from_text(std::path::Path::new("axi.ron"), &axi, &[]).unwrap();
+    assert!(kdmpm::scene::build(&along).is_ok());
+    let e = refusal(&axi.replacen("velocity: [0.0, -0.01]", "velocity: [0.005, -0.01]", 1));
+    assert!(
+        e.contains("rigid_bodies[0].motion.velocity") && e.contains("along the axis only"),
+        "{e}"
+    );
+    let loaded = axi.replacen(
+        "motion: (velocity: [0.0, -0.01], travel: 0.1, increment: 0.05)",
+        "load: (force: [100.0, -1000.0], increments: 2)",
+        1,
+    );
+    assert_ne!(loaded, axi);
+    let e = refusal(&loaded);
+    assert!(
+        e.contains("rigid_bodies[0].load.force") && e.contains("along the axis only"),
+        "{e}"
+    );
+}
+
 #[test]
 fn a_negative_initial_pressure_is_refused() {
     let e = refused(

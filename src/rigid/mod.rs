@@ -222,10 +222,13 @@ impl RigidBodySpec {
                 .check(n, axisymmetric)
                 .map_err(|(f, r)| (format!("parts[{k}].{f}"), r))?;
         }
-        self.check_interface_and_motion(n)
+        self.check_interface_and_motion(n, axisymmetric)
     }
 
-    fn check_interface_and_motion(&self, n: usize) -> Result<(), (String, String)> {
+    /// The interface, the area and the control; in an axisymmetric scene the body, a solid
+    /// of revolution, moves along the axis only (a radial motion of its section would open
+    /// it into a ring, which no rigid body does).
+    fn check_interface_and_motion(&self, n: usize, axisymmetric: bool) -> Result<(), (String, String)> {
         let bad = |f: &str, r: String| Err((f.to_string(), r));
         let finite = |v: &[f64]| v.iter().all(|c| c.is_finite());
         if let Interface::Frictional { angle, adhesion } = self.interface {
@@ -260,6 +263,16 @@ impl RigidBodySpec {
             if l.vector() == [0.0; 3] {
                 return bad("load.force", "the load is zero: give it a force".into());
             }
+            if axisymmetric && l.force[0] != 0.0 {
+                return bad(
+                    "load.force",
+                    format!(
+                        "{} N along r: an axisymmetric body moves along the axis only (y); the \
+                         radial entry (x) must be 0",
+                        l.force[0]
+                    ),
+                );
+            }
             if !(1..=1_000_000).contains(&l.increments) {
                 return bad(
                     "load.increments",
@@ -285,6 +298,16 @@ impl RigidBodySpec {
             return bad(
                 "motion.velocity",
                 "the body does not move: give it a velocity".into(),
+            );
+        }
+        if axisymmetric && m.velocity[0] != 0.0 {
+            return bad(
+                "motion.velocity",
+                format!(
+                    "{} m/s along r: an axisymmetric body moves along the axis only (y); the \
+                     radial entry (x) must be 0",
+                    m.velocity[0]
+                ),
             );
         }
         if !(m.travel.is_finite() && m.travel > 0.0) {
