@@ -376,16 +376,17 @@ impl RigidBodySpec {
         }
     }
 
-    /// True when the body is driven during stage `k` of `stages` (the scene's stage names,
-    /// in order; none for a scene without stages): it has a motion or a load, and no stage
-    /// to wait for or one among the first k + 1.
-    pub fn moves_in(&self, k: usize, stages: &[&str]) -> bool {
+    /// The first stage (index into `stages`, the scene's stage names in order; none for a
+    /// scene without stages) in which the body is driven: 0 unless its control waits for a
+    /// later stage. `None` for a body with neither a motion nor a load, or one waiting for
+    /// a stage the scene does not have (validation refuses that).
+    pub fn first_stage(&self, stages: &[&str]) -> Option<usize> {
         if self.motion.is_none() && self.load.is_none() {
-            return false;
+            return None;
         }
         match self.stage() {
-            None => true,
-            Some(s) => stages.iter().take(k + 1).any(|t| t == s),
+            None => Some(0),
+            Some(s) => stages.iter().position(|t| t == s),
         }
     }
 
@@ -426,17 +427,18 @@ impl RigidBodySpec {
         volume * cell.powi(n as i32)
     }
 
-    /// The body's state at the start of a run (`stages`: the scene's stage names): moving,
-    /// unless it holds its place or waits for a later stage.
-    pub fn state(&self, stages: &[&str]) -> BodyState {
+    /// The body's state at the start of a run (`first`: its [`Self::first_stage`]):
+    /// moving, unless it holds its place or waits for a later stage.
+    pub fn state(&self, first: Option<usize>) -> BodyState {
+        let now = first == Some(0);
         BodyState {
             name: self.name.clone(),
             velocity: match &self.motion {
-                Some(m) if self.moves_in(0, stages) => m.vector(),
+                Some(m) if now => m.vector(),
                 _ => [0.0; 3],
             },
             load: match &self.load {
-                Some(l) if self.moves_in(0, stages) => l.at(0),
+                Some(l) if now => l.at(0),
                 _ => [0.0; 3],
             },
             parts: vec![[0.0; 3]; self.parts.len()],

@@ -395,7 +395,10 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
             drives: s.motions.iter().map(MotionSpec::drive).collect(),
             bodies: {
                 let stages: Vec<&str> = s.stages.iter().map(|t| t.name.as_str()).collect();
-                s.rigid_bodies.iter().map(|b| b.state(&stages)).collect()
+                s.rigid_bodies
+                    .iter()
+                    .map(|b| b.state(b.first_stage(&stages)))
+                    .collect()
             },
             ..Control::default()
         },

@@ -503,7 +503,7 @@ fn relaxing<D: Dim, S: Shape>() -> Vec<Entry<D>> {
                 ("prescribed_motion", "the bodies' rows follow the motions'"),
             ],
             "rigid bodies: travel or carry a load, hold, curve of static states",
-            |s| Box::new(RigidControl::new(s.bodies.clone())),
+            |s| Box::new(RigidControl::new(s.bodies.clone(), &s.stages)),
         ),
         e(
             "load_steps",

@@ -41,7 +41,7 @@ use crate::infra::columns::{col_mut, points_with};
 use crate::rigid::{BodyLoad, BodyState, RigidBodySpec};
 use crate::schedule::System;
 use crate::state::{CurvePoint, StopReason};
-use crate::state::{Settings, SolverState};
+use crate::state::{LoadStage, Settings, SolverState};
 use crate::systems::increments::Increments;
 
 /// Moves the bodies, holds them at the end of an increment and, at the static state that
@@ -49,13 +49,22 @@ use crate::systems::increments::Increments;
 #[derive(Debug)]
 pub struct RigidControl {
     bodies: Vec<RigidBodySpec>,
+    /// Per body: the first stage in which it is driven ([`RigidBodySpec::first_stage`]).
+    first: Vec<Option<usize>>,
 }
 
 impl RigidControl {
-    /// The system for these bodies (in scene order).
-    pub fn new(bodies: Vec<RigidBodySpec>) -> Self {
-        RigidControl { bodies }
+    /// The system for these bodies (in scene order) in a run of these `stages`.
+    pub fn new(bodies: Vec<RigidBodySpec>, stages: &[LoadStage]) -> Self {
+        let names: Vec<&str> = stages.iter().map(|t| t.name.as_str()).collect();
+        let first = bodies.iter().map(|b| b.first_stage(&names)).collect();
+        RigidControl { bodies, first }
     }
+}
+
+/// True when a body whose first driven stage is `first` is driven during stage `k`.
+fn driven(first: Option<usize>, k: usize) -> bool {
+    first.is_some_and(|f| k >= f)
 }
 
 /// Puts every point whose centre lies inside a body back on its surface (along the
@@ -147,10 +156,14 @@ fn check_in_grid<D: Dim>(
 
 /// At the run's `max_time`: the first body still in an increment of this stage found no
 /// static state.
-fn stuck(bodies: &[RigidBodySpec], s: &SolverState, settings: &Settings) -> Result<(), StepError> {
-    let stages: Vec<&str> = settings.stages.iter().map(|t| t.name.as_str()).collect();
-    for (spec, b) in bodies.iter().zip(&s.control.bodies) {
-        if spec.moves_in(s.control.stage, &stages) && b.increments < spec.increments() {
+fn stuck(
+    bodies: &[RigidBodySpec],
+    first: &[Option<usize>],
+    s: &SolverState,
+    settings: &Settings,
+) -> Result<(), StepError> {
+    for ((spec, b), &f) in bodies.iter().zip(&s.control.bodies).zip(first) {
+        if driven(f, s.control.stage) && b.increments < spec.increments() {
             return Err(StepError::NoStaticState {
                 step: s.clock.step,
                 time: s.clock.time,
@@ -200,16 +213,15 @@ impl<D: Dim> System<D> for RigidControl {
         }
         let s = &mut ctx.state;
         if s.stop == Some(StopReason::MaxTime) {
-            stuck(&self.bodies, s, &ctx.settings)?;
+            stuck(&self.bodies, &self.first, s, &ctx.settings)?;
         }
         // A static state: the run's stop, or one `prescribed_motion` took this step.
         if s.stop != Some(StopReason::Converged) && !s.control.milestone {
             return Ok(());
         }
-        let stages: Vec<&str> = ctx.settings.stages.iter().map(|t| t.name.as_str()).collect();
         // Every body holds (a moving one blocks convergence): a static state.
         let mut more = false;
-        for (spec, b) in self.bodies.iter().zip(&mut s.control.bodies) {
+        for ((spec, b), &first) in self.bodies.iter().zip(&mut s.control.bodies).zip(&self.first) {
             // The mean pressure along the motion, or, for a body that holds its place, of
             // the whole force.
             let along = |f: [f64; 3]| -> f64 {
@@ -239,7 +251,7 @@ impl<D: Dim> System<D> for RigidControl {
                     });
                 }
             }
-            if !spec.moves_in(s.control.stage, &stages) || b.increments >= spec.increments() {
+            if !driven(first, s.control.stage) || b.increments >= spec.increments() {
                 continue;
             }
             b.increments += 1;
