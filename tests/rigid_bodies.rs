@@ -449,6 +449,35 @@ fn a_rough_wall_pushed_into_sand_carries_more_than_the_smooth_one() {
     assert_eq!(sm[2], 129290.75556154626);
 }
 
+/// The same block on a rigid base with adhesion alone (`Frictional(angle: 0.0, adhesion:
+/// 5 kPa)`), pushed 6 mm: once it slides the wall's push is the adhesion times the block's
+/// length, a·L = 10 kN/m. The static states 9.77, 10.03 and 10.13 kN/m (the last +1.3 %,
+/// pinned). When MUSL's remap granted the adhesion a second time in each step, the block
+/// never came to rest (K_F held at 1.2 % for 100 s).
+#[test]
+fn a_block_slides_on_an_adhesive_base_at_the_adhesion_times_its_length() {
+    let s = run(
+        "block_on_rigid_base.ron",
+        &[
+            "rigid_bodies[0].interface=Frictional(angle: 0.0, adhesion: 5.0e3)",
+            "rigid_bodies[1].motion.travel=0.006",
+        ],
+    );
+    assert!(s.converged, "{:?}", s.error);
+    let wall: Vec<f64> = s
+        .curve
+        .iter()
+        .filter(|c| c.name == "wall")
+        .map(|c| c.force[0])
+        .collect();
+    assert_eq!(wall.len(), 3);
+    let adhesion = 5.0e3 * 2.0;
+    for f in &wall {
+        assert!(rel(*f, adhesion).abs() < 0.03, "{wall:?} against {adhesion}");
+    }
+    assert_eq!(wall[2], 10131.32214958934);
+}
+
 /// `scenes/footing_rigid_load.ron`: the rigid footing under load control, 5 kPa a time to
 /// 55 kPa. The footing settles until the soil carries each load, and the curve it traces
 /// is the displacement-controlled one of `footing_rigid.ron` (54.98 kPa at 3 cm there;
