@@ -231,6 +231,19 @@ impl RigidBodySpec {
     fn check_interface_and_motion(&self, n: usize, axisymmetric: bool) -> Result<(), (String, String)> {
         let bad = |f: &str, r: String| Err((f.to_string(), r));
         let finite = |v: &[f64]| v.iter().all(|c| c.is_finite());
+        // The radial entry `along_r` (in `unit`) of a control: none in an axisymmetric scene.
+        let radial = |field: &str, along_r: f64, unit: &str| {
+            if axisymmetric && along_r != 0.0 {
+                return bad(
+                    field,
+                    format!(
+                        "{along_r} {unit} along r: an axisymmetric body moves along the axis only \
+                         (y); the radial entry (x) must be 0"
+                    ),
+                );
+            }
+            Ok(())
+        };
         if let Interface::Frictional { angle, adhesion } = self.interface {
             if !(angle.is_finite() && (0.0..90.0).contains(&angle)) {
                 return bad(
@@ -263,16 +276,7 @@ impl RigidBodySpec {
             if l.vector() == [0.0; 3] {
                 return bad("load.force", "the load is zero: give it a force".into());
             }
-            if axisymmetric && l.force[0] != 0.0 {
-                return bad(
-                    "load.force",
-                    format!(
-                        "{} N along r: an axisymmetric body moves along the axis only (y); the \
-                         radial entry (x) must be 0",
-                        l.force[0]
-                    ),
-                );
-            }
+            radial("load.force", l.force[0], "N")?;
             if !(1..=1_000_000).contains(&l.increments) {
                 return bad(
                     "load.increments",
@@ -300,16 +304,7 @@ impl RigidBodySpec {
                 "the body does not move: give it a velocity".into(),
             );
         }
-        if axisymmetric && m.velocity[0] != 0.0 {
-            return bad(
-                "motion.velocity",
-                format!(
-                    "{} m/s along r: an axisymmetric body moves along the axis only (y); the \
-                     radial entry (x) must be 0",
-                    m.velocity[0]
-                ),
-            );
-        }
+        radial("motion.velocity", m.velocity[0], "m/s")?;
         if !(m.travel.is_finite() && m.travel > 0.0) {
             return bad("motion.travel", format!("must be above 0 m, found {}", m.travel));
         }
