@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{refusal, rel, run};
+use common::{forces, refusal, rel, run};
 
 /// `scenes/footing_rigid.ron`: the smooth strip footing of `footing.ron` as a rigid body
 /// pushed 0.1 m into weightless Tresca clay. Prandtl's limit pressure (2 + π) c = 51.42 kPa
@@ -300,12 +300,7 @@ fn a_rough_tbar_has_the_rough_flow_round_factor() {
 fn a_block_slides_on_a_rigid_base_at_its_weight_times_tan_delta() {
     let friction = 20f64.to_radians().tan() * 2000.0 * 9.81 * 2.0;
     let s = run("block_on_rigid_base.ron", &[]);
-    let wall: Vec<f64> = s
-        .curve
-        .iter()
-        .filter(|c| c.name == "wall")
-        .map(|c| c.force[0])
-        .collect();
+    let wall = forces(&s, "wall", 0);
     assert_eq!(wall.len(), 10);
     for f in &wall[1..] {
         assert!(rel(*f, friction).abs() < 0.05, "{wall:?} against {friction}");
@@ -423,9 +418,7 @@ fn a_rough_wall_pushed_into_sand_carries_more_than_the_smooth_one() {
     let mut smooth_sets = coarse.to_vec();
     smooth_sets.push("rigid_bodies[0].interface=Smooth");
     let smooth = run("passive_wall_rough.ron", &smooth_sets);
-    let thrust =
-        |s: &kdmpm::output::summary::Summary| -> Vec<f64> { s.curve.iter().map(|c| c.force[0]).collect() };
-    let (r, sm) = (thrust(&rough), thrust(&smooth));
+    let (r, sm) = (forces(&rough, "wall", 0), forces(&smooth, "wall", 0));
     assert_eq!((r.len(), sm.len()), (3, 3), "{r:?} {sm:?}");
     let (phi, delta) = (30f64.to_radians(), 30f64.to_radians());
     let two_theta = (delta.sin() / phi.sin()).asin() + delta;
@@ -464,12 +457,7 @@ fn a_block_slides_on_an_adhesive_base_at_the_adhesion_times_its_length() {
         ],
     );
     assert!(s.converged, "{:?}", s.error);
-    let wall: Vec<f64> = s
-        .curve
-        .iter()
-        .filter(|c| c.name == "wall")
-        .map(|c| c.force[0])
-        .collect();
+    let wall = forces(&s, "wall", 0);
     assert_eq!(wall.len(), 3);
     let adhesion = 5.0e3 * 2.0;
     for f in &wall {

@@ -118,6 +118,16 @@ pub fn rel(a: f64, b: f64) -> f64 {
     a / b - 1.0
 }
 
+/// The force along `axis` (N; N/m in 2D) at each static state in `s`'s curve rows named
+/// `name` (a motion or a rigid body).
+pub fn forces(s: &Summary, name: &str, axis: usize) -> Vec<f64> {
+    s.curve
+        .iter()
+        .filter(|c| c.name == name)
+        .map(|c| c.force[axis])
+        .collect()
+}
+
 /// The bank's material: cohesionless Mohr-Coulomb sand.
 pub const SAND: &str = "MohrCoulomb(density: 1900.0, youngs_modulus: 1.0e7, poisson_ratio: 0.3, \
                         cohesion: 0.0, friction_angle: 25.0, dilatancy_angle: 0.0)";
