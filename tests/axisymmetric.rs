@@ -265,7 +265,29 @@ fn a_smooth_cone_takes_its_resistance_at_the_tip() {
     assert!(shaft.force[1].abs() < 0.01 * tip.force[1].abs(), "{shaft:?}");
     assert_eq!(shaft.pressure, None);
     let n_kt = (tip.pressure.unwrap() - 100.0e3) / 10.0e3;
-    assert_eq!(n_kt, 7.792174954797936);
+    assert_eq!(n_kt, SMOOTH_CONE_FIRST_N_KT);
+}
+
+/// N_kt of the smooth cone at h = D/4 after its first D/4 (pinned above).
+const SMOOTH_CONE_FIRST_N_KT: f64 = 7.792174954797936;
+
+/// The same first D/4 with the tip's part rough (`interface: Some(Rough)`) below the
+/// smooth shaft: the tip bears more than the smooth cone's, and the shaft still nothing
+/// but its shoulder's corner. N_kt = 12.95 here, pinned; steady over 5–10 D it is 16.7
+/// at h = D/4 against the smooth 13.1 (+27 %; Teh & Houlsby 1991 give about +25 % for a
+/// rough cone at I_r = 100), docs/verification.md.
+#[test]
+fn a_cone_with_a_rough_tip_bears_more_than_the_smooth_one() {
+    let mut sets = at_d4("rigid_bodies[0].motion.travel=0.25").to_vec();
+    sets.push("rigid_bodies[0].parts[0].interface=Some(Rough)");
+    let s = run("cpt.ron", &sets);
+    assert!(s.converged, "{:?}", s.error);
+    let row = |name: &str| s.curve.iter().find(|c| c.name == name).unwrap().clone();
+    let (tip, shaft) = (row("cone.tip"), row("cone.shaft"));
+    let n_kt = (tip.pressure.unwrap() - 100.0e3) / 10.0e3;
+    assert!(n_kt > 1.2 * SMOOTH_CONE_FIRST_N_KT, "{n_kt}");
+    assert!(shaft.force[1].abs() < 0.05 * tip.force[1].abs(), "{shaft:?}");
+    assert_eq!(n_kt, 12.946914020004103);
 }
 
 /// `scenes/pile_jacking.ron` at h = D/4 over its first D/2: the base's N_c = (q_b − σ_v0)/c_u

@@ -138,6 +138,20 @@ fn a_friction_angle_of_ninety_degrees_is_refused() {
     );
 }
 
+/// A part's own interface keeps the body's rules, the part's field named.
+#[test]
+fn a_parts_negative_adhesion_is_refused_with_the_parts_field() {
+    let e = refused(
+        "geometry: Polygon(vertices: [[0.0, 1.0], [0.5, 1.0], [0.5, 1.5], [0.0, 1.5]]))",
+        "geometry: Polygon(vertices: [[0.0, 1.0], [0.5, 1.0], [0.5, 1.5], [0.0, 1.5]]), \
+         interface: Some(Frictional(angle: 10.0, adhesion: -1.0)))",
+    );
+    assert!(
+        e.contains("rigid_bodies[0].parts[0].interface") && e.contains("adhesion is ≥ 0"),
+        "{e}"
+    );
+}
+
 #[test]
 fn a_body_that_does_not_move_is_refused() {
     let e = refused("velocity: [0.0, -0.01]", "velocity: [0.0, 0.0]");

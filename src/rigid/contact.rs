@@ -52,6 +52,8 @@ pub struct Contact {
     pub part: usize,
     /// Unit outward normal of the body (x y z).
     pub normal: [f64; 3],
+    /// Friction coefficient tan δ of the sample's part (infinite when rough).
+    pub friction: f64,
     /// Adhesion cap on the sample's tangential impulse (N s), a·A_s·Δt.
     pub adhesion: f64,
     /// False for a node inside the body: it holds the normal only (friction and adhesion
@@ -212,9 +214,9 @@ fn velocity(p: &Contact, slots: &[Slot]) -> [f64; 3] {
 
 /// Projected Gauss–Seidel over the samples, each normal impulse starting at its value in
 /// `memory` (zero when it has none; the tangential ones at zero): no entry into a body
-/// moving at `body_velocity` (m/s, per body), then friction (`mu` = tan δ per body,
-/// infinite when rough, 0 with adhesion alone) where a sample presses.
-pub fn solve(set: &mut Contacts, body_velocity: &[[f64; 3]], mu: &[f64], memory: &Memory) {
+/// moving at `body_velocity` (m/s, per body), then friction (each sample's
+/// [`Contact::friction`] and [`Contact::adhesion`]) where a sample presses.
+pub fn solve(set: &mut Contacts, body_velocity: &[[f64; 3]], memory: &Memory) {
     let slots = &mut set.slots[..];
     for s in slots.iter_mut() {
         s.pressed = [0.0; 3];
@@ -275,7 +277,7 @@ pub fn solve(set: &mut Contacts, body_velocity: &[[f64; 3]], mu: &[f64], memory:
                 let took = push(p, slots, n, delta, s2, true);
                 (0..3).for_each(|a| p.impulse[a] += took[a]);
             }
-            let m = mu[p.body];
+            let m = p.friction;
             if !p.surface || (m == 0.0 && p.adhesion == 0.0) {
                 continue;
             }

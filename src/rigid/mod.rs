@@ -32,7 +32,7 @@ pub struct RigidBodySpec {
     /// Its shape at the start: one or more named parts (a cone's `tip` and `shaft`), whose
     /// union is the body; the resistance is summed per part as well as per body.
     pub parts: Vec<PartSpec>,
-    /// How the soil slides along it.
+    /// How the soil slides along it (along every part that does not give its own).
     #[serde(default)]
     pub interface: Interface,
     /// How it moves; without one the body holds its place (a rigid base, a wall at rest)
@@ -59,6 +59,10 @@ pub struct PartSpec {
     /// Loaded area, as the body's, for the part's mean pressure.
     #[serde(default)]
     pub area: Option<f64>,
+    /// The part's own interface (a cone's rough tip below a smooth sleeve); the body's
+    /// when absent.
+    #[serde(default)]
+    pub interface: Option<Interface>,
 }
 
 /// The soil–structure interface.
@@ -166,7 +170,27 @@ impl Interface {
     }
 }
 
+impl Interface {
+    /// The rules an interface holds by itself (the friction angle and the adhesion).
+    pub fn check(&self) -> Result<(), String> {
+        if let Interface::Frictional { angle, adhesion } = *self {
+            if !(angle.is_finite() && (0.0..90.0).contains(&angle)) {
+                return Err(format!("the friction angle is 0 ≤ δ < 90°, found {angle}"));
+            }
+            if !(adhesion.is_finite() && adhesion >= 0.0) {
+                return Err(format!("the adhesion is ≥ 0 Pa, found {adhesion}"));
+            }
+        }
+        Ok(())
+    }
+}
+
 impl RigidBodySpec {
+    /// The interface along part `k`: its own, or the body's.
+    pub fn interface_of(&self, k: usize) -> Interface {
+        self.parts[k].interface.unwrap_or(self.interface)
+    }
+
     /// Signed distance φ (m, negative inside) from `x` (m, in the body's starting frame) to
     /// the body, the unit outward normal there and the part it belongs to (the nearest
     /// surface; inside, the part that holds `x` deepest).
@@ -221,6 +245,9 @@ impl RigidBodySpec {
             p.geometry
                 .check(n, axisymmetric)
                 .map_err(|(f, r)| (format!("parts[{k}].{f}"), r))?;
+            if let Some(i) = p.interface {
+                i.check().map_err(|r| (format!("parts[{k}].interface"), r))?;
+            }
         }
         self.check_interface_and_motion(n, axisymmetric)
     }
@@ -244,17 +271,7 @@ impl RigidBodySpec {
             }
             Ok(())
         };
-        if let Interface::Frictional { angle, adhesion } = self.interface {
-            if !(angle.is_finite() && (0.0..90.0).contains(&angle)) {
-                return bad(
-                    "interface",
-                    format!("the friction angle is 0 ≤ δ < 90°, found {angle}"),
-                );
-            }
-            if !(adhesion.is_finite() && adhesion >= 0.0) {
-                return bad("interface", format!("the adhesion is ≥ 0 Pa, found {adhesion}"));
-            }
-        }
+        self.interface.check().map_err(|r| ("interface".to_string(), r))?;
         if let Some(a) = self.area {
             if !(a.is_finite() && a > 0.0) {
                 return bad("area", format!("must be above 0, found {a}"));

@@ -11,7 +11,8 @@
 //! summed per sample), so that overlapping samples share their nodes' correction. Where the
 //! soil presses, the tangential slip at a sample is removed the same way, by at most
 //! tan δ · N_s + a·A_s·Δt (Coulomb friction with an adhesion cap a on the sample's surface
-//! A_s; no cap when rough, nothing when smooth), N_s being the normal impulse its nodes
+//! A_s, from the interface of the sample's part; no cap when rough, nothing when smooth),
+//! N_s being the normal impulse its nodes
 //! took, from the samples and the inside nodes alike, shared among the samples that reach
 //! them ([`crate::rigid::contact`]).
 //!
@@ -94,7 +95,10 @@ fn place<D: Dim, S: Shape>(ctx: &Context<D>, samples: &[Vec<(Sample, usize)>]) -
     for (b, body) in samples.iter().enumerate() {
         let state = &ctx.state.control.bodies[b];
         let spec = &st.bodies[b];
-        let (_, adhesion) = spec.interface.friction();
+        // Per part: (tan δ, a) of its interface.
+        let interfaces: Vec<(f64, f64)> = (0..spec.parts.len())
+            .map(|k| spec.interface_of(k).friction())
+            .collect();
         // The nodes inside the body hold their normal velocity too: the soil's field
         // there is the body's, and a light node that only a point's tail reaches would
         // otherwise be free to run into it (under a confining stress it does).
@@ -124,6 +128,7 @@ fn place<D: Dim, S: Shape>(ctx: &Context<D>, samples: &[Vec<(Sample, usize)>]) -
                 body: b,
                 part,
                 normal,
+                friction: 0.0,
                 adhesion: 0.0,
                 surface: false,
                 nodes: vec![(k, 1.0)],
@@ -163,7 +168,8 @@ fn place<D: Dim, S: Shape>(ctx: &Context<D>, samples: &[Vec<(Sample, usize)>]) -
                 body: b,
                 part: *part,
                 normal: s.normal,
-                adhesion: adhesion * area * st.dt,
+                friction: interfaces[*part].0,
+                adhesion: interfaces[*part].1 * area * st.dt,
                 surface: true,
                 nodes: reach,
                 weight,
@@ -211,8 +217,7 @@ impl<D: Dim, S: Shape> System<D> for RigidContact<D, S> {
         let mut set = place::<D, S>(ctx, &self.samples);
         let bodies = &ctx.settings.bodies;
         let velocities: Vec<[f64; 3]> = ctx.state.control.bodies.iter().map(|b| b.velocity).collect();
-        let mu: Vec<f64> = bodies.iter().map(|b| b.interface.friction().0).collect();
-        solve(&mut set, &velocities, &mu, &ctx.state.control.contact_memory);
+        solve(&mut set, &velocities, &ctx.state.control.contact_memory);
         ctx.state.control.contact_memory = remember(&set.contacts);
         let dt = ctx.settings.dt;
         let n = nodes(&ctx.world);
@@ -277,16 +282,10 @@ pub fn project<D: Dim>(ctx: &mut Context<D>) {
         s.inertia = grid.inertia(s.node, nm[s.node].0, floor);
     }
     let velocities: Vec<[f64; 3]> = control.bodies.iter().map(|b| b.velocity).collect();
-    let mu: Vec<f64> = ctx
-        .settings
-        .bodies
-        .iter()
-        .map(|b| b.interface.friction().0)
-        .collect();
     for p in &mut control.contacts.contacts {
         p.adhesion = 0.0;
     }
-    solve(&mut control.contacts, &velocities, &mu, &Memory::new());
+    solve(&mut control.contacts, &velocities, &Memory::new());
     for s in &control.contacts.slots {
         nv[s.node].0 = D::vec_from(s.v);
     }
