@@ -168,20 +168,26 @@ impl Interface {
             Interface::Frictional { angle, adhesion } => (angle.to_radians().tan(), adhesion),
         }
     }
-}
 
-impl Interface {
     /// The rules an interface holds by itself (the friction angle and the adhesion).
     pub fn check(&self) -> Result<(), String> {
         if let Interface::Frictional { angle, adhesion } = *self {
-            if !(angle.is_finite() && (0.0..90.0).contains(&angle)) {
-                return Err(format!("the friction angle is 0 ≤ δ < 90°, found {angle}"));
-            }
+            check_friction_angle(angle)?;
             if !(adhesion.is_finite() && adhesion >= 0.0) {
                 return Err(format!("the adhesion is ≥ 0 Pa, found {adhesion}"));
             }
         }
         Ok(())
+    }
+}
+
+/// The rule for a friction angle δ (degrees) between soil and a structure, a body's or a
+/// `Friction` face's: 0 ≤ δ < 90°.
+pub fn check_friction_angle(angle: f64) -> Result<(), String> {
+    if angle.is_finite() && (0.0..90.0).contains(&angle) {
+        Ok(())
+    } else {
+        Err(format!("the friction angle is 0 ≤ δ < 90°, found {angle}"))
     }
 }
 

@@ -12,9 +12,8 @@
 //! soil presses, the tangential slip at a sample is removed the same way, by at most
 //! tan δ · N_s + a·A_s·Δt (Coulomb friction with an adhesion cap a on the sample's surface
 //! A_s, from the interface of the sample's part; no cap when rough, nothing when smooth),
-//! N_s being the normal impulse its nodes
-//! took, from the samples and the inside nodes alike, shared among the samples that reach
-//! them ([`crate::rigid::contact`]).
+//! N_s being the normal impulse its nodes took, from the samples and the inside nodes
+//! alike, shared among the samples that reach them ([`crate::rigid::contact`]).
 //!
 //! It runs before `boundary`, so that a `Friction` face and a motion's nodes feel the
 //! contact's force; the components they hold enter the contact as `boundary` will set
@@ -49,6 +48,8 @@ use std::marker::PhantomData;
 pub struct RigidContact<D: Dim, S> {
     /// Per body: its samples in its starting frame and the part each belongs to.
     samples: Vec<Vec<(Sample, usize)>>,
+    /// Per body, per part: (tan δ, adhesion a in Pa) of the part's interface.
+    interfaces: Vec<Vec<(f64, f64)>>,
     _marker: PhantomData<fn() -> (D, S)>,
 }
 
@@ -56,6 +57,7 @@ impl<D: Dim, S> Default for RigidContact<D, S> {
     fn default() -> Self {
         RigidContact {
             samples: Vec::new(),
+            interfaces: Vec::new(),
             _marker: PhantomData,
         }
     }
@@ -64,7 +66,11 @@ impl<D: Dim, S> Default for RigidContact<D, S> {
 /// Places every sample that meets soil at its body's current place: its nodes that carry
 /// soil and their weights, each node's trial velocity p/m + f Δt/m̃. A sample meets soil
 /// when nodes carrying mass hold at least half its support.
-fn place<D: Dim, S: Shape>(ctx: &Context<D>, samples: &[Vec<(Sample, usize)>]) -> Contacts {
+fn place<D: Dim, S: Shape>(
+    ctx: &Context<D>,
+    samples: &[Vec<(Sample, usize)>],
+    interfaces: &[Vec<(f64, f64)>],
+) -> Contacts {
     let n = nodes(&ctx.world);
     let (nm, np, nf, fix) = (
         col::<NodeMass>(n),
@@ -95,10 +101,7 @@ fn place<D: Dim, S: Shape>(ctx: &Context<D>, samples: &[Vec<(Sample, usize)>]) -
     for (b, body) in samples.iter().enumerate() {
         let state = &ctx.state.control.bodies[b];
         let spec = &st.bodies[b];
-        // Per part: (tan δ, a) of its interface.
-        let interfaces: Vec<(f64, f64)> = (0..spec.parts.len())
-            .map(|k| spec.interface_of(k).friction())
-            .collect();
+        let interfaces = &interfaces[b];
         // The nodes inside the body hold their normal velocity too: the soil's field
         // there is the body's, and a light node that only a point's tail reaches would
         // otherwise be free to run into it (under a confining stress it does).
@@ -210,11 +213,17 @@ impl<D: Dim, S: Shape> System<D> for RigidContact<D, S> {
                     .collect()
             })
             .collect();
+        self.interfaces = ctx
+            .settings
+            .bodies
+            .iter()
+            .map(|b| (0..b.parts.len()).map(|k| b.interface_of(k).friction()).collect())
+            .collect();
         Ok(())
     }
 
     fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
-        let mut set = place::<D, S>(ctx, &self.samples);
+        let mut set = place::<D, S>(ctx, &self.samples, &self.interfaces);
         let bodies = &ctx.settings.bodies;
         let velocities: Vec<[f64; 3]> = ctx.state.control.bodies.iter().map(|b| b.velocity).collect();
         solve(&mut set, &velocities, &ctx.state.control.contact_memory);

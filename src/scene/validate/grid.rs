@@ -2,6 +2,7 @@
 
 use super::*;
 use crate::error::SceneError;
+use crate::rigid::check_friction_angle;
 use crate::scene::{pad3, BoundarySpec, Condition};
 use crate::shape::ShapeKind;
 
@@ -82,12 +83,7 @@ pub(super) fn check_faces(
             Condition::Fixed => ((1u8 << n) - 1, None),
             Condition::Roller => (1u8 << axis, None),
             Condition::Friction(angle) => {
-                if !(angle.is_finite() && (0.0..90.0).contains(&angle)) {
-                    return Err((
-                        format!("{field}[{i}].condition"),
-                        format!("the friction angle is 0 ≤ δ < 90°, found {angle}"),
-                    ));
-                }
+                check_friction_angle(angle).map_err(|r| (format!("{field}[{i}].condition"), r))?;
                 (1u8 << axis, Some(angle.to_radians().tan()))
             }
         };
