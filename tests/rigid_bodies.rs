@@ -255,13 +255,12 @@ fn a_negative_initial_pressure_is_refused() {
     assert!(e.contains("bodies[0].initial_pressure"), "{e}");
 }
 
-/// `scenes/tbar.ron` at h = D/8 over 0.15 D with `extra` overrides: its summary and
-/// N = F/(c_u D) at its three static states.
+/// `scenes/tbar.ron` with 2 × 2 points a cell (the scene has 3 × 3) over 0.15 D, with
+/// `extra` overrides: its summary and N = F/(c_u D) at its three static states.
 fn coarse_tbar(extra: &[&str]) -> (kdmpm::output::summary::Summary, Vec<f64>) {
     let coarse = [
         &[
-            "grid.cell_size=0.125",
-            "grid.cells=[20, 56]",
+            "bodies[0].points_per_cell=[2, 2]",
             "rigid_bodies[0].motion.travel=0.15",
         ][..],
         extra,
@@ -273,11 +272,12 @@ fn coarse_tbar(extra: &[&str]) -> (kdmpm::output::summary::Summary, Vec<f64>) {
     (s, n)
 }
 
-/// `scenes/tbar.ron`, coarser and shorter (h = D/8, 0.15 D of travel): a smooth T-bar in
-/// confined Tresca clay. Randolph & Houlsby (1984) and Martin & Randolph (2006) give
-/// N = F/(c_u D) = 9.14 for full flow round a smooth cylinder; the static states here
-/// (9.21, 9.38, 9.62) average 9.40, +2.9 %, within 5 % (the swing as the bar crosses the
-/// cells is a few per cent; over 0.25 D the mean is 9.23), and the last is pinned.
+/// `scenes/tbar.ron`, coarser and shorter (2 × 2 points a cell, 0.15 D of travel): a
+/// smooth T-bar in confined Tresca clay. Randolph & Houlsby (1984) and Martin & Randolph
+/// (2006) give N = F/(c_u D) = 9.14 for full flow round a smooth cylinder; the static
+/// states here (9.21, 9.38, 9.62) average 9.40, +2.9 %, within 5 % (the swing as the bar
+/// crosses the cells is a few per cent; over 0.25 D the mean is 9.23), and the last is
+/// pinned.
 #[test]
 fn a_smooth_tbar_in_confined_tresca_clay_has_the_flow_round_factor() {
     let (s, n) = coarse_tbar(&[]);
