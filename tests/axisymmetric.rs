@@ -275,7 +275,7 @@ const SMOOTH_CONE_FIRST_N_KT: f64 = 7.792174954797936;
 /// smooth shaft: the part's interface holds along the tip, which bears more than the
 /// smooth cone's, and the shaft still takes nothing but its shoulder's corner. N_kt =
 /// 12.95 here, pinned. (The excess comes through a face shear of several c_u, more than
-/// the clay can hold: docs/verification.md has why it is not yet a rough cone's figure.)
+/// the clay can hold: the rough cone's figure is the adhesive tip's, below.)
 #[test]
 fn a_cone_with_a_rough_tip_bears_more_than_the_smooth_one() {
     let mut sets = at_d4("rigid_bodies[0].motion.travel=0.25").to_vec();
@@ -288,6 +288,23 @@ fn a_cone_with_a_rough_tip_bears_more_than_the_smooth_one() {
     assert!(n_kt > 1.2 * SMOOTH_CONE_FIRST_N_KT, "{n_kt}");
     assert!(shaft.force[1].abs() < 0.05 * tip.force[1].abs(), "{shaft:?}");
     assert_eq!(n_kt, 12.946914020004103);
+}
+
+/// The same first D/4 with an adhesion of c_u on the tip (`Frictional(angle: 0.0,
+/// adhesion: 10.0e3)`: a shear of at most c_u along the face, the fully rough interface of
+/// the plasticity solutions in Tresca clay): the tip bears more than the smooth cone's,
+/// pinned (the shipped h = D/8 over 5–10 D: N_kt 11.80 against 11.28,
+/// docs/verification.md).
+#[test]
+fn a_cone_with_an_adhesive_tip_bears_more_than_the_smooth_one() {
+    let mut sets = at_d4("rigid_bodies[0].motion.travel=0.25").to_vec();
+    sets.push("rigid_bodies[0].parts[0].interface=Some(Frictional(angle: 0.0, adhesion: 10.0e3))");
+    let s = run("cpt.ron", &sets);
+    assert!(s.converged, "{:?}", s.error);
+    let tip = s.curve.iter().find(|c| c.name == "cone.tip").unwrap();
+    let n_kt = (tip.pressure.unwrap() - 100.0e3) / 10.0e3;
+    assert!(n_kt > SMOOTH_CONE_FIRST_N_KT, "{n_kt}");
+    assert_eq!(n_kt, 9.505941584754712);
 }
 
 /// `scenes/pile_jacking.ron` at h = D/4 over its first D/2: the base's N_c = (q_b − σ_v0)/c_u
