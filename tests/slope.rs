@@ -5,6 +5,8 @@
 //! Expected angle here: Davis's effective friction angle for non-associated flow in plane
 //! strain, tan φ* = sin φ cos ψ / (1 − sin φ sin ψ) = sin 20° → φ* = 18.9°.
 
+mod common;
+
 use kdmpm::components::Mass;
 use kdmpm::infra::columns::{col, points_with};
 use kdmpm::measure::{all_positions_finite, max_displacements, max_movement, positions, surface_angle};
@@ -105,28 +107,32 @@ fn run_and_continue<D: Dim>(sim: &mut Simulation<D>) -> Rest {
 /// by Davis for ψ = 0), crest u_x 22.5158 m, max u_x 35.312 m.
 #[test]
 fn failing_slope_comes_to_rest_at_its_repose_angle() {
-    let mut sim = scene("slope.ron", &[]);
-    let r = with_simulation!(&mut sim, s => run_and_continue(s));
-    pinned("steps", r.steps as f64, 28131.0, 0.01);
-    pinned("stop time (s)", r.time, 38.434, 0.01);
-    // 0.005° of 19°: a change of 0.5° fails by a hundred times.
-    pinned("angle (°)", r.angle, REFERENCE_ANGLE, 0.005 / 19.0);
-    pinned("crest u_x (m)", r.crest_ux, REFERENCE_CREST_UX, 5e-4);
-    pinned("max u_x (m)", r.max_ux, 35.312, 5e-4);
-    assert!(r.moved <= 0.01, "not static: {} m in 10 s", r.moved);
+    common::on_own_thread(|| {
+        let mut sim = scene("slope.ron", &[]);
+        let r = with_simulation!(&mut sim, s => run_and_continue(s));
+        pinned("steps", r.steps as f64, 28131.0, 0.01);
+        pinned("stop time (s)", r.time, 38.434, 0.01);
+        // 0.005° of 19°: a change of 0.5° fails by a hundred times.
+        pinned("angle (°)", r.angle, REFERENCE_ANGLE, 0.005 / 19.0);
+        pinned("crest u_x (m)", r.crest_ux, REFERENCE_CREST_UX, 5e-4);
+        pinned("max u_x (m)", r.max_ux, 35.312, 5e-4);
+        assert!(r.moved <= 0.01, "not static: {} m in 10 s", r.moved);
+    })
 }
 
 /// φ = 35° under a 30° face: it stands, settling 0.17 m at most (`kdmpm run
 /// scenes/slope_stable.ron`: 8 937 steps, angle 29.7668°, crest u_x 0.05444 m).
 #[test]
 fn slope_steeper_friction_than_its_face_stands() {
-    let mut sim = scene("slope_stable.ron", &[]);
-    let r = with_simulation!(&mut sim, s => run_and_continue(s));
-    pinned("steps", r.steps as f64, 8937.0, 0.01);
-    pinned("angle (°)", r.angle, 29.7668, 0.005 / 30.0);
-    pinned("crest u_x (m)", r.crest_ux, 0.05444, 0.005);
-    pinned("max u_x (m)", r.max_ux, 0.1654, 0.005);
-    assert!(r.moved <= 0.01, "not static: {} m in 10 s", r.moved);
+    common::on_own_thread(|| {
+        let mut sim = scene("slope_stable.ron", &[]);
+        let r = with_simulation!(&mut sim, s => run_and_continue(s));
+        pinned("steps", r.steps as f64, 8937.0, 0.01);
+        pinned("angle (°)", r.angle, 29.7668, 0.005 / 30.0);
+        pinned("crest u_x (m)", r.crest_ux, 0.05444, 0.005);
+        pinned("max u_x (m)", r.max_ux, 0.1654, 0.005);
+        assert!(r.moved <= 0.01, "not static: {} m in 10 s", r.moved);
+    })
 }
 
 /// The shipped slope.ron's resting state (2 threads or 1: the run is deterministic):
@@ -136,53 +142,57 @@ const REFERENCE_CREST_UX: f64 = 22.5158;
 
 #[test]
 fn the_fast_preset_comes_to_rest_where_the_paper_settings_do() {
-    // scenes/slope_fast.ron (USF, Courant 0.8, a 2 s static check): within 0.25° of the surface
-    // angle and 3 % of the crest's run-out of slope.ron, the target of the fast preset.
-    let mut sim = scene("slope_fast.ron", &[]);
-    with_simulation!(&mut sim, s => {
-        s.run(|_| {}).expect("runs");
-        assert_eq!(s.ctx.state.stop, Some(StopReason::Converged));
-        let angle = surface_angle(s).expect("a surface").degrees;
-        let crest = s.traced_results().into_iter().find(|t| t.name == "crest").unwrap();
-        println!("fast preset: {} steps, angle {angle:.3}°, crest u_x {:.3} m", s.ctx.state.clock.step, crest.displacement[0]);
-        assert!((angle - REFERENCE_ANGLE).abs() <= 0.25, "angle {angle}");
-        assert!((crest.displacement[0] / REFERENCE_CREST_UX - 1.0).abs() <= 0.03, "crest u_x {}", crest.displacement[0]);
-        // And pinned to what the preset gives: 3 767 steps, 18.93675°, crest u_x 22.5185 m.
-        pinned("steps", s.ctx.state.clock.step as f64, 3767.0, 0.01);
-        pinned("angle (°)", angle, 18.93675, 0.005 / 19.0);
-        pinned("crest u_x (m)", crest.displacement[0], 22.5185, 5e-4);
-    });
+    common::on_own_thread(|| {
+        // scenes/slope_fast.ron (USF, Courant 0.8, a 2 s static check): within 0.25° of the surface
+        // angle and 3 % of the crest's run-out of slope.ron, the target of the fast preset.
+        let mut sim = scene("slope_fast.ron", &[]);
+        with_simulation!(&mut sim, s => {
+            s.run(|_| {}).expect("runs");
+            assert_eq!(s.ctx.state.stop, Some(StopReason::Converged));
+            let angle = surface_angle(s).expect("a surface").degrees;
+            let crest = s.traced_results().into_iter().find(|t| t.name == "crest").unwrap();
+            println!("fast preset: {} steps, angle {angle:.3}°, crest u_x {:.3} m", s.ctx.state.clock.step, crest.displacement[0]);
+            assert!((angle - REFERENCE_ANGLE).abs() <= 0.25, "angle {angle}");
+            assert!((crest.displacement[0] / REFERENCE_CREST_UX - 1.0).abs() <= 0.03, "crest u_x {}", crest.displacement[0]);
+            // And pinned to what the preset gives: 3 767 steps, 18.93675°, crest u_x 22.5185 m.
+            pinned("steps", s.ctx.state.clock.step as f64, 3767.0, 0.01);
+            pinned("angle (°)", angle, 18.93675, 0.005 / 19.0);
+            pinned("crest u_x (m)", crest.displacement[0], 22.5185, 5e-4);
+        });
+    })
 }
 
 #[test]
 fn the_fast_preset_still_refuses_the_creeping_slope() {
-    // Without the virtual mass floor, nodes reached only by a point's far tail push that
-    // point with its own stress and the failed slope creeps by centimetres a second while
-    // K_F and K_E may already meet the tolerance: the static check must refuse to stop.
-    // Under the preset itself the creep keeps K_F above the tolerance to the 30 s limit;
-    // under MUSL at Courant 1 K_F and K_E are met and a 2 s window closes with centimetres
-    // of movement (2.4 cm measured): either way the run must not stop. (The paper's slope
-    // with its 10 s window refuses the same creep, 30 s of simulation: docs/verification.md.)
-    for extra in [
-        &[][..],
-        &["solver.scheme=Musl", "solver.time_step=Courant(1.0)"][..],
-    ] {
-        let mut set = vec![
-            "solver.max_time=30",
-            "solver.virtual_mass_floor=0",
-            "solver.node_mass_cutoff=1e-9",
-        ];
-        set.extend_from_slice(extra);
-        let mut sim = scene("slope_fast.ron", &set);
-        with_simulation!(&mut sim, s => {
-            s.run(|_| {}).expect("runs");
-            let st = &s.ctx.state;
-            assert_eq!(st.stop, Some(StopReason::MaxTime), "{extra:?}");
-            if let Some(moved) = st.static_window.movement {
-                assert!(moved > 0.01, "{extra:?}: a window moved only {moved} m");
-            } else {
-                assert!(extra.is_empty(), "{extra:?}: no window closed");
-            }
-        });
-    }
+    common::on_own_thread(|| {
+        // Without the virtual mass floor, nodes reached only by a point's far tail push that
+        // point with its own stress and the failed slope creeps by centimetres a second while
+        // K_F and K_E may already meet the tolerance: the static check must refuse to stop.
+        // Under the preset itself the creep keeps K_F above the tolerance to the 30 s limit;
+        // under MUSL at Courant 1 K_F and K_E are met and a 2 s window closes with centimetres
+        // of movement (2.4 cm measured): either way the run must not stop. (The paper's slope
+        // with its 10 s window refuses the same creep, 30 s of simulation: docs/verification.md.)
+        for extra in [
+            &[][..],
+            &["solver.scheme=Musl", "solver.time_step=Courant(1.0)"][..],
+        ] {
+            let mut set = vec![
+                "solver.max_time=30",
+                "solver.virtual_mass_floor=0",
+                "solver.node_mass_cutoff=1e-9",
+            ];
+            set.extend_from_slice(extra);
+            let mut sim = scene("slope_fast.ron", &set);
+            with_simulation!(&mut sim, s => {
+                s.run(|_| {}).expect("runs");
+                let st = &s.ctx.state;
+                assert_eq!(st.stop, Some(StopReason::MaxTime), "{extra:?}");
+                if let Some(moved) = st.static_window.movement {
+                    assert!(moved > 0.01, "{extra:?}: a window moved only {moved} m");
+                } else {
+                    assert!(extra.is_empty(), "{extra:?}: no window closed");
+                }
+            });
+        }
+    })
 }

@@ -35,7 +35,19 @@ pub fn refusal(text: &str) -> String {
 /// Runs `loaded` in memory with the library's runner; a run that stops on an error gives
 /// its summary (outcome `Failed`, the error in `error`).
 fn run_loaded(loaded: LoadedScene) -> Summary {
-    Run::scene(loaded).quiet(true).go().expect("scene builds").summary
+    on_own_thread(|| Run::scene(loaded).quiet(true).go().expect("scene builds").summary)
+}
+
+/// Runs `f` on a rayon pool of one thread of its own. The harness runs two tests at once,
+/// and on the shared global pool each run's parallel passes (broadcasts to every worker)
+/// wait for the other run's worker: the two ran one after the other. A run's bits do not
+/// depend on its thread count.
+pub fn on_own_thread<R: Send>(f: impl FnOnce() -> R + Send) -> R {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .expect("a thread starts")
+        .install(f)
 }
 
 /// Runs the `kdmpm` binary with `args` and waits for it.
