@@ -3,7 +3,8 @@
 
 mod common;
 
-use common::{refusal, rel, run};
+use common::{factors, refusal, rel, run};
+use kdmpm::state::CurvePoint;
 
 /// Lamé's thick cylinder (`scenes/cylinder.ron`: a = 1 m, b = 2 m, p = 100 kPa on the bore,
 /// plane strain along the axis): σ_rr = A − B/r², σ_θθ = A + B/r², σ_zz = 2νA with
@@ -248,6 +249,24 @@ fn at_d4(travel: &str) -> [&str; 4] {
     ]
 }
 
+/// (q − σ_v0)/c_u of a pressure q (Pa) in the clay of `scenes/cpt.ron` and
+/// `scenes/pile_jacking.ron` (σ_v0 = 100 kPa, c_u = 10 kPa): N_kt of a cone's tip, N_c of
+/// a pile's base.
+fn factor_over_overburden(pressure: f64) -> f64 {
+    (pressure - 100.0e3) / 10.0e3
+}
+
+/// `scenes/cpt.ron` at h = D/4 over its first D/4, the tip's part with `tip_interface`
+/// when given (the body's, smooth, otherwise): the cone's, its tip's and its shaft's rows.
+fn cone_first_quarter(tip_interface: Option<&str>) -> [CurvePoint; 3] {
+    let mut sets = at_d4("rigid_bodies[0].motion.travel=0.25").to_vec();
+    let part = tip_interface.map(|i| format!("rigid_bodies[0].parts[0].interface={i}"));
+    sets.extend(part.as_deref());
+    let s = run("cpt.ron", &sets);
+    assert!(s.converged, "{:?}", s.error);
+    ["cone", "cone.tip", "cone.shaft"].map(|name| s.curve.iter().find(|c| c.name == name).unwrap().clone())
+}
+
 /// `scenes/cpt.ron` at h = D/4 over its first D/4 from the surface, in one increment: the
 /// cone's tip takes the whole resistance and its smooth shaft none (the face the tip and
 /// the shaft share is inside the body, not sampled; its corner samples at the shoulder take
@@ -255,16 +274,13 @@ fn at_d4(travel: &str) -> [&str; 4] {
 /// (h = D/8, 10 D) is in docs/verification.md.
 #[test]
 fn a_smooth_cone_takes_its_resistance_at_the_tip() {
-    let s = run("cpt.ron", &at_d4("rigid_bodies[0].motion.travel=0.25"));
-    assert!(s.converged, "{:?}", s.error);
-    let row = |name: &str| s.curve.iter().find(|c| c.name == name).unwrap().clone();
-    let (cone, tip, shaft) = (row("cone"), row("cone.tip"), row("cone.shaft"));
+    let [cone, tip, shaft] = cone_first_quarter(None);
     // Along the axis (the radial sums of an axisymmetric body are not a resultant): the
     // smooth shaft takes a little at its shoulder only, where its corner samples lean.
     assert_eq!(cone.force[1], tip.force[1] + shaft.force[1]);
     assert!(shaft.force[1].abs() < 0.01 * tip.force[1].abs(), "{shaft:?}");
     assert_eq!(shaft.pressure, None);
-    let n_kt = (tip.pressure.unwrap() - 100.0e3) / 10.0e3;
+    let n_kt = factor_over_overburden(tip.pressure.unwrap());
     assert_eq!(n_kt, SMOOTH_CONE_FIRST_N_KT);
 }
 
@@ -278,13 +294,8 @@ const SMOOTH_CONE_FIRST_N_KT: f64 = 7.792174954797936;
 /// the clay can hold: the rough cone's figure is the adhesive tip's, below.)
 #[test]
 fn a_cone_with_a_rough_tip_bears_more_than_the_smooth_one() {
-    let mut sets = at_d4("rigid_bodies[0].motion.travel=0.25").to_vec();
-    sets.push("rigid_bodies[0].parts[0].interface=Some(Rough)");
-    let s = run("cpt.ron", &sets);
-    assert!(s.converged, "{:?}", s.error);
-    let row = |name: &str| s.curve.iter().find(|c| c.name == name).unwrap().clone();
-    let (tip, shaft) = (row("cone.tip"), row("cone.shaft"));
-    let n_kt = (tip.pressure.unwrap() - 100.0e3) / 10.0e3;
+    let [_, tip, shaft] = cone_first_quarter(Some("Some(Rough)"));
+    let n_kt = factor_over_overburden(tip.pressure.unwrap());
     assert!(n_kt > 1.2 * SMOOTH_CONE_FIRST_N_KT, "{n_kt}");
     assert!(shaft.force[1].abs() < 0.05 * tip.force[1].abs(), "{shaft:?}");
     assert_eq!(n_kt, 12.946914020004103);
@@ -297,12 +308,8 @@ fn a_cone_with_a_rough_tip_bears_more_than_the_smooth_one() {
 /// docs/verification.md).
 #[test]
 fn a_cone_with_an_adhesive_tip_bears_more_than_the_smooth_one() {
-    let mut sets = at_d4("rigid_bodies[0].motion.travel=0.25").to_vec();
-    sets.push("rigid_bodies[0].parts[0].interface=Some(Frictional(angle: 0.0, adhesion: 10.0e3))");
-    let s = run("cpt.ron", &sets);
-    assert!(s.converged, "{:?}", s.error);
-    let tip = s.curve.iter().find(|c| c.name == "cone.tip").unwrap();
-    let n_kt = (tip.pressure.unwrap() - 100.0e3) / 10.0e3;
+    let [_, tip, _] = cone_first_quarter(Some("Some(Frictional(angle: 0.0, adhesion: 10.0e3))"));
+    let n_kt = factor_over_overburden(tip.pressure.unwrap());
     assert!(n_kt > SMOOTH_CONE_FIRST_N_KT, "{n_kt}");
     assert_eq!(n_kt, 9.505941584754712);
 }
@@ -323,7 +330,7 @@ fn a_jacked_pile_carries_its_base_bearing_and_its_shaft_adhesion() {
     assert_eq!(base.len(), 2);
     let n_c: Vec<f64> = base
         .iter()
-        .map(|b| (b.pressure.unwrap() - 100.0e3) / 10.0e3)
+        .map(|b| factor_over_overburden(b.pressure.unwrap()))
         .collect();
     // The shaft's stress: its axial force per radian over R times the length in the clay
     // (the pile starts 1 m in, the base's slab 0.0625 m).
@@ -387,7 +394,7 @@ fn a_cone_in_sand_bears_in_proportion_to_its_confining_stress() {
 fn a_smooth_ball_on_the_axis_has_the_flow_round_factor() {
     let s = run("ball.ron", &["rigid_bodies[0].motion.travel=0.3"]);
     assert!(s.converged, "{:?}", s.error);
-    let n: Vec<f64> = s.curve.iter().map(|c| c.pressure.unwrap() / 10.0e3).collect();
+    let n = factors(&s, 10.0e3);
     assert_eq!(n.len(), 3);
     let mean = n.iter().sum::<f64>() / 3.0;
     assert!(rel(mean, 11.0).abs() < 0.03, "N {n:?}, mean {mean} against 11.0");

@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{forces, refusal, rel, run};
+use common::{factors, forces, refusal, rel, run};
 
 /// `scenes/footing_rigid.ron`: the smooth strip footing of `footing.ron` as a rigid body
 /// pushed 0.1 m into weightless Tresca clay. Prandtl's limit pressure (2 + π) c = 51.42 kPa
@@ -267,7 +267,7 @@ fn coarse_tbar(extra: &[&str]) -> (kdmpm::output::summary::Summary, Vec<f64>) {
     ]
     .concat();
     let s = run("tbar.ron", &coarse);
-    let n: Vec<f64> = s.curve.iter().map(|c| c.pressure.unwrap() / 10.0e3).collect();
+    let n = factors(&s, 10.0e3);
     assert_eq!(n.len(), 3);
     (s, n)
 }
@@ -354,7 +354,7 @@ fn a_strip_footing_pushed_below_the_surface_meets_more_resistance() {
         "rigid_bodies[0].motion.increment=0.25",
     ];
     let s = run("footing_deep.ron", &coarse);
-    let n: Vec<f64> = s.curve.iter().map(|c| c.pressure.unwrap() / 10.0e3).collect();
+    let n = factors(&s, 10.0e3);
     assert_eq!(n.len(), 2);
     assert!(n[1] > n[0], "{n:?}");
     assert_eq!(n[1], 7.283145327389176);
@@ -715,7 +715,7 @@ fn an_open_or_missing_stl_mesh_or_one_in_a_plane_scene_is_refused() {
 #[test]
 fn a_smooth_ball_in_confined_tresca_clay_has_the_flow_round_factor() {
     let s = run("ball_3d.ron", &["rigid_bodies[0].motion.travel=0.2"]);
-    let n: Vec<f64> = s.curve.iter().map(|c| c.pressure.unwrap() / 10.0e3).collect();
+    let n = factors(&s, 10.0e3);
     assert_eq!(n.len(), 2);
     let mean = n.iter().sum::<f64>() / 2.0;
     assert!(rel(mean, 11.0).abs() < 0.10, "N {n:?}, mean {mean} against 11.0");

@@ -26,6 +26,12 @@ pub fn run_text(name: &str, text: &str) -> Summary {
     run_loaded(loaded)
 }
 
+/// Each static state's mean pressure over `c_u` (a penetrometer's or a footing's factor
+/// N), in curve order.
+pub fn factors(s: &Summary, c_u: f64) -> Vec<f64> {
+    s.curve.iter().map(|c| c.pressure.unwrap() / c_u).collect()
+}
+
 /// The error that building the scene `text` gives.
 pub fn refusal(text: &str) -> String {
     let loaded = LoadedScene::from_text(Path::new("refused.ron"), text, &[]).expect("scene parses");
