@@ -33,7 +33,7 @@ use thiserror::Error;
 /// The first bytes of a checkpoint file.
 const MAGIC: &[u8; 8] = b"KDMPMCK\0";
 /// Format version; a file of another version is refused.
-const VERSION: u32 = 11;
+const VERSION: u32 = 12;
 /// The build that writes and reads checkpoints: the crate's version and a fingerprint of
 /// its sources (build.rs).
 pub const BUILD_ID: &str = concat!(env!("CARGO_PKG_VERSION"), "+", env!("KDMPM_SOURCE_HASH"));
@@ -75,6 +75,9 @@ pub struct Header {
     pub history_crc: u32,
     /// Wall time of the stepping loop so far (s).
     pub wall_seconds: f64,
+    /// CRC-32 of the STL meshes the scene read ([`crate::scene::LoadedScene::mesh_crc`]):
+    /// a file replaced or moved before a resume would change the body under the run.
+    pub meshes_crc: u32,
 }
 
 /// Serialises the header, the solver state and every point column of `sim`.
@@ -90,6 +93,7 @@ pub fn encode<D: Dim>(sim: &Simulation<D>, header: &Header) -> Vec<u8> {
     w.u64(header.history_bytes);
     w.u32(header.history_crc);
     w.f64(header.wall_seconds);
+    w.u32(header.meshes_crc);
     encode_state(&mut w, &sim.ctx.state);
     let archs: Vec<&Archetype> = points_with::<Position<D::Vec>>(&sim.ctx.world).collect();
     w.u64(archs.len() as u64);
@@ -710,6 +714,7 @@ impl<'a> Reader<'a> {
             history_bytes: self.u64()?,
             history_crc: self.u32()?,
             wall_seconds: self.f64()?,
+            meshes_crc: self.u32()?,
         })
     }
 }

@@ -323,6 +323,13 @@ fn refine<T>(
     mut at: impl FnMut(LoadedScene, PathBuf, f64) -> Result<Answer<T>, RefineError>,
     mut show: impl FnMut(&Level),
 ) -> Result<(T, Refinement), RefineError> {
+    // The finer levels of an earlier analysis into the same folder (`--refine 3`, then
+    // `--refine 2`) would stand beside this one's as if they were its own.
+    let earlier = out.join("refine");
+    match std::fs::remove_dir_all(&earlier) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => return Err(RefineError::Output(earlier, e)),
+        _ => {}
+    }
     let mut first = None;
     let mut levels = Vec::new();
     for k in 0..count {

@@ -60,11 +60,11 @@ pub struct WaterSpec {
     pub table: Surface,
     /// Materials with their own piezometric surface (a perched table in a clay layer), by
     /// material name.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::unique_map::deserialize")]
     pub material_tables: BTreeMap<String, Surface>,
     /// Saturated density of each material that has points below its surface (kg/m³, at
     /// least its dry density).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::unique_map::deserialize")]
     pub saturated_density: BTreeMap<String, f64>,
 }
 
@@ -76,7 +76,7 @@ pub struct StageWaterSpec {
     /// The piezometric surface of every material `material_tables` leaves out.
     pub table: Surface,
     /// Materials with their own piezometric surface, by material name.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::unique_map::deserialize")]
     pub material_tables: BTreeMap<String, Surface>,
 }
 
@@ -104,6 +104,47 @@ enum Head {
 }
 
 impl Head {
+    /// The lowest and highest height (m) and the steepest slope of the surface.
+    fn extremes(&self) -> (f64, f64, f64) {
+        let span = |h: &mut dyn Iterator<Item = f64>| {
+            h.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+                (lo.min(v), hi.max(v))
+            })
+        };
+        match self {
+            Head::Level(h) => (*h, *h, 0.0),
+            Head::Polyline { x, segments } => {
+                let ends = segments
+                    .iter()
+                    .zip(x.windows(2))
+                    .flat_map(|(s, k)| [s[0], s[0] + s[1] * (k[1] - k[0])]);
+                let (lo, hi) = span(&mut ends.into_iter());
+                (lo, hi, segments.iter().fold(0.0f64, |m, s| m.max(s[1].abs())))
+            }
+            Head::Heights {
+                inv_spacing,
+                nodes,
+                h,
+                ..
+            } => {
+                let (lo, hi) = span(&mut h.iter().copied());
+                let mut steep = 0.0f64;
+                for j in 0..nodes[1] {
+                    for i in 0..nodes[0] {
+                        let at = |i: usize, j: usize| h[j * nodes[0] + i];
+                        if i + 1 < nodes[0] {
+                            steep = steep.max(((at(i + 1, j) - at(i, j)) * inv_spacing[0]).abs());
+                        }
+                        if j + 1 < nodes[1] {
+                            steep = steep.max(((at(i, j + 1) - at(i, j)) * inv_spacing[1]).abs());
+                        }
+                    }
+                }
+                (lo, hi, steep)
+            }
+        }
+    }
+
     /// The height h and its slope ∂h/∂s along each axis across, at the place `s`.
     #[inline(always)]
     fn at(&self, s: [f64; 2]) -> (f64, [f64; 2]) {
@@ -166,9 +207,33 @@ pub struct Water {
     of_material: Arc<[u16]>,
     /// Density ratio ρ_sat/ρ_dry of each material (1 without a saturated density).
     wet_ratio: Arc<[f64]>,
+    /// Saturated density of each material (kg/m³; 0 without one): a stage that changes a
+    /// material's dry density keeps it.
+    saturated: Arc<[f64]>,
+    /// γ_w as the scene gives it (N/m³), under the scene's gravity, whose entry along
+    /// `axis` is `given_gravity` (m/s², negative): γ_w = ρ_w |g| follows the gravity in
+    /// force ([`Water::follow_gravity`]).
+    given_unit_weight: f64,
+    given_gravity: f64,
 }
 
+/// The largest pore pressure or seepage force (Pa, N/m³) a surface may give: the bound on
+/// any stiffness a scene takes (a Young's modulus of 1e15 Pa).
+const MOST_PRESSURE: f64 = 1e15;
+
 impl Water {
+    /// Sets γ_w for the gravity `g` (m/s², x y z) in force: the scene's γ_w times
+    /// g_axis / g_axis of the scene's gravity (the check refuses a gravity that turns from
+    /// the water's axis). Idempotent: from the scene's γ_w each time.
+    pub fn follow_gravity(&mut self, g: [f64; 3]) {
+        let ratio = g[self.axis] / self.given_gravity;
+        self.unit_weight = if ratio == 1.0 {
+            self.given_unit_weight
+        } else {
+            self.given_unit_weight * ratio
+        };
+    }
+
     /// The surface's height above `x` and its slopes, for a point of `material`.
     #[inline(always)]
     fn head(&self, material: u16, x: [f64; 3]) -> (f64, [f64; 2]) {
@@ -236,6 +301,24 @@ impl Water {
     pub fn density_factor(&self, material: u16, x: [f64; 3], volume: f64) -> f64 {
         let share = self.submerged(self.head(material, x).0 - x[self.axis], volume, x);
         1.0 + share * (self.wet_ratio[material as usize] - 1.0)
+    }
+
+    /// The factor a point's mass changes by when its material's dry density goes from `old`
+    /// to `new` (kg/m³) and its saturated density stays: (ρ′ + s (ρ_sat − ρ′)) / (ρ + s
+    /// (ρ_sat − ρ)) for its submerged share s at its current place `x` (volume `volume`);
+    /// ρ′/ρ for a material without a saturated density.
+    pub fn reweigh_ratio(&self, material: u16, x: [f64; 3], volume: f64, old: f64, new: f64) -> f64 {
+        let sat = self.saturated[material as usize];
+        if sat == 0.0 {
+            return new / old;
+        }
+        let share = self.submerged(self.head(material, x).0 - x[self.axis], volume, x);
+        (new + share * (sat - new)) / (old + share * (sat - old))
+    }
+
+    /// The saturated density of `material` (kg/m³), if it has one.
+    pub fn saturated_density(&self, material: u16) -> Option<f64> {
+        Some(self.saturated[material as usize]).filter(|&s| s > 0.0)
     }
 
     /// The factor a point's mass changes by when the water goes from `self` to `next`, judged
@@ -394,6 +477,7 @@ impl Frame<'_> {
     fn heads(
         &self,
         axis: usize,
+        unit_weight: f64,
         table: &Surface,
         material_tables: &BTreeMap<String, Surface>,
     ) -> Result<(Vec<Head>, Vec<u16>), Refusal> {
@@ -411,7 +495,29 @@ impl Frame<'_> {
             };
             (field, r)
         };
-        let mut heads = vec![head(table, n - 1, lo, hi).map_err(|e| within("table", e))?];
+        // Pore pressures and seepage forces a run can hold: γ_w |h − z| and γ_w |∇h| at
+        // most 1e15 (a table 1e306 m up would write pore pressures of inf).
+        let bounded = |f: &str, h: Head| -> Result<Head, Refusal> {
+            let (low, high, steep) = h.extremes();
+            let base = self.lo[axis];
+            let depth = (high - base).abs().max((low - base).abs());
+            let (pressure, seepage) = (unit_weight * depth, unit_weight * steep);
+            let within = |v: f64| v.is_finite() && v <= MOST_PRESSURE;
+            if !within(pressure) || !within(seepage) {
+                return Err((
+                    f.to_string(),
+                    format!(
+                        "a pore pressure γ_w |h − z| or seepage force γ_w |∇h| above 1e15 (the \
+                         surface reaches {high} m, {} m above the grid's bottom, and slopes up to \
+                         {steep}): give heights near the ground",
+                        high - base
+                    ),
+                ));
+            }
+            Ok(h)
+        };
+        let first = head(table, n - 1, lo, hi).map_err(|e| within("table", e))?;
+        let mut heads = vec![bounded("table", first)?];
         let mut of_material = vec![0u16; self.materials.len()];
         for (name, surface) in material_tables {
             let field = format!("material_tables.{name}");
@@ -419,7 +525,8 @@ impl Frame<'_> {
                 return Err((field, format!("the scene has no material \"{name}\"")));
             };
             of_material[m] = heads.len() as u16;
-            heads.push(head(surface, n - 1, lo, hi).map_err(|e| within(&field, e))?);
+            let h = head(surface, n - 1, lo, hi).map_err(|e| within(&field, e))?;
+            heads.push(bounded(&field, h)?);
         }
         Ok((heads, of_material))
     }
@@ -447,6 +554,7 @@ impl WaterSpec {
         }
         let axis = frame.axis()?;
         let mut wet_ratio = vec![1.0; frame.materials.len()];
+        let mut saturated = vec![0.0; frame.materials.len()];
         for (name, &rho) in &self.saturated_density {
             let field = format!("saturated_density.{name}");
             let Some(m) = frame.materials.iter().position(|(n, _)| n == name) else {
@@ -460,8 +568,9 @@ impl WaterSpec {
                 ));
             }
             wet_ratio[m] = rho / dry;
+            saturated[m] = rho;
         }
-        let (heads, of_material) = frame.heads(axis, &self.table, &self.material_tables)?;
+        let (heads, of_material) = frame.heads(axis, self.unit_weight, &self.table, &self.material_tables)?;
         Ok(Water {
             unit_weight: self.unit_weight,
             axis,
@@ -471,6 +580,9 @@ impl WaterSpec {
             heads: heads.into(),
             of_material: of_material.into(),
             wet_ratio: wet_ratio.into(),
+            saturated: saturated.into(),
+            given_unit_weight: self.unit_weight,
+            given_gravity: frame.gravity.map_or(-1.0, |g| g[axis]),
         })
     }
 }
@@ -479,7 +591,12 @@ impl StageWaterSpec {
     /// The scene's `water` with this stage's surfaces. As (field under the stage's `water`,
     /// rule) on failure.
     pub fn checked(&self, water: &Water, frame: &Frame) -> Result<Water, Refusal> {
-        let (heads, of_material) = frame.heads(water.axis, &self.table, &self.material_tables)?;
+        let (heads, of_material) = frame.heads(
+            water.axis,
+            water.given_unit_weight,
+            &self.table,
+            &self.material_tables,
+        )?;
         Ok(Water {
             heads: heads.into(),
             of_material: of_material.into(),

@@ -177,9 +177,10 @@ impl<D: Dim> System<D> for Snapshots<D> {
             ctx.settings.water.clone(),
         );
         let spacing = 0.5 * ctx.grid.cell_size;
+        let grid = (D::vec_to3(ctx.grid.origin), D::vec_to3(ctx.grid.max_corner()));
         frame.bodies = (0u32..)
             .zip(ctx.settings.bodies.iter().zip(&ctx.state.control.bodies))
-            .flat_map(|(k, (spec, state))| spec.outlines(k, state.offset, spacing))
+            .flat_map(|(k, (spec, state))| spec.outlines(k, state.offset, spacing, grid))
             .collect();
         let start = Instant::now();
         if tx.send(frame).is_err() {

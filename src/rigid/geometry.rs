@@ -19,7 +19,7 @@ pub enum Geometry {
         /// Radius (m).
         radius: f64,
     },
-    /// 2D: a simple polygon, its vertices in order (either sense).
+    /// 2D: a simple polygon, its vertices in order (either sense); no two edges cross.
     Polygon {
         /// Vertices (m, x y), at least three.
         vertices: Vec<Vec<f64>>,
@@ -119,7 +119,7 @@ impl Geometry {
                     std::array::from_fn(|a| r(a, 1.0)),
                 )
             }
-            Geometry::Polygon { vertices } => polygon_bounds(vertices),
+            Geometry::Polygon { vertices } => crate::polygon::bounds(vertices),
             Geometry::Box { min, max } => (point(min), point(max)),
             Geometry::Cylinder {
                 base,
@@ -150,6 +150,16 @@ impl Geometry {
 /// The mesh a scene's loading read ([`Geometry::read`]); a scene checks that it did.
 fn loaded(mesh: &Option<Arc<TriangleMesh>>) -> &TriangleMesh {
     mesh.as_deref().expect("meshes are read as the scene loads")
+}
+
+impl Geometry {
+    /// A `Mesh`'s triangles, as read with the scene.
+    pub fn mesh(&self) -> &TriangleMesh {
+        match self {
+            Geometry::Mesh { mesh, .. } => loaded(mesh),
+            _ => unreachable!("only a Mesh has triangles"),
+        }
+    }
 }
 
 impl Geometry {
@@ -199,8 +209,8 @@ impl Geometry {
                         "needs at least three vertices, each two finite coordinates [x, y]".into(),
                     );
                 }
-                if signed_area(vertices).abs() <= 0.0 {
-                    return bad("geometry.vertices", "the polygon encloses no area".into());
+                if let Some(rule) = crate::polygon::fault(vertices) {
+                    return bad("geometry.vertices", rule);
                 }
             }
             Geometry::Box { min, max } => {
@@ -276,207 +286,11 @@ pub struct Sample {
     pub measure: f64,
 }
 
-impl Geometry {
-    /// Points of the surface at most `spacing` (m) apart, at the middles of equal pieces
-    /// (a polygon's corners stand between the samples of its two edges).
-    pub fn samples(&self, spacing: f64) -> Vec<Sample> {
-        use std::f64::consts::PI;
-        let pieces = |length: f64| pieces(length, spacing);
-        match self {
-            Geometry::Circle { centre, radius } => {
-                let c = point(centre);
-                let k = pieces(2.0 * PI * radius);
-                (0..k)
-                    .map(|i| {
-                        let t = 2.0 * PI * (i as f64 + 0.5) / k as f64;
-                        let n = [t.cos(), t.sin(), 0.0];
-                        Sample {
-                            x: [c[0] + radius * n[0], c[1] + radius * n[1], 0.0],
-                            normal: n,
-                            measure: 2.0 * PI * radius / k as f64,
-                        }
-                    })
-                    .collect()
-            }
-            Geometry::Polygon { vertices } => {
-                let ccw = signed_area(vertices) > 0.0;
-                let mut out = Vec::new();
-                for i in 0..vertices.len() {
-                    let (a, b) = (&vertices[i], &vertices[(i + 1) % vertices.len()]);
-                    let e = [b[0] - a[0], b[1] - a[1]];
-                    let l = (e[0] * e[0] + e[1] * e[1]).sqrt();
-                    let out_n = if ccw {
-                        [e[1] / l, -e[0] / l, 0.0]
-                    } else {
-                        [-e[1] / l, e[0] / l, 0.0]
-                    };
-                    let k = pieces(l);
-                    for j in 0..k {
-                        let t = (j as f64 + 0.5) / k as f64;
-                        out.push(Sample {
-                            x: [a[0] + t * e[0], a[1] + t * e[1], 0.0],
-                            normal: out_n,
-                            measure: l / k as f64,
-                        });
-                    }
-                }
-                out
-            }
-            Geometry::Sphere { centre, radius } => {
-                // Rings of equal latitude steps, each cut in pieces of about `spacing`.
-                let c = point(centre);
-                let rings = pieces(PI * radius);
-                let mut out = Vec::new();
-                for i in 0..rings {
-                    let (t0, t1) = (PI * i as f64 / rings as f64, PI * (i + 1) as f64 / rings as f64);
-                    let t = 0.5 * (t0 + t1);
-                    let band = 2.0 * PI * radius * radius * (t0.cos() - t1.cos());
-                    let k = pieces(2.0 * PI * radius * t.sin());
-                    for j in 0..k {
-                        let f = 2.0 * PI * (j as f64 + 0.5) / k as f64;
-                        let n = [t.sin() * f.cos(), t.sin() * f.sin(), t.cos()];
-                        out.push(Sample {
-                            x: std::array::from_fn(|a| c[a] + radius * n[a]),
-                            normal: n,
-                            measure: band / k as f64,
-                        });
-                    }
-                }
-                out
-            }
-            Geometry::Box { min, max } => box_samples(min, max, spacing),
-            Geometry::Cylinder {
-                base,
-                axis,
-                length,
-                radius,
-            } => cylinder_samples(base, *axis, *length, *radius, spacing),
-            Geometry::Mesh { mesh, .. } => loaded(mesh)
-                .samples(spacing)
-                .into_iter()
-                .map(|(x, normal, measure)| Sample { x, normal, measure })
-                .collect(),
-        }
-    }
-}
-
-/// The number of equal pieces of at most `spacing` that cut `length` (at least one).
-fn pieces(length: f64, spacing: f64) -> usize {
-    (length / spacing).ceil().max(1.0) as usize
-}
-
-/// A box's samples: each face cut into pieces of at most `spacing` a side.
-fn box_samples(min: &[f64], max: &[f64], spacing: f64) -> Vec<Sample> {
-    let pieces = |length: f64| pieces(length, spacing);
-    let (lo, hi) = (point(min), point(max));
-    let n = min.len();
-    let mut out = Vec::new();
-    for axis in 0..n {
-        for (side, at) in [(-1.0, lo[axis]), (1.0, hi[axis])] {
-            let others: Vec<usize> = (0..n).filter(|&a| a != axis).collect();
-            let counts: Vec<usize> = others.iter().map(|&a| pieces(hi[a] - lo[a])).collect();
-            let total: usize = counts.iter().product();
-            let measure: f64 = others.iter().map(|&a| hi[a] - lo[a]).product::<f64>() / total as f64;
-            for q in 0..total {
-                let mut x = [0.0; 3];
-                x[axis] = at;
-                let mut rest = q;
-                for (&a, &k) in others.iter().zip(&counts) {
-                    let j = rest % k;
-                    rest /= k;
-                    x[a] = lo[a] + (hi[a] - lo[a]) * (j as f64 + 0.5) / k as f64;
-                }
-                let mut normal = [0.0; 3];
-                normal[axis] = side;
-                out.push(Sample { x, normal, measure });
-            }
-        }
-    }
-    out
-}
-
-/// A cylinder's samples: its side in pieces of at most `spacing`, its end caps in rings.
-fn cylinder_samples(base: &[f64], axis: usize, length: f64, radius: f64, spacing: f64) -> Vec<Sample> {
-    use std::f64::consts::PI;
-    let pieces = |length: f64| pieces(length, spacing);
-    let b = point(base);
-    let (u, w) = ((axis + 1) % 3, (axis + 2) % 3);
-    let mut out = Vec::new();
-    let (around, along) = (pieces(2.0 * PI * radius), pieces(length));
-    for i in 0..around {
-        let f = 2.0 * PI * (i as f64 + 0.5) / around as f64;
-        for j in 0..along {
-            let mut x = b;
-            x[axis] += length * (j as f64 + 0.5) / along as f64;
-            x[u] += radius * f.cos();
-            x[w] += radius * f.sin();
-            let mut normal = [0.0; 3];
-            normal[u] = f.cos();
-            normal[w] = f.sin();
-            out.push(Sample {
-                x,
-                normal,
-                measure: 2.0 * PI * radius * length / (around * along) as f64,
-            });
-        }
-    }
-    // The end caps: rings of equal radial steps.
-    let rings = pieces(radius);
-    for (side, at) in [(-1.0, b[axis]), (1.0, b[axis] + length)] {
-        for i in 0..rings {
-            let (r0, r1) = (
-                radius * i as f64 / rings as f64,
-                radius * (i + 1) as f64 / rings as f64,
-            );
-            let r = 0.5 * (r0 + r1);
-            let k = pieces(2.0 * PI * r);
-            for j in 0..k {
-                let f = 2.0 * PI * (j as f64 + 0.5) / k as f64;
-                let mut x = b;
-                x[axis] = at;
-                x[u] += r * f.cos();
-                x[w] += r * f.sin();
-                let mut normal = [0.0; 3];
-                normal[axis] = side;
-                out.push(Sample {
-                    x,
-                    normal,
-                    measure: PI * (r1 * r1 - r0 * r0) / k as f64,
-                });
-            }
-        }
-    }
-    out
-}
-
-/// Bounds (m) of a polygon's vertices `[x, y]`, z 0..0.
-pub(crate) fn polygon_bounds(vertices: &[Vec<f64>]) -> ([f64; 3], [f64; 3]) {
-    let mut lo = [f64::INFINITY, f64::INFINITY, 0.0];
-    let mut hi = [f64::NEG_INFINITY, f64::NEG_INFINITY, 0.0];
-    for v in vertices {
-        for a in 0..2 {
-            lo[a] = lo[a].min(v[a]);
-            hi[a] = hi[a].max(v[a]);
-        }
-    }
-    (lo, hi)
-}
-
-/// Twice the signed area of a polygon (positive counter-clockwise).
-pub(crate) fn signed_area(v: &[Vec<f64>]) -> f64 {
-    (0..v.len())
-        .map(|i| {
-            let (a, b) = (&v[i], &v[(i + 1) % v.len()]);
-            a[0] * b[1] - b[0] * a[1]
-        })
-        .sum()
-}
-
 /// Signed distance to a simple polygon: the nearest edge's distance, negative inside
 /// (crossing number); the normal points from the closest point to `x` outside, from `x` to
 /// it inside, and is the edge's outward normal on the surface itself.
 fn polygon(v: &[Vec<f64>], x: [f64; 3]) -> (f64, [f64; 3]) {
-    let ccw = signed_area(v) > 0.0;
+    let ccw = crate::polygon::signed_area(v) > 0.0;
     let (mut best, mut closest, mut edge_normal) = (f64::INFINITY, [0.0; 3], [0.0; 3]);
     let mut inside = false;
     for i in 0..v.len() {
@@ -563,8 +377,8 @@ fn cylinder(base: [f64; 3], axis: usize, length: f64, radius: f64, x: [f64; 3]) 
 impl Geometry {
     /// The shape to draw (m, at its starting place): in 2D and axisymmetric scenes its
     /// outline, closed (a polygon's vertices, a circle in 72 pieces, `true`); in 3D the
-    /// surface samples every `spacing` m as a cloud of points (`false`).
-    pub fn outline(&self, spacing: f64) -> (Vec<[f64; 3]>, bool) {
+    /// surface samples every `spacing` m within `reach` as a cloud of points (`false`).
+    pub fn outline(&self, spacing: f64, reach: &super::sampling::Reach) -> (Vec<[f64; 3]>, bool) {
         match self {
             Geometry::Polygon { vertices } => (vertices.iter().map(|v| [v[0], v[1], 0.0]).collect(), true),
             Geometry::Circle { centre, radius } => (
@@ -576,7 +390,10 @@ impl Geometry {
                     .collect(),
                 true,
             ),
-            _ => (self.samples(spacing).into_iter().map(|s| s.x).collect(), false),
+            _ => (
+                self.samples(spacing, reach).into_iter().map(|s| s.x).collect(),
+                false,
+            ),
         }
     }
 }

@@ -1,11 +1,11 @@
-//! A closed triangle mesh read from an STL file (ASCII or binary, by `stl_io`): a rigid
+//! A closed triangle mesh read from an STL file (ASCII or binary, [`super::stl`]): a rigid
 //! body of any shape in 3D.
 //!
 //! The signed distance of a point is the distance to the nearest triangle, found through a
 //! bounding-volume tree, with the sign of the angle-weighted pseudonormal of the feature
 //! (face, edge or vertex) the closest point lies on (Bærentzen & Aanæs 2005, IEEE TVCG
-//! 11(3)): exact for a closed, consistently oriented mesh, which `stl_io` checks (every
-//! edge shared by two faces of opposite senses). A mesh wound inwards (negative volume)
+//! 11(3)): exact for a closed, consistently oriented mesh, which [`TriangleMesh::read`] checks
+//! (every edge shared by two faces of opposite senses), its shells apart. A mesh wound inwards (negative volume)
 //! is turned outwards.
 
 use std::collections::HashMap;
@@ -85,25 +85,26 @@ pub struct TriangleMesh {
 const LEAF: usize = 4;
 
 impl TriangleMesh {
-    /// Reads and checks the STL file at `path`: an error says what is wrong with it.
+    /// Reads and checks the STL file at `path` ([`super::stl`]): an error says what is wrong
+    /// with it. The surface must be closed (every edge met once each way) and its shells
+    /// (the connected pieces) must neither cross nor hold one another.
     pub fn read(path: &Path) -> Result<Self, String> {
-        let mut file =
-            std::fs::File::open(path).map_err(|e| format!("cannot open {}: {e}", path.display()))?;
-        let mesh =
-            stl_io::read_stl(&mut file).map_err(|e| format!("{} is not an STL file: {e}", path.display()))?;
-        if mesh.faces.is_empty() {
-            return Err(format!("{} holds no triangles", path.display()));
-        }
-        mesh.validate().map_err(|e| {
+        let (vertices, faces) = super::stl::read(path)?;
+        let shown = path.display();
+        // A triangle with two equal corners has no edges of its own.
+        let faces: Vec<[usize; 3]> = faces
+            .into_iter()
+            .filter(|f| f[0] != f[1] && f[1] != f[2] && f[2] != f[0])
+            .collect();
+        closed(&vertices, &faces).map_err(|e| {
             format!(
-                "{} is not a closed surface ({e}): a body needs a watertight mesh, every edge \
-                 shared by two triangles",
-                path.display()
+                "{shown} is not a closed surface ({e}): a body needs a watertight mesh, every edge \
+                 shared by two triangles of opposite senses"
             )
         })?;
-        let vertices: Vec<V3> = mesh.vertices.iter().map(|v| v.0.map(f64::from)).collect();
-        let faces: Vec<[usize; 3]> = mesh.faces.iter().map(|f| f.vertices).collect();
-        Self::new(vertices, faces)
+        let mesh = Self::new(vertices, faces)?;
+        mesh.shells_apart().map_err(|e| format!("{shown}: {e}"))?;
+        Ok(mesh)
     }
 
     /// The mesh of these vertices (m) and faces (corner indices); it must be closed.
@@ -155,8 +156,13 @@ impl TriangleMesh {
             order: Vec::new(),
             tree: Vec::new(),
         };
-        mesh.order = (0..mesh.faces.len()).collect();
+        // A face of no area (a needle filling a crack) closes the surface but has no
+        // point of its own: the tree and the samples leave it out.
+        mesh.order = (0..mesh.faces.len()).filter(|&f| mesh.areas[f] > 0.0).collect();
         let n = mesh.order.len();
+        if n == 0 {
+            return Err("every triangle has zero area".into());
+        }
         mesh.build(0, n);
         Ok(mesh)
     }
@@ -202,6 +208,16 @@ impl TriangleMesh {
         let right = self.build(first + half, count - half);
         self.tree[index].children = [left, right];
         index
+    }
+
+    /// Feeds its vertices and triangles to `h` (the fingerprint a checkpoint keeps).
+    pub fn fingerprint(&self, h: &mut crc32fast::Hasher) {
+        for v in &self.vertices {
+            v.iter().for_each(|c| h.update(&c.to_le_bytes()));
+        }
+        for f in &self.faces {
+            f.iter().for_each(|&i| h.update(&(i as u64).to_le_bytes()));
+        }
     }
 
     /// Axis-aligned bounds (m).
@@ -305,10 +321,21 @@ impl TriangleMesh {
     /// the larger of √(2 area) and half the longest side, over `spacing`, rounded up: a
     /// right triangle of legs L in pieces of legs `spacing`), one point at each one's
     /// centre, with the face's normal and the piece's area (m²).
-    pub fn samples(&self, spacing: f64) -> Vec<(V3, V3, f64)> {
+    ///
+    /// Only the pieces whose centres may lie in `reach` are visited: a face's pieces are
+    /// those of the parallelogram a + i u + j v, and the reach's corners, projected on the
+    /// face's plane, bound the (i, j) it can hold.
+    pub fn samples(&self, spacing: f64, reach: &super::Reach) -> Vec<(V3, V3, f64)> {
         let mut out = Vec::new();
         for (f, face) in self.faces.iter().enumerate() {
+            if self.areas[f] <= 0.0 {
+                continue;
+            }
             let [a, b, c] = face.map(|i| self.vertices[i]);
+            let (flo, fhi) = self.face_box(f);
+            if (0..3).any(|k| fhi[k] < reach.lo[k] || flo[k] > reach.hi[k]) {
+                continue;
+            }
             let longest = [sub(b, a), sub(c, b), sub(a, c)]
                 .iter()
                 .map(|e| dot(*e, *e).sqrt())
@@ -321,8 +348,9 @@ impl TriangleMesh {
             let (u, v) = (mul(sub(b, a), 1.0 / k as f64), mul(sub(c, a), 1.0 / k as f64));
             let at = |i: f64, j: f64| add(a, add(mul(u, i), mul(v, j)));
             let piece = self.areas[f] / (k * k) as f64;
-            for i in 0..k {
-                for j in 0..k - i {
+            let (irange, jrange) = piece_range(a, u, v, k, reach);
+            for i in irange {
+                for j in jrange.start..jrange.end.min(k - i) {
                     let (fi, fj) = (i as f64, j as f64);
                     out.push((at(fi + 1.0 / 3.0, fj + 1.0 / 3.0), self.normals[f], piece));
                     if i + j + 1 < k {
@@ -332,6 +360,193 @@ impl TriangleMesh {
             }
         }
         out
+    }
+}
+
+/// The rows i and columns j of a face's pieces (a + i u + j v, k a side) whose centres may
+/// lie in `reach`: the parallelogram coordinates of the reach's corners projected on the
+/// face's plane bound them (the map to (i, j) is affine, so the box's part in the plane maps
+/// inside its corners' hull); all of them when the reach is unbounded.
+fn piece_range(
+    a: V3,
+    u: V3,
+    v: V3,
+    k: usize,
+    reach: &super::Reach,
+) -> (std::ops::Range<usize>, std::ops::Range<usize>) {
+    let all = (0..k, 0..k);
+    if (0..3).any(|d| !reach.lo[d].is_finite() || !reach.hi[d].is_finite()) {
+        return all;
+    }
+    // (i, j) of x: solve [u·u u·v; u·v v·v] (i, j) = (u·(x − a), v·(x − a)).
+    let (uu, uv, vv) = (dot(u, u), dot(u, v), dot(v, v));
+    let det = uu * vv - uv * uv;
+    if det.is_nan() || det <= 0.0 {
+        return all;
+    }
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for corner in 0..8 {
+        let x: V3 = std::array::from_fn(|d| {
+            if (corner >> d) & 1 == 1 {
+                reach.hi[d]
+            } else {
+                reach.lo[d]
+            }
+        });
+        let (pu, pv) = (dot(u, sub(x, a)), dot(v, sub(x, a)));
+        let ij = [(vv * pu - uv * pv) / det, (uu * pv - uv * pu) / det];
+        for m in 0..2 {
+            lo[m] = lo[m].min(ij[m]);
+            hi[m] = hi[m].max(ij[m]);
+        }
+    }
+    let span = |m: usize| {
+        let first = (lo[m] - 1.0).floor().max(0.0).min(k as f64) as usize;
+        let last = (hi[m] + 1.0).ceil().max(0.0).min(k as f64) as usize;
+        first..last.max(first)
+    };
+    (span(0), span(1))
+}
+
+/// Checks that every directed edge of `faces` is met once and its reverse once: a closed,
+/// consistently wound surface.
+fn closed(vertices: &[V3], faces: &[[usize; 3]]) -> Result<(), String> {
+    let mut count: HashMap<(usize, usize), u32> = HashMap::new();
+    for f in faces {
+        for k in 0..3 {
+            *count.entry((f[k], f[(k + 1) % 3])).or_insert(0) += 1;
+        }
+    }
+    for (&(i, j), &c) in &count {
+        let back = count.get(&(j, i)).copied().unwrap_or(0);
+        if c != 1 || back != 1 {
+            return Err(format!(
+                "the edge from {:?} to {:?} is met {c} time(s) that way and {back} the other",
+                vertices[i], vertices[j]
+            ));
+        }
+    }
+    Ok(())
+}
+
+impl TriangleMesh {
+    /// The shells: sets of faces joined by shared corners, each a closed surface of its own.
+    fn shells(&self) -> Vec<Vec<usize>> {
+        let mut parent: Vec<usize> = (0..self.vertices.len()).collect();
+        fn root(parent: &mut [usize], mut i: usize) -> usize {
+            while parent[i] != i {
+                parent[i] = parent[parent[i]];
+                i = parent[i];
+            }
+            i
+        }
+        for f in &self.faces {
+            for k in 1..3 {
+                let (a, b) = (root(&mut parent, f[0]), root(&mut parent, f[k]));
+                parent[a.max(b)] = a.min(b);
+            }
+        }
+        let mut by_root: std::collections::BTreeMap<usize, Vec<usize>> = Default::default();
+        for (i, f) in self.faces.iter().enumerate() {
+            by_root.entry(root(&mut parent, f[0])).or_default().push(i);
+        }
+        by_root.into_values().collect()
+    }
+
+    /// Refuses shells that cross or hold one another: the distance to the whole mesh is the
+    /// nearest shell's, so inside two overlapping shells it is too shallow, and points placed
+    /// in their common part stay inside the body.
+    fn shells_apart(&self) -> Result<(), String> {
+        let shells = self.shells();
+        if shells.len() < 2 {
+            return Ok(());
+        }
+        let meshes: Vec<TriangleMesh> = shells
+            .iter()
+            .map(|s| {
+                let faces = s.iter().map(|&f| self.faces[f]).collect();
+                TriangleMesh::new(self.vertices.clone(), faces)
+            })
+            .collect::<Result<_, _>>()?;
+        let (lo, hi) = self.bounds();
+        let tol = 1e-9 * dot(sub(hi, lo), sub(hi, lo)).sqrt();
+        for (a, ma) in meshes.iter().enumerate() {
+            for (b, mb) in meshes.iter().enumerate().filter(|&(b, _)| b != a) {
+                let (alo, ahi) = ma.bounds();
+                let (blo, bhi) = mb.bounds();
+                if (0..3).any(|k| ahi[k] < blo[k] || bhi[k] < alo[k]) {
+                    continue;
+                }
+                // Corners and face centres: shells that share a plane (two boxes side by
+                // side, overlapping) have no corner inside the other, but a face centre.
+                let corners = ma.faces.iter().flatten().map(|&i| ma.vertices[i]);
+                let centres = ma.faces.iter().map(|f| {
+                    mul(
+                        add(add(ma.vertices[f[0]], ma.vertices[f[1]]), ma.vertices[f[2]]),
+                        1.0 / 3.0,
+                    )
+                });
+                let inside = corners.chain(centres).find(|&v| mb.distance(v).0 < -tol);
+                let crossing = ma
+                    .faces
+                    .iter()
+                    .flat_map(|f| (0..3).map(move |k| (f[k], f[(k + 1) % 3])))
+                    .find(|&(i, j)| mb.segment_crosses(ma.vertices[i], ma.vertices[j], tol));
+                if inside.is_some() || crossing.is_some() {
+                    let at =
+                        inside.unwrap_or_else(|| crossing.map(|(i, _)| ma.vertices[i]).unwrap_or_default());
+                    return Err(format!(
+                        "its closed shells {a} and {b} (of {}) cross or one holds the other (near \
+                         {at:?}): give the body one closed surface, their union, or each shell as a \
+                         part of its own",
+                        shells.len()
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// True when the segment `p`–`q` passes through a face's inside (by more than `tol` from
+    /// its ends and the face's edges, Möller & Trumbore 1997).
+    fn segment_crosses(&self, p: V3, q: V3, tol: f64) -> bool {
+        let d = sub(q, p);
+        let (slo, shi): (V3, V3) = (
+            std::array::from_fn(|k| p[k].min(q[k]) - tol),
+            std::array::from_fn(|k| p[k].max(q[k]) + tol),
+        );
+        let mut stack = vec![0usize];
+        while let Some(k) = stack.pop() {
+            let node = &self.tree[k];
+            if (0..3).any(|a| node.hi[a] < slo[a] || shi[a] < node.lo[a]) {
+                continue;
+            }
+            if node.children[0] != usize::MAX {
+                stack.extend(node.children);
+                continue;
+            }
+            for &f in &self.order[node.first..node.first + node.count] {
+                let [a, b, c] = self.faces[f].map(|i| self.vertices[i]);
+                let (e1, e2) = (sub(b, a), sub(c, a));
+                let h = cross(d, e2);
+                let det = dot(e1, h);
+                if det.abs() <= f64::MIN_POSITIVE {
+                    continue; // along the face's plane: touching, not crossing
+                }
+                let s = sub(p, a);
+                let u = dot(s, h) / det;
+                let qv = cross(s, e1);
+                let v = dot(d, qv) / det;
+                let t = dot(e2, qv) / det;
+                let len = dot(d, d).sqrt();
+                let margin = tol / len.max(f64::MIN_POSITIVE);
+                let edge = tol / (dot(e1, e1).sqrt().max(dot(e2, e2).sqrt()));
+                if u > edge && v > edge && u + v < 1.0 - edge && t > margin && t < 1.0 - margin {
+                    return true;
+                }
+            }
+        }
+        false
     }
 }
 
@@ -425,7 +640,7 @@ mod tests {
     fn a_cube_mesh_samples_its_whole_surface() {
         let (v, f) = cube(1.0);
         let m = TriangleMesh::new(v, f).unwrap();
-        let s = m.samples(0.1);
+        let s = m.samples(0.1, &crate::rigid::Reach::ALL);
         let area: f64 = s.iter().map(|p| p.2).sum();
         assert!((area - 6.0).abs() < 1e-9, "{area}");
         // Every sample on the surface, its normal the face's.

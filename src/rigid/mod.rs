@@ -17,9 +17,12 @@
 pub mod contact;
 pub mod geometry;
 pub mod mesh;
+pub mod sampling;
+pub mod stl;
 
 pub use contact::Contact;
 pub use geometry::{Geometry, Sample};
+pub use sampling::Reach;
 
 use serde::{Deserialize, Serialize};
 
@@ -139,9 +142,12 @@ impl BodyLoad {
         self.vector().map(|f| f * share)
     }
 
-    /// The unit vector along the force.
+    /// The unit vector along the force. The force is scaled by its largest entry first, so
+    /// that the squares neither overflow (1e160 N) nor vanish (1e-170 N).
     pub fn direction(&self) -> [f64; 3] {
         let f = self.vector();
+        let big = f.iter().fold(0.0f64, |m, c| m.max(c.abs()));
+        let f = f.map(|c| c / big);
         let l = f.iter().map(|c| c * c).sum::<f64>().sqrt();
         f.map(|c| c / l)
     }
@@ -343,12 +349,23 @@ impl RigidBodySpec {
     }
 
     /// Its parts drawn at displacement `offset` (m), body index `body`, 3D surfaces sampled
-    /// every `spacing` m (the snapshots' `bodies_*.vtu`).
-    pub fn outlines(&self, body: u32, offset: [f64; 3], spacing: f64) -> Vec<Outline> {
+    /// every `spacing` m where they lie in `grid` (lower and upper corner, m; the
+    /// snapshots' `bodies_*.vtu`).
+    pub fn outlines(
+        &self,
+        body: u32,
+        offset: [f64; 3],
+        spacing: f64,
+        grid: ([f64; 3], [f64; 3]),
+    ) -> Vec<Outline> {
+        let reach = Reach {
+            lo: std::array::from_fn(|a| grid.0[a] - offset[a]),
+            hi: std::array::from_fn(|a| grid.1[a] - offset[a]),
+        };
         (0u32..)
             .zip(&self.parts)
             .map(|(part, p)| {
-                let (points, closed) = p.geometry.outline(spacing);
+                let (points, closed) = p.geometry.outline(spacing, &reach);
                 Outline {
                     body,
                     part,
@@ -358,6 +375,56 @@ impl RigidBodySpec {
                         .collect(),
                     closed,
                 }
+            })
+            .collect()
+    }
+
+    /// The box (m, in the body's starting frame) its surface can reach the grid
+    /// `lo`..`hi` (m, `n` axes) from over its travel, `margin` wider on every side (the
+    /// shape functions' support): the grid shifted back along its motion, or under a load
+    /// by the grid's own size along each axis the load acts on.
+    pub fn reach(&self, n: usize, lo: [f64; 3], hi: [f64; 3], margin: f64) -> Reach {
+        let mut reach = Reach {
+            lo: std::array::from_fn(|a| if a < n { lo[a] - margin } else { f64::NEG_INFINITY }),
+            hi: std::array::from_fn(|a| if a < n { hi[a] + margin } else { f64::INFINITY }),
+        };
+        for a in 0..n {
+            if let Some(m) = &self.motion {
+                let moved = m.vector()[a] / m.speed() * m.travel;
+                reach.lo[a] -= moved.max(0.0);
+                reach.hi[a] -= moved.min(0.0);
+            }
+            if self.load.as_ref().is_some_and(|l| l.vector()[a] != 0.0) {
+                reach.lo[a] -= hi[a] - lo[a];
+                reach.hi[a] += hi[a] - lo[a];
+            }
+        }
+        reach
+    }
+
+    /// Its contact samples in a grid of cell size `cell` spanning `lo`..`hi` (m): its
+    /// surface every half cell where it can reach the grid over its travel (the shape
+    /// functions' support, two cells, around it), each with its part, less those on a face
+    /// two parts share (a cone's tip against its shaft: inside the body, not on its
+    /// surface).
+    pub fn samples(&self, n: usize, cell: f64, (lo, hi): ([f64; 3], [f64; 3])) -> Vec<(Sample, usize)> {
+        let reach = self.reach(n, lo, hi, 2.0 * cell);
+        let spacing = 0.5 * cell;
+        let inner = 1e-9 * cell;
+        self.parts
+            .iter()
+            .enumerate()
+            .flat_map(|(k, p)| {
+                p.geometry
+                    .samples(spacing, &reach)
+                    .into_iter()
+                    .map(move |s| (s, k))
+            })
+            .filter(|(s, k)| {
+                self.parts
+                    .iter()
+                    .enumerate()
+                    .all(|(j, q)| j == *k || q.geometry.distance(s.x, n).0 > inner)
             })
             .collect()
     }

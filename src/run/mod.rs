@@ -241,6 +241,7 @@ impl<'a> Run<'a> {
                 let header = checkpoint::Header {
                     scene_path: loaded.path.clone(),
                     scene_text: loaded.text.clone(),
+                    meshes_crc: loaded.mesh_crc(),
                     ..checkpoint::Header::default()
                 };
                 with_simulation!(&mut sim, s => watch.drive(s, &loaded, dir.as_ref(), None, header))
@@ -253,6 +254,16 @@ impl<'a> Run<'a> {
                 })?;
                 let header = checkpoint::header(&bytes, &file)?;
                 let loaded = LoadedScene::from_text(&header.scene_path, &header.scene_text, &[])?;
+                if loaded.mesh_crc() != header.meshes_crc {
+                    return Err(CheckpointError::Format {
+                        path: file,
+                        reason: "an STL mesh of the scene differs from the one the run was \
+                                 started with (replaced or moved since): put the file back, or \
+                                 start the run again"
+                            .into(),
+                    }
+                    .into());
+                }
                 let (mut sim, _) = build(&loaded)?;
                 let dir = claim(&dir)?;
                 with_simulation!(&mut sim, s => {

@@ -49,26 +49,12 @@ fn visit_support<D: Dim>(grid: &Grid<D>, shape: ShapeKind, x: D::Vec, mut f: imp
     }
 }
 
-/// Even-odd rule point-in-polygon test.
-fn in_polygon(vertices: &[Vec<f64>], x: f64, y: f64) -> bool {
-    let mut inside = false;
-    let mut j = vertices.len() - 1;
-    for i in 0..vertices.len() {
-        let (a, b) = (&vertices[i], &vertices[j]);
-        if (a[1] > y) != (b[1] > y) && x < (b[0] - a[0]) * (y - a[1]) / (b[1] - a[1]) + a[0] {
-            inside = !inside;
-        }
-        j = i;
-    }
-    inside
-}
-
 /// Bounding box of a region (m, x y z; z is 0..0 in 2D).
 pub(super) fn region_bounds(region: &Region, n: usize) -> ([f64; 3], [f64; 3]) {
     match region {
         Region::Box { min, max } => (pad3(min), pad3(max)),
         Region::Polygon { vertices, z } => {
-            let (mut lo, mut hi) = crate::rigid::geometry::polygon_bounds(vertices);
+            let (mut lo, mut hi) = crate::polygon::bounds(vertices);
             if n == 3 {
                 let z = z.as_ref().expect("validated");
                 (lo[2], hi[2]) = (z[0], z[1]);
@@ -82,7 +68,7 @@ fn region_contains(region: &Region, x: [f64; 3], n: usize) -> bool {
     match region {
         Region::Box { min, max } => (0..n).all(|a| x[a] > min[a] && x[a] < max[a]),
         Region::Polygon { vertices, z } => {
-            in_polygon(vertices, x[0], x[1])
+            crate::polygon::contains(vertices, x[0], x[1])
                 && (n == 2 || z.as_ref().is_some_and(|z| x[2] > z[0] && x[2] < z[1]))
         }
     }
@@ -389,6 +375,25 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         systems: schedule.names(),
         unused_materials,
         estimate,
+        bodies: describe_bodies::<D>(s, &grid),
+        water: settings.water.as_ref().map(|w| {
+            let moved: Vec<&str> = s
+                .stages
+                .iter()
+                .filter(|st| st.water.is_some())
+                .map(|st| st.name.as_str())
+                .collect();
+            format!(
+                "γ_w {} N/m³, gravity along axis {}{}",
+                w.unit_weight,
+                w.axis,
+                if moved.is_empty() {
+                    String::new()
+                } else {
+                    format!("; moved by stages {moved:?}")
+                }
+            )
+        }),
     };
     let state = SolverState {
         control: Control {
@@ -426,6 +431,34 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         },
         derived,
     ))
+}
+
+/// Each rigid body as `kdmpm check` prints it: name, parts, samples within reach, control
+/// and travel.
+fn describe_bodies<D: Dim>(s: &Scene, grid: &Grid<D>) -> Vec<String> {
+    let span = (D::vec_to3(grid.origin), D::vec_to3(grid.max_corner()));
+    s.rigid_bodies
+        .iter()
+        .map(|b| {
+            let samples = b.samples(D::N, grid.cell_size, span).len();
+            let control = match (&b.motion, &b.load) {
+                (Some(m), _) => format!(
+                    "moves {} m at {:?} m/s in {} increment(s)",
+                    m.travel,
+                    m.velocity,
+                    b.increments()
+                ),
+                (_, Some(l)) => format!("under a load of {:?} N in {} increment(s)", l.force, l.increments),
+                _ => "holds its place".into(),
+            };
+            format!(
+                "\"{}\": {} part(s), {samples} contact samples, {:?} interface, {control}",
+                b.name,
+                b.parts.len(),
+                b.interface
+            )
+        })
+        .collect()
 }
 
 /// The checked grid, with each axis's point half-width (uniform GIMP).

@@ -101,7 +101,7 @@ pub struct Scene {
     #[serde(default)]
     pub shape: ShapeKind,
     /// Materials by name; a name given twice is an error.
-    #[serde(deserialize_with = "unique_keys")]
+    #[serde(deserialize_with = "crate::unique_map::deserialize")]
     pub materials: BTreeMap<String, MaterialSpec>,
     /// Bodies filled with material points.
     pub bodies: Vec<BodySpec>,
@@ -200,10 +200,10 @@ pub struct StageSpec {
     /// Name (a row of `stages.csv`).
     pub name: String,
     /// Materials replaced, by name (each must be in `materials`).
-    #[serde(default, deserialize_with = "unique_keys")]
+    #[serde(default, deserialize_with = "crate::unique_map::deserialize")]
     pub materials: BTreeMap<String, MaterialSpec>,
     /// Point loads' new forces, by name (N; N/m in 2D).
-    #[serde(default, deserialize_with = "unique_keys")]
+    #[serde(default, deserialize_with = "crate::unique_map::deserialize")]
     pub point_loads: BTreeMap<String, Vec<f64>>,
     /// The face conditions from this stage on, replacing the scene's (nodes a motion drives
     /// keep its axes).
@@ -214,7 +214,7 @@ pub struct StageSpec {
     #[serde(default)]
     pub gravity: Option<GravitySpec>,
     /// Tractions' new values, by name (Pa).
-    #[serde(default, deserialize_with = "unique_keys")]
+    #[serde(default, deserialize_with = "crate::unique_map::deserialize")]
     pub tractions: BTreeMap<String, Vec<f64>>,
     /// The piezometric surfaces from this stage on (filling a reservoir, a drawdown); the
     /// scene must have `water`.
@@ -447,38 +447,8 @@ pub enum CheckpointEvery {
     Seconds(f64),
 }
 
-/// A map whose keys are all different: serde's own map keeps the last of two equal keys
-/// without a word, so that a second `"soil"` would silently replace the first.
-fn unique_keys<'de, D, V>(deserializer: D) -> Result<BTreeMap<String, V>, D::Error>
-where
-    D: serde::Deserializer<'de>,
-    V: Deserialize<'de>,
-{
-    struct Unique<V>(std::marker::PhantomData<V>);
-    impl<'de, V: Deserialize<'de>> serde::de::Visitor<'de> for Unique<V> {
-        type Value = BTreeMap<String, V>;
-        fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
-            f.write_str("a map with distinct names")
-        }
-        fn visit_map<A: serde::de::MapAccess<'de>>(self, mut map: A) -> Result<Self::Value, A::Error> {
-            let mut out = BTreeMap::new();
-            while let Some(key) = map.next_key::<String>()? {
-                if out.contains_key(&key) {
-                    return Err(serde::de::Error::custom(format!(
-                        "the name \"{key}\" is given twice: each entry needs its own name"
-                    )));
-                }
-                let value = map.next_value()?;
-                out.insert(key, value);
-            }
-            Ok(out)
-        }
-    }
-    deserializer.deserialize_map(Unique(std::marker::PhantomData))
-}
-
 /// A scene vector (one entry per axis) as x y z, the missing axes 0.
-fn pad3(v: &[f64]) -> [f64; 3] {
+pub(crate) fn pad3(v: &[f64]) -> [f64; 3] {
     [
         v[0],
         v.get(1).copied().unwrap_or(0.0),
@@ -611,6 +581,21 @@ impl Scene {
 }
 
 impl LoadedScene {
+    /// CRC-32 of every STL mesh the scene's bodies read (vertices and triangles, in scene
+    /// order); 0 for a scene without one. A checkpoint keeps it, since it keeps the scene's
+    /// text but not its files.
+    pub fn mesh_crc(&self) -> u32 {
+        let mut h = crc32fast::Hasher::new();
+        for b in &self.scene.rigid_bodies {
+            for p in &b.parts {
+                if let crate::rigid::Geometry::Mesh { .. } = p.geometry {
+                    p.geometry.mesh().fingerprint(&mut h);
+                }
+            }
+        }
+        h.finalize()
+    }
+
     /// Reads and parses a scene file, applying `overrides` (`path.to.field=value`) first.
     pub fn from_file(path: &Path, overrides: &[String]) -> Result<Self, SceneError> {
         let text = std::fs::read_to_string(path).map_err(|source| SceneError::Read {

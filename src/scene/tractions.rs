@@ -60,6 +60,17 @@ pub(super) fn place<D: Dim>(
                 (true, 0) => x[0] - 0.5 * sub(0),
                 (true, _) => x[0],
             };
+            if radius <= 1e-9 * s.grid.cell_size {
+                return Err(loaded.invalid(
+                    &format!("tractions[{i}].surface"),
+                    format!(
+                        "traction \"{}\" loads points whose face lies on the axis (r = 0), which \
+                         has no area: it would carry nothing; an XMin surface is a hollow body's \
+                         inner face, off the axis",
+                        t.name
+                    ),
+                ));
+            }
             let share: f64 = (0..n).filter(|&a| a != normal).map(sub).product::<f64>() * radius;
             let out = if upper { x[normal] } else { -x[normal] };
             let subs = std::array::from_fn(|a| if a < n { sub(a) } else { 0.0 });

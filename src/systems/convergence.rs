@@ -64,7 +64,8 @@ pub struct ForceNorms {
 impl ForceNorms {
     /// K_F = max|F_ext + F_int| / max|F_ext| and Σ|F_ext + F_int| / Σ|F_ext|, measured
     /// against `reference` (the last applied load's norms) when no external force acts:
-    /// [`UNDEFINED`] when there is neither.
+    /// 0 when there is neither and no force at all (soil that nothing has touched, a body
+    /// that moved away from it), [`UNDEFINED`] when there is neither but a force.
     pub fn ratios(&self, reference: Option<[f64; 2]>) -> [f64; 2] {
         let e = if self.external[0] > 0.0 {
             self.external
@@ -74,6 +75,8 @@ impl ForceNorms {
         std::array::from_fn(|k| {
             if e[k] > 0.0 {
                 self.unbalanced[k] / e[k]
+            } else if self.unbalanced[k] == 0.0 {
+                0.0
             } else {
                 UNDEFINED
             }
@@ -226,8 +229,12 @@ impl<D: Dim> System<D> for Convergence {
         if norms.external[0] > 0.0 {
             s.convergence.force_reference = Some(norms.external);
         }
+        // No work done and nothing moving: K_E is 0, as K_F is with no force at all (a
+        // ramp or a drive still under way keeps such a state from counting as static).
         s.convergence.energy_ratio = if s.convergence.external_work > 0.0 {
             s.energy.current() / s.convergence.external_work
+        } else if s.energy.current() == 0.0 {
+            0.0
         } else {
             UNDEFINED
         };

@@ -86,6 +86,11 @@ impl<D: Dim, S: Shape> P2g<D, S> {
         let mut nf = col_mut::<NodeForce<D::Vec>>(n);
         let mut ne = col_mut::<NodeExternalForce<D::Vec>>(n);
         let water = ctx.settings.water.as_ref();
+        // The pore water's load rises with gravity's ramp, as the weight it buoys does.
+        let ramp = ctx
+            .settings
+            .gravity
+            .map_or(1.0, |g| g.step_factor(ctx.state.clock.time, ctx.settings.dt));
         let (mass_momentum, force) = match self.part {
             P2gPart::All => (true, true),
             P2gPart::MassMomentum => (true, false),
@@ -134,7 +139,7 @@ impl<D: Dim, S: Shape> P2g<D, S> {
                             (Some((w, ids)), Some((_, neg_vol))) => {
                                 let vol = -neg_vol;
                                 let b = w.body_force(ids[p].0, D::vec_to3(x[p].0), vol);
-                                (b != [0.0; 3]).then(|| D::vec_from(b) * (vol / mp))
+                                (b != [0.0; 3]).then(|| D::vec_from(b) * (vol * ramp / mp))
                             }
                             _ => None,
                         };

@@ -122,7 +122,7 @@ fn place<D: Dim, S: Shape>(
             let x = D::vec_to3(grid.node_position(grid.node_ijk(i)));
             let at: [f64; 3] = std::array::from_fn(|a| x[a] - state.offset[a]);
             let (phi, normal, part) = spec.distance(at, D::N);
-            if phi > 0.0 {
+            if phi > 0.0 || !faces_soil(grid, &nm, i, normal) {
                 continue;
             }
             let k = slot(&mut set.slots, &mut slot_of, i);
@@ -184,34 +184,38 @@ fn place<D: Dim, S: Shape>(
     set
 }
 
+/// True unless the face whose normal `normal` an inside node `i` takes faces away from the
+/// soil that reaches the node: along the normal's main axis the next node out carries no
+/// mass and the next node in does. In a body thinner than a point's reach, a node nearer
+/// the top face than the base is reached from below; held along the top's normal it would
+/// drag the soil with a body moving up, a pull no interface carries.
+fn faces_soil<D: Dim>(grid: &crate::grid::Grid<D>, nm: &[NodeMass], i: usize, normal: [f64; 3]) -> bool {
+    let a = (0..D::N).fold(0, |m, a| if normal[a].abs() > normal[m].abs() { a } else { m });
+    let ijk = grid.node_ijk(i);
+    let mass = |k: Option<usize>| {
+        k.filter(|&k| k <= grid.axes[a].cells).map_or(0.0, |k| {
+            let mut at = ijk;
+            at[a] = k;
+            nm[grid.node_id(at)].0
+        })
+    };
+    let (up, down) = (mass(Some(ijk[a] + 1)), mass(ijk[a].checked_sub(1)));
+    let (outward, inward) = if normal[a] > 0.0 { (up, down) } else { (down, up) };
+    !(outward == 0.0 && inward > 0.0)
+}
+
 impl<D: Dim, S: Shape> System<D> for RigidContact<D, S> {
     fn name(&self) -> &str {
         "rigid_contact"
     }
 
     fn prepare(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
-        let spacing = 0.5 * ctx.grid.cell_size;
-        let n = D::N;
-        // A sample on a face two parts share (a cone's tip against its shaft) is inside
-        // the body, not on its surface: it is left out.
-        let inner = 1e-9 * ctx.grid.cell_size;
+        let grid = (D::vec_to3(ctx.grid.origin), D::vec_to3(ctx.grid.max_corner()));
         self.samples = ctx
             .settings
             .bodies
             .iter()
-            .map(|b| {
-                b.parts
-                    .iter()
-                    .enumerate()
-                    .flat_map(|(k, p)| p.geometry.samples(spacing).into_iter().map(move |s| (s, k)))
-                    .filter(|(s, k)| {
-                        b.parts
-                            .iter()
-                            .enumerate()
-                            .all(|(j, q)| j == *k || q.geometry.distance(s.x, n).0 > inner)
-                    })
-                    .collect()
-            })
+            .map(|b| b.samples(D::N, ctx.grid.cell_size, grid))
             .collect();
         self.interfaces = ctx
             .settings

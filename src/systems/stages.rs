@@ -1,7 +1,8 @@
 //! Loading stages: a scene's `stages` run one after another, each to the static stop; a
 //! stage changes materials (e.g. elastic soil for the geostatic state, then its
 //! Mohr-Coulomb strength), gravity, point loads, tractions and the water's piezometric
-//! surfaces when it begins, and may zero the displacements.
+//! surfaces when it begins, and may zero the displacements. The water's unit weight
+//! follows the stage's gravity.
 
 use crate::components::*;
 use crate::context::Context;
@@ -43,6 +44,10 @@ fn apply<D: Dim>(ctx: &mut Context<D>, stage: &LoadStage, start: f64) {
     if let Some(w) = &stage.water {
         ctx.settings.water = Some(w.clone());
     }
+    // γ_w = ρ_w |g| follows the gravity in force (a centrifuge stage doubles both).
+    if let (Some(w), Some(g)) = (ctx.settings.water.as_mut(), ctx.settings.gravity) {
+        w.follow_gravity(g.acceleration);
+    }
     set_point_loads(ctx, &stage.loads, 1.0);
 }
 
@@ -64,26 +69,34 @@ fn rewet<D: Dim>(ctx: &mut Context<D>, stage: &LoadStage) {
     }
 }
 
-/// Scales the mass of every point whose material `stage` gives another density by
-/// ρ_new/ρ_old (its volume is what it is; its mass, and with it its weight, change). Called
-/// once as the stage begins, before [`apply`] replaces the models: unlike `apply` it is
-/// not idempotent, and a resumed run's masses are already those of its stage.
+/// Scales the mass of every point whose material `stage` gives another dry density by
+/// ρ_new/ρ_old (its volume is what it is; its mass, and with it its weight, change); below
+/// a piezometric surface the saturated density stays the scene's
+/// ([`crate::water::Water::reweigh_ratio`]). Called once as the stage begins, before
+/// [`apply`] replaces the models: unlike `apply` it is not idempotent, and a resumed run's
+/// masses are already those of its stage.
 fn reweigh<D: Dim>(ctx: &mut Context<D>, stage: &LoadStage) {
-    let ratios: Vec<(u16, f64)> = stage
+    let changes: Vec<(u16, f64, f64)> = stage
         .materials
         .iter()
-        .map(|(id, model)| (*id, model.density() / ctx.materials[*id as usize].density()))
-        .filter(|&(_, r)| r != 1.0)
+        .map(|(id, model)| (*id, ctx.materials[*id as usize].density(), model.density()))
+        .filter(|&(_, old, new)| old != new)
         .collect();
-    if ratios.is_empty() {
+    if changes.is_empty() {
         return;
     }
+    let water = ctx.settings.water.as_ref();
     for arch in points_with::<MaterialId>(&ctx.world) {
         let ids = col::<MaterialId>(arch);
+        let xs = col::<Position<D::Vec>>(arch);
+        let vs = col::<Volume>(arch);
         let mut mass = col_mut::<Mass>(arch);
-        for (m, id) in mass.iter_mut().zip(ids.iter()) {
-            if let Some(&(_, r)) = ratios.iter().find(|(k, _)| *k == id.0) {
-                m.0 *= r;
+        for (((m, id), x), v) in mass.iter_mut().zip(ids.iter()).zip(xs.iter()).zip(vs.iter()) {
+            if let Some(&(_, old, new)) = changes.iter().find(|(k, _, _)| *k == id.0) {
+                m.0 *= match water {
+                    Some(w) => w.reweigh_ratio(id.0, D::vec_to3(x.0), v.0, old, new),
+                    None => new / old,
+                };
             }
         }
     }
@@ -104,8 +117,10 @@ impl<D: Dim> System<D> for Stages {
             // A stage starts when the one before it ended.
             let start = k.checked_sub(1).map_or(0.0, |j| ctx.state.control.stages[j].time);
             // A fresh run begins in the first stage with the scene's masses; a resumed one
-            // has the masses of its stage in its checkpoint.
-            if k == 0 && ctx.state.clock.step == 0 {
+            // has the masses of its stage in its checkpoint. `prepare` runs inside the
+            // first step, whose clock already reads 1 (a checkpoint taken before any step
+            // holds the scene's masses too).
+            if k == 0 && ctx.state.clock.step <= 1 {
                 reweigh(ctx, stage);
                 rewet(ctx, stage);
             }

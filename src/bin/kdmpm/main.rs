@@ -82,8 +82,13 @@ fn command(command: Command, comm: &Arc<Comm>) -> Result<ExitCode, Fault> {
         Command::Run { stepping, trace, .. } => (stepping.workers.threads, trace.clone()),
         Command::Resume { stepping, .. } => (stepping.workers.threads, None),
         Command::Fos { workers, .. } => (workers.threads, None),
+        Command::Study { workers, .. } => {
+            check_threads(workers.threads)?;
+            (None, None)
+        }
         _ => (None, None),
     };
+    check_threads(threads)?;
     // The trace's guard flushes the file when the command returns.
     let _trace = trace
         .map(kdmpm::infra::trace::start)
@@ -137,6 +142,21 @@ fn command(command: Command, comm: &Arc<Comm>) -> Result<ExitCode, Fault> {
         }
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// Refuses more threads than 4 a core this process may use: a step's work is shared
+/// among them, so more only queue for the cores (10 000 threads on 2 cores spent minutes
+/// starting before the first step).
+fn check_threads(threads: Option<std::num::NonZeroUsize>) -> Result<(), Fault> {
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    match threads {
+        Some(n) if n.get() > 4 * cores => Err(Fault::bad(format!(
+            "--threads {n}: at most 4 a core, {} on the {cores} core(s) this process may use \
+             (results are the same for any count; more threads only queue for the cores)",
+            4 * cores
+        ))),
+        _ => Ok(()),
+    }
 }
 
 /// The output directory when none is given: `out/<prefix><file stem>` (`fallback` for a
@@ -199,7 +219,9 @@ fn run_refined(
     };
     let (r, refinement) = kdmpm::refine::limit_pressure(loaded, out, levels, quiet, show)
         .map_err(|e| Fault(e.to_string(), e.ending()))?;
-    println!("{}\n{}", r.describe(), refinement.describe());
+    if !quiet {
+        println!("{}\n{}", r.describe(), refinement.describe());
+    }
     Ok(ExitCode::SUCCESS)
 }
 
@@ -222,7 +244,9 @@ fn run_fos(
         };
         let (r, refinement) = kdmpm::refine::factor_of_safety(&loaded, &out, levels, show)
             .map_err(|e| Fault(e.to_string(), e.ending()))?;
-        println!("{} → {}\n{}", r.describe(), out.display(), refinement.describe());
+        if !quiet {
+            println!("{} → {}\n{}", r.describe(), out.display(), refinement.describe());
+        }
         return Ok(());
     }
     let show = |t: &kdmpm::fos::Trial| {
@@ -232,7 +256,9 @@ fn run_fos(
     };
     let r =
         kdmpm::fos::strength_reduction(&loaded, &out, show).map_err(|e| Fault(e.to_string(), e.ending()))?;
-    println!("{} → {}", r.describe(), out.display());
+    if !quiet {
+        println!("{} → {}", r.describe(), out.display());
+    }
     Ok(())
 }
 

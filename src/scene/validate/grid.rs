@@ -165,14 +165,6 @@ pub(super) fn check_grid(r: &Rules) -> Result<CheckedGrid, SceneError> {
             );
         }
         check_axis(&faces, "boundaries").map_err(|(field, rule)| r.loaded.invalid(&field, rule))?;
-        if let Some(g) = &s.gravity {
-            if g.acceleration.first().is_some_and(|&gx| gx != 0.0) {
-                return r.bad(
-                    "gravity.acceleration",
-                    "in an axisymmetric scene gravity acts along the axis (y): its x entry must be 0".into(),
-                );
-            }
-        }
     }
     let mut cells = [0usize; 3];
     cells[..n].copy_from_slice(&s.grid.cells);

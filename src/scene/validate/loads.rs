@@ -10,14 +10,7 @@ use crate::materials::MaterialModel;
 pub(super) fn check_loads(r: &Rules, table: &[(String, MaterialModel)]) -> Result<(), SceneError> {
     let (loaded, s, n) = (r.loaded, &r.loaded.scene, r.n);
     if let Some(g) = &s.gravity {
-        r.len("gravity.acceleration", g.acceleration.len())?;
-        r.finite("gravity.acceleration", &g.acceleration, "m/s²")?;
-        if !non_negative(g.ramp_time) {
-            return r.bad(
-                "gravity.ramp_time",
-                format!("must be ≥ 0 s, found {}", g.ramp_time),
-            );
-        }
+        check_gravity(r, "gravity", g)?;
     }
     check_mass_finite(loaded, table, n)?;
     if s.solver.volumetric_smoothing {
@@ -28,6 +21,57 @@ pub(super) fn check_loads(r: &Rules, table: &[(String, MaterialModel)]) -> Resul
         r.len(&format!("point_loads[{i}].force"), l.force.len())?;
         r.finite(&format!("point_loads[{i}].position"), &l.position, "m")?;
         r.finite(&format!("point_loads[{i}].force"), &l.force, "N")?;
+    }
+    Ok(())
+}
+
+/// A gravity, the scene's or a stage's (`field` its path): one finite entry per axis, a
+/// ramp of at least 0 s; along the axis in an axisymmetric scene (a radial gravity would
+/// pull every ring outwards alike); and, under a water table, down the axis the heights
+/// are measured up (the scene's gravity's) or zero: the water's unit weight follows the
+/// gravity in force (γ_w ∝ |g|, a centrifuge stage included), its surfaces do not turn.
+pub(super) fn check_gravity(r: &Rules, field: &str, g: &crate::scene::GravitySpec) -> Result<(), SceneError> {
+    let s = &r.loaded.scene;
+    let at = format!("{field}.acceleration");
+    r.len(&at, g.acceleration.len())?;
+    r.finite(&at, &g.acceleration, "m/s²")?;
+    if !non_negative(g.ramp_time) {
+        return r.bad(
+            &format!("{field}.ramp_time"),
+            format!("must be ≥ 0 s, found {}", g.ramp_time),
+        );
+    }
+    if s.dimension == crate::scene::Dimension::Axisymmetric && g.acceleration[0] != 0.0 {
+        return r.bad(
+            &at,
+            "in an axisymmetric scene gravity acts along the axis (y): its x entry must be 0".into(),
+        );
+    }
+    let water_axis = s.water.as_ref().and(s.gravity.as_ref()).and_then(|scene| {
+        let along: Vec<usize> = (0..scene.acceleration.len())
+            .filter(|&a| scene.acceleration[a] != 0.0)
+            .collect();
+        (along.len() == 1).then(|| along[0])
+    });
+    if let Some(axis) = water_axis {
+        let turned = (0..g.acceleration.len()).any(|a| {
+            if a == axis {
+                g.acceleration[a] > 0.0
+            } else {
+                g.acceleration[a] != 0.0
+            }
+        });
+        if turned {
+            return r.bad(
+                &at,
+                format!(
+                    "{:?} under the scene's water: gravity points down axis {axis}, as the \
+                     scene's does, or is 0 (the piezometric surfaces are heights up that axis, \
+                     and γ_w follows |g|)",
+                    g.acceleration
+                ),
+            );
+        }
     }
     Ok(())
 }
@@ -100,7 +144,13 @@ pub(super) fn check_has_load(r: &Rules) -> Result<(), SceneError> {
         .is_some_and(|g| g.acceleration.iter().any(|&a| a != 0.0));
     let loads = s.point_loads.iter().any(|l| l.force.iter().any(|&f| f != 0.0))
         || s.tractions.iter().any(|t| t.vector().iter().any(|&f| f != 0.0));
-    if !gravity && !loads && s.motions.is_empty() && s.rigid_bodies.is_empty() {
+    // A rigid body loads the soil only when something drives it: one that holds its place
+    // (a base, a wall at rest) only answers to what else acts.
+    let driven = s
+        .rigid_bodies
+        .iter()
+        .any(|b| b.motion.is_some() || b.load.is_some());
+    if !gravity && !loads && s.motions.is_empty() && !driven {
         return r.bad(
             if s.gravity.is_some() {
                 "gravity.acceleration"
@@ -108,8 +158,8 @@ pub(super) fn check_has_load(r: &Rules) -> Result<(), SceneError> {
                 "gravity"
             },
             "the scene applies no load (no gravity, no non-zero point load, no motion, no rigid \
-             body): its static state is the state it starts in; add gravity, point_loads, \
-             motions or rigid_bodies"
+             body with a motion or a load): its static state is the state it starts in; add \
+             gravity, point_loads, motions or a driven rigid body"
                 .into(),
         );
     }

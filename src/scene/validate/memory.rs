@@ -15,9 +15,17 @@ pub struct Estimate {
     pub points: u64,
     /// Grid nodes, Π (cells + 1).
     pub nodes: u64,
-    /// Bytes of the point and node columns and of the largest set-up and sort buffers.
+    /// The rigid bodies' contact samples: their surfaces every half cell within reach of
+    /// the grid.
+    pub samples: u64,
+    /// Bytes of the point and node columns, of the largest set-up and sort buffers and of
+    /// the contact samples.
     pub bytes: u64,
 }
+
+/// Bytes a contact sample costs: its place, normal, measure and part (64 B) and, each step
+/// it meets soil, its contact with up to 27 nodes' slots and weights (about 512 B).
+const SAMPLE_BYTES: u64 = 576;
 
 /// Bytes a point costs besides its components: the ECS entity record (16 B), its slot in
 /// the scatter's slab grouping (4 B) and the sort's permutation (4 B), rounded up.
@@ -194,7 +202,31 @@ pub(super) fn estimate(
             .and_then(|b| bytes.checked_add(b))
             .ok_or_else(|| too_many(&field, "the points' memory"))?;
     }
-    Ok(Estimate { points, nodes, bytes })
+    let (lo, hi) = (
+        crate::scene::pad3(&s.grid.origin),
+        std::array::from_fn(|a| {
+            if a < n {
+                s.grid.origin[a] + s.grid.cells[a] as f64 * s.grid.cell_size
+            } else {
+                0.0
+            }
+        }),
+    );
+    let samples: u64 = s
+        .rigid_bodies
+        .iter()
+        .map(|b| b.samples(n, s.grid.cell_size, (lo, hi)).len() as u64)
+        .sum();
+    let bytes = samples
+        .checked_mul(SAMPLE_BYTES)
+        .and_then(|b| bytes.checked_add(b))
+        .ok_or_else(|| too_many("rigid_bodies", "the contact samples' memory"))?;
+    Ok(Estimate {
+        points,
+        nodes,
+        samples,
+        bytes,
+    })
 }
 
 /// The memory bound against what the process may have.

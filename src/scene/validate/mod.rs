@@ -61,6 +61,11 @@ pub struct Derived {
     pub unused_materials: Vec<String>,
     /// The memory bound checked before anything was allocated.
     pub estimate: Estimate,
+    /// Each rigid body as `kdmpm check` describes it: its name, parts, control and travel.
+    pub bodies: Vec<String>,
+    /// The water as `kdmpm check` describes it: γ_w, the saturated points, the stages that
+    /// move it.
+    pub water: Option<String>,
 }
 
 impl std::fmt::Display for Derived {
@@ -87,6 +92,15 @@ impl std::fmt::Display for Derived {
             self.estimate.points,
             self.estimate.nodes
         )?;
+        if self.estimate.samples > 0 {
+            writeln!(f, "  contact samples       {}", self.estimate.samples)?;
+        }
+        for b in &self.bodies {
+            writeln!(f, "  rigid body            {b}")?;
+        }
+        if let Some(w) = &self.water {
+            writeln!(f, "  water                 {w}")?;
+        }
         writeln!(f, "  systems               {}", self.systems.join(" → "))?;
         if !self.unused_materials.is_empty() {
             writeln!(
@@ -256,7 +270,7 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
     check_increments_span_a_step(&r, step.dt)?;
     let stages = check_stages(&r, &table, step.p_wave_speed)?;
     let estimate = check_memory(&r, &table)?;
-    let (water, stage_waters) = check_water(&r, &grid, &table)?;
+    let (water, stage_waters) = check_water(&r, &grid, &table, &stages)?;
     let mut stages = stages;
     for (st, w) in stages.iter_mut().zip(stage_waters) {
         st.water = w;

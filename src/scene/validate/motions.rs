@@ -105,6 +105,18 @@ pub(crate) fn check_motion_boxes<D: Dim>(
                     ),
                 ));
             }
+            // On the axis of an axisymmetric scene r stays 0: a radial velocity there would
+            // override the axis's roller and tear the soil off the axis.
+            if D::AXISYMMETRIC && grid.node_ijk(id)[0] == 0 && m.vector()[0] != 0.0 {
+                return Err(loaded.invalid(
+                    &format!("motions[{k}].velocity"),
+                    format!(
+                        "{} m/s along r drives nodes on the axis (r = 0), which stay on it: give \
+                         the motion no radial entry, or a box that starts off the axis",
+                        m.vector()[0]
+                    ),
+                ));
+            }
             *o = Some(k);
             inside += 1;
             loaded_nodes += usize::from(touched[id]);

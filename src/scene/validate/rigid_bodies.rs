@@ -20,7 +20,9 @@ pub(super) fn check_rigid_bodies(r: &Rules) -> Result<(), SceneError> {
     let hi: Vec<f64> = (0..n)
         .map(|a| g.origin[a] + g.cells[a] as f64 * g.cell_size)
         .collect();
-    let mut boxes: Vec<([f64; 3], [f64; 3])> = Vec::new();
+    // Each body's box at the start and the box it sweeps.
+    type Boxed = ([f64; 3], [f64; 3]);
+    let mut boxes: Vec<(Boxed, Boxed)> = Vec::new();
     for (i, b) in s.rigid_bodies.iter().enumerate() {
         let field = |f: &str| format!("rigid_bodies[{i}].{f}");
         b.check(n, s.dimension == crate::scene::Dimension::Axisymmetric)
@@ -86,9 +88,27 @@ pub(super) fn check_rigid_bodies(r: &Rules) -> Result<(), SceneError> {
                 }
             }
         }
-        for (j, (olo, ohi)) in boxes.iter().enumerate() {
-            let apart = (0..n).any(|a: usize| start_hi[a] <= olo[a] || ohi[a] <= start_lo[a]);
-            if !apart {
+        // The box the body sweeps: to the end of its travel, or under a load to the grid's
+        // edge along each axis the load acts on (it finds its own travel).
+        let (mut swept_lo, mut swept_hi) = (start_lo, start_hi);
+        for a in 0..n {
+            if let Some(l) = &b.load {
+                let f = l.vector()[a];
+                if f < 0.0 {
+                    swept_lo[a] = swept_lo[a].min(lo[a]);
+                } else if f > 0.0 {
+                    swept_hi[a] = swept_hi[a].max(hi[a]);
+                }
+            }
+            let moved = v[a] * step;
+            swept_lo[a] = swept_lo[a].min(start_lo[a] + moved);
+            swept_hi[a] = swept_hi[a].max(start_hi[a] + moved);
+        }
+        let meet = |(alo, ahi): &([f64; 3], [f64; 3]), (blo, bhi): &([f64; 3], [f64; 3])| {
+            !(0..n).any(|a: usize| ahi[a] <= blo[a] || bhi[a] <= alo[a])
+        };
+        for (j, (start, swept)) in boxes.iter().enumerate() {
+            if meet(&(start_lo, start_hi), start) {
                 return r.bad(
                     &field("geometry"),
                     format!(
@@ -96,8 +116,18 @@ pub(super) fn check_rigid_bodies(r: &Rules) -> Result<(), SceneError> {
                     ),
                 );
             }
+            if meet(&(swept_lo, swept_hi), swept) {
+                return r.bad(
+                    &field("motion"),
+                    format!(
+                        "the body's path crosses rigid_bodies[{j}]'s (the boxes they sweep over \
+                         their travels meet, a load's to the grid's edge): rigid bodies do not \
+                         meet each other, only the soil; give them paths apart"
+                    ),
+                );
+            }
         }
-        boxes.push((start_lo, start_hi));
+        boxes.push(((start_lo, start_hi), (swept_lo, swept_hi)));
     }
     Ok(())
 }

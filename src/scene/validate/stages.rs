@@ -130,15 +130,7 @@ pub(super) fn check_stages(
                     "the scene has no gravity: give it one (even [0, 0]) for a stage to change".into(),
                 );
             }
-            r.len(&format!("stages[{k}].gravity.acceleration"), g.acceleration.len())?;
-            r.finite(
-                &format!("stages[{k}].gravity.acceleration"),
-                &g.acceleration,
-                "m/s²",
-            )?;
-            if !non_negative(g.ramp_time) {
-                return r.bad(&format!("stages[{k}].gravity.ramp_time"), "must be ≥ 0 s".into());
-            }
+            super::loads::check_gravity(r, &format!("stages[{k}].gravity"), g)?;
         }
         if st.reset_displacements && !s.output.displacements {
             return r.bad(

@@ -14,6 +14,7 @@ pub(super) fn check_water(
     r: &Rules,
     grid: &CheckedGrid,
     table: &[(String, MaterialModel)],
+    checked_stages: &[super::CheckedStage],
 ) -> Result<(Option<Water>, Vec<Option<Water>>), SceneError> {
     let (loaded, s) = (r.loaded, &r.loaded.scene);
     let n = r.n;
@@ -48,6 +49,24 @@ pub(super) fn check_water(
         return Ok((None, vec![None; s.stages.len()]));
     };
     let water = spec.checked(&frame).map_err(|e| at("water", e))?;
+    // A stage's dry density stays at most the saturated density, which stages keep.
+    for (k, st) in checked_stages.iter().enumerate() {
+        for (id, m) in &st.materials {
+            let name = &table[*id as usize].0;
+            let sat = water.saturated_density(*id);
+            let dry = m.density();
+            if let Some(sat) = sat.filter(|&sat| dry > sat) {
+                return r.bad(
+                    &format!("stages[{k}].materials.{name}.density"),
+                    format!(
+                        "{dry} kg/m³ is above the saturated density the water gives \"{name}\" \
+                         ({sat} kg/m³): a stage keeps the scene's saturated densities, and a \
+                         dry density is at most that"
+                    ),
+                );
+            }
+        }
+    }
     let mut stages = Vec::with_capacity(s.stages.len());
     for (k, st) in s.stages.iter().enumerate() {
         stages.push(match &st.water {
