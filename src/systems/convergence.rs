@@ -64,8 +64,7 @@ pub struct ForceNorms {
 impl ForceNorms {
     /// K_F = max|F_ext + F_int| / max|F_ext| and Σ|F_ext + F_int| / Σ|F_ext|, measured
     /// against `reference` (the last applied load's norms) when no external force acts:
-    /// 0 when there is neither and no force at all (soil that nothing has touched, a body
-    /// that moved away from it), [`UNDEFINED`] when there is neither but a force.
+    /// [`UNDEFINED`] when there is neither.
     pub fn ratios(&self, reference: Option<[f64; 2]>) -> [f64; 2] {
         let e = if self.external[0] > 0.0 {
             self.external
@@ -75,8 +74,6 @@ impl ForceNorms {
         std::array::from_fn(|k| {
             if e[k] > 0.0 {
                 self.unbalanced[k] / e[k]
-            } else if self.unbalanced[k] == 0.0 {
-                0.0
             } else {
                 UNDEFINED
             }
@@ -197,7 +194,22 @@ impl<D: Dim> System<D> for Convergence {
     }
     fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
         let norms = force_norms(ctx);
-        let ratios = norms.ratios(ctx.state.convergence.force_reference);
+        // A load still ramping up, or a prescribed motion still moving, is not a static
+        // state, however balanced this step is; nor is a body whose load the soil does not
+        // yet balance.
+        let time = ctx.state.clock.time;
+        let loading = ctx
+            .settings
+            .gravity
+            .is_some_and(|g| g.step_factor(time, ctx.settings.dt) < 1.0)
+            || ctx.state.control.driving();
+        // Nothing acts and nothing moves once the loading is done (soil that nothing has
+        // touched, a body that moved away from it): K_F and K_E are 0, not 0/0.
+        let quiet = !loading && norms.unbalanced[0] == 0.0 && ctx.state.energy.current() == 0.0;
+        let mut ratios = norms.ratios(ctx.state.convergence.force_reference);
+        if quiet {
+            ratios = ratios.map(|r| if is_defined(r) { r } else { 0.0 });
+        }
         let dw = if let Some(dt) = ctx.motion_dt() {
             let n = nodes(&ctx.world);
             let ne = col::<NodeExternalForce<D::Vec>>(n);
@@ -229,11 +241,9 @@ impl<D: Dim> System<D> for Convergence {
         if norms.external[0] > 0.0 {
             s.convergence.force_reference = Some(norms.external);
         }
-        // No work done and nothing moving: K_E is 0, as K_F is with no force at all (a
-        // ramp or a drive still under way keeps such a state from counting as static).
         s.convergence.energy_ratio = if s.convergence.external_work > 0.0 {
             s.energy.current() / s.convergence.external_work
-        } else if s.energy.current() == 0.0 {
+        } else if quiet {
             0.0
         } else {
             UNDEFINED
@@ -251,15 +261,6 @@ impl<D: Dim> System<D> for Convergence {
             });
         }
         let tol = ctx.settings.tolerance;
-        let time = s.clock.time;
-        // A load still ramping up, or a prescribed motion still moving, is not a static
-        // state, however balanced this step is; nor is a body whose load the soil does not
-        // yet balance.
-        let loading = ctx
-            .settings
-            .gravity
-            .is_some_and(|g| g.step_factor(time, ctx.settings.dt) < 1.0)
-            || s.control.driving();
         // An undefined ratio (NaN) compares false: it never meets the tolerance.
         let met = !loading
             && s.convergence.force_ratio(ctx.settings.force_norm) <= tol
