@@ -77,17 +77,15 @@ fn a_huge_or_tiny_body_load_keeps_its_direction() {
     }
 }
 
-/// A smooth footing thinner than the points' reach, pulled 4 cm up off weightless clay:
-/// it carries no force at any static state. Once the nodes inside it that the clay below
-/// reaches were held along its top face's normal and dragged the clay up with it, and a
-/// body that touched nothing never found a static state (K_F 0/0).
+/// The smooth footing of footing_rigid.ron pulled 4 cm up off weightless clay: it carries
+/// no force at any static state. Once a body that touched nothing never found a static
+/// state (K_F 0/0) and the run ended at max_time.
 #[test]
 fn a_smooth_body_pulled_off_the_soil_carries_nothing() {
     let text = edited(
         "footing_rigid.ron",
         &[
             ("cells: [24, 18]", "cells: [24, 20]"),
-            (FOOTING, "[[-1.0, 4.0], [1.0, 4.0], [1.0, 4.4], [-1.0, 4.4]]"),
             (
                 "velocity: [0.0, -0.01], travel: 0.1",
                 "velocity: [0.0, 0.01], travel: 0.04",
@@ -131,7 +129,7 @@ fn bodies_whose_paths_cross_are_refused() {
 
 /// A circle of radius 1e9 m as a base, and a polygon 2e9 m wide: only what the grid can
 /// reach is sampled (once 1.4 TB and 3.7 GB), and both carry the block on them as a flat
-/// base does: the same weight, to 1e-3.
+/// base does: the same weight, to 1 %.
 #[test]
 fn a_base_far_larger_than_the_grid_is_sampled_where_the_grid_reaches() {
     let scene = |geometry: &str| {
@@ -161,7 +159,7 @@ fn a_base_far_larger_than_the_grid_is_sampled_where_the_grid_reaches() {
         let s = common::run_text("huge.ron", &scene(g));
         assert!(s.converged, "{g}: {:?}", s.error);
         let f = s.curve[0].force[1];
-        assert!(common::rel(f, held).abs() < 1e-3, "{g}: {f} N/m against {held}");
+        assert!(common::rel(f, held).abs() < 1e-2, "{g}: {f} N/m against {held}");
     }
 }
 

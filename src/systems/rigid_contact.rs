@@ -122,7 +122,7 @@ fn place<D: Dim, S: Shape>(
             let x = D::vec_to3(grid.node_position(grid.node_ijk(i)));
             let at: [f64; 3] = std::array::from_fn(|a| x[a] - state.offset[a]);
             let (phi, normal, part) = spec.distance(at, D::N);
-            if phi > 0.0 || !faces_soil(grid, &nm, i, normal) {
+            if phi > 0.0 {
                 continue;
             }
             let k = slot(&mut set.slots, &mut slot_of, i);
@@ -182,26 +182,6 @@ fn place<D: Dim, S: Shape>(
         }
     }
     set
-}
-
-/// True unless the face whose normal `normal` an inside node `i` takes faces away from the
-/// soil that reaches the node: along the normal's main axis the next node out carries no
-/// mass and the next node in does. In a body thinner than a point's reach, a node nearer
-/// the top face than the base is reached from below; held along the top's normal it would
-/// drag the soil with a body moving up, a pull no interface carries.
-fn faces_soil<D: Dim>(grid: &crate::grid::Grid<D>, nm: &[NodeMass], i: usize, normal: [f64; 3]) -> bool {
-    let a = (0..D::N).fold(0, |m, a| if normal[a].abs() > normal[m].abs() { a } else { m });
-    let ijk = grid.node_ijk(i);
-    let mass = |k: Option<usize>| {
-        k.filter(|&k| k <= grid.axes[a].cells).map_or(0.0, |k| {
-            let mut at = ijk;
-            at[a] = k;
-            nm[grid.node_id(at)].0
-        })
-    };
-    let (up, down) = (mass(Some(ijk[a] + 1)), mass(ijk[a].checked_sub(1)));
-    let (outward, inward) = if normal[a] > 0.0 { (up, down) } else { (down, up) };
-    !(outward == 0.0 && inward > 0.0)
 }
 
 impl<D: Dim, S: Shape> System<D> for RigidContact<D, S> {
