@@ -44,12 +44,7 @@ pub fn contains(vertices: &[Vec<f64>], x: f64, y: f64) -> bool {
 pub fn fault(vertices: &[Vec<f64>]) -> Option<String> {
     let m = vertices.len();
     let p = |i: usize| (vertices[i % m][0], vertices[i % m][1]);
-    let twice_area: f64 = (0..m)
-        .map(|i| {
-            let ((x0, y0), (x1, y1)) = (p(i), p(i + 1));
-            x0 * y1 - x1 * y0
-        })
-        .sum();
+    let twice_area = signed_area(vertices);
     if !(twice_area.abs() > 0.0 && twice_area.is_finite()) {
         return Some("the polygon encloses no area".into());
     }

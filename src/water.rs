@@ -234,6 +234,21 @@ impl Water {
         };
     }
 
+    /// Why gravity `g` (m/s², one entry an axis) cannot act on this water, if it cannot:
+    /// it points down the water's axis, as the scene's does, or is 0. The surfaces are
+    /// heights up that axis and do not turn; γ_w follows |g| ([`Self::follow_gravity`]).
+    pub fn gravity_fault(&self, g: &[f64]) -> Option<String> {
+        let axis = self.axis;
+        let turned = (0..g.len()).any(|a| if a == axis { g[a] > 0.0 } else { g[a] != 0.0 });
+        turned.then(|| {
+            format!(
+                "{g:?} under the scene's water: gravity points down axis {axis}, as the scene's \
+                 does, or is 0 (the piezometric surfaces are heights up that axis, and γ_w \
+                 follows |g|)"
+            )
+        })
+    }
+
     /// The surface's height above `x` and its slopes, for a point of `material`.
     #[inline(always)]
     fn head(&self, material: u16, x: [f64; 3]) -> (f64, [f64; 2]) {

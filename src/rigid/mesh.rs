@@ -332,8 +332,7 @@ impl TriangleMesh {
                 continue;
             }
             let [a, b, c] = face.map(|i| self.vertices[i]);
-            let (flo, fhi) = self.face_box(f);
-            if (0..3).any(|k| fhi[k] < reach.lo[k] || flo[k] > reach.hi[k]) {
+            if apart(self.face_box(f), (reach.lo, reach.hi)) {
                 continue;
             }
             let longest = [sub(b, a), sub(c, b), sub(a, c)]
@@ -472,9 +471,7 @@ impl TriangleMesh {
         let tol = 1e-9 * dot(sub(hi, lo), sub(hi, lo)).sqrt();
         for (a, ma) in meshes.iter().enumerate() {
             for (b, mb) in meshes.iter().enumerate().filter(|&(b, _)| b != a) {
-                let (alo, ahi) = ma.bounds();
-                let (blo, bhi) = mb.bounds();
-                if (0..3).any(|k| ahi[k] < blo[k] || bhi[k] < alo[k]) {
+                if apart(ma.bounds(), mb.bounds()) {
                     continue;
                 }
                 // Corners and face centres: shells that share a plane (two boxes side by
@@ -486,15 +483,21 @@ impl TriangleMesh {
                         1.0 / 3.0,
                     )
                 });
-                let inside = corners.chain(centres).find(|&v| mb.distance(v).0 < -tol);
-                let crossing = ma
+                // Or an edge of one through a face of the other (two boxes crossed like a
+                // plus sign hold no corner or face centre of each other).
+                let mut edges = ma
                     .faces
                     .iter()
-                    .flat_map(|f| (0..3).map(move |k| (f[k], f[(k + 1) % 3])))
-                    .find(|&(i, j)| mb.segment_crosses(ma.vertices[i], ma.vertices[j], tol));
-                if inside.is_some() || crossing.is_some() {
-                    let at =
-                        inside.unwrap_or_else(|| crossing.map(|(i, _)| ma.vertices[i]).unwrap_or_default());
+                    .flat_map(|f| (0..3).map(move |k| (f[k], f[(k + 1) % 3])));
+                let met = corners
+                    .chain(centres)
+                    .find(|&v| mb.distance(v).0 < -tol)
+                    .or_else(|| {
+                        edges
+                            .find(|&(i, j)| mb.segment_crosses(ma.vertices[i], ma.vertices[j], tol))
+                            .map(|(i, _)| ma.vertices[i])
+                    });
+                if let Some(at) = met {
                     return Err(format!(
                         "its closed shells {a} and {b} (of {}) cross or one holds the other (near \
                          {at:?}): give the body one closed surface, their union, or each shell as a \
@@ -511,14 +514,16 @@ impl TriangleMesh {
     /// its ends and the face's edges, Möller & Trumbore 1997).
     fn segment_crosses(&self, p: V3, q: V3, tol: f64) -> bool {
         let d = sub(q, p);
-        let (slo, shi): (V3, V3) = (
+        let span: (V3, V3) = (
             std::array::from_fn(|k| p[k].min(q[k]) - tol),
             std::array::from_fn(|k| p[k].max(q[k]) + tol),
         );
+        // The tolerance as a share of the segment's length.
+        let margin = tol / dot(d, d).sqrt().max(f64::MIN_POSITIVE);
         let mut stack = vec![0usize];
         while let Some(k) = stack.pop() {
             let node = &self.tree[k];
-            if (0..3).any(|a| node.hi[a] < slo[a] || shi[a] < node.lo[a]) {
+            if apart((node.lo, node.hi), span) {
                 continue;
             }
             if node.children[0] != usize::MAX {
@@ -538,8 +543,6 @@ impl TriangleMesh {
                 let qv = cross(s, e1);
                 let v = dot(d, qv) / det;
                 let t = dot(e2, qv) / det;
-                let len = dot(d, d).sqrt();
-                let margin = tol / len.max(f64::MIN_POSITIVE);
                 let edge = tol / (dot(e1, e1).sqrt().max(dot(e2, e2).sqrt()));
                 if u > edge && v > edge && u + v < 1.0 - edge && t > margin && t < 1.0 - margin {
                     return true;
@@ -548,6 +551,11 @@ impl TriangleMesh {
         }
         false
     }
+}
+
+/// True when the boxes `a` and `b` (lower and upper corners) have no point in common.
+fn apart(a: (V3, V3), b: (V3, V3)) -> bool {
+    (0..3).any(|k| a.1[k] < b.0[k] || b.1[k] < a.0[k])
 }
 
 /// Squared distance from `x` to the box `lo..hi` (0 inside).

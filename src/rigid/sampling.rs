@@ -268,6 +268,7 @@ fn cylinder(base: &[f64], axis: usize, length: f64, radius: f64, spacing: f64, r
     let b = point(base);
     let (u, w) = ((axis + 1) % 3, (axis + 2) % 3);
     let (across_lo, across_hi) = ([reach.lo[u], reach.lo[w]], [reach.hi[u], reach.hi[w]]);
+    let axis_at = [b[u], b[w]];
     let mut out = Vec::new();
     let (around, along) = (pieces(2.0 * PI * radius, spacing), pieces(length, spacing));
     let pad = 1.0 / along as f64;
@@ -276,7 +277,7 @@ fn cylinder(base: &[f64], axis: usize, length: f64, radius: f64, spacing: f64, r
         (reach.lo[axis] - b[axis]) / length - pad,
         (reach.hi[axis] - b[axis]) / length + pad,
     );
-    for i in arc([b[u], b[w]], radius, around, across_lo, across_hi) {
+    for i in arc(axis_at, radius, around, across_lo, across_hi) {
         let f = 2.0 * PI * (i as f64 + 0.5) / around as f64;
         for j in rows.clone() {
             let mut x = b;
@@ -295,22 +296,13 @@ fn cylinder(base: &[f64], axis: usize, length: f64, radius: f64, spacing: f64, r
     }
     // The end caps: rings of equal radial steps, those whose circle meets the reach.
     let rings = pieces(radius, spacing);
-    let nearest: f64 = (0..2)
-        .map(|k| {
-            (across_lo[k] - [b[u], b[w]][k])
-                .max([b[u], b[w]][k] - across_hi[k])
-                .max(0.0)
-                .powi(2)
-        })
-        .sum::<f64>()
-        .sqrt();
-    let farthest: f64 = (0..2)
-        .map(|k| {
-            let c = [b[u], b[w]][k];
-            (c - across_lo[k]).abs().max((across_hi[k] - c).abs()).powi(2)
-        })
-        .sum::<f64>()
-        .sqrt();
+    // The distances from the axis to the nearest and farthest points of the reach across.
+    let (nearest, farthest) = (0..2).fold((0.0f64, 0.0f64), |(near, far), k| {
+        let (below, above) = (axis_at[k] - across_lo[k], across_hi[k] - axis_at[k]);
+        let gap = (-below).max(-above).max(0.0);
+        (near + gap * gap, far + below.abs().max(above.abs()).powi(2))
+    });
+    let (nearest, farthest) = (nearest.sqrt(), farthest.sqrt());
     let pad = 1.0 / rings as f64;
     let ring_range = middles(rings, nearest / radius - pad, farthest / radius + pad);
     for (side, at) in [(-1.0, b[axis]), (1.0, b[axis] + length)] {
@@ -324,7 +316,7 @@ fn cylinder(base: &[f64], axis: usize, length: f64, radius: f64, spacing: f64, r
             );
             let r = 0.5 * (r0 + r1);
             let k = pieces(2.0 * PI * r, spacing);
-            for j in arc([b[u], b[w]], r, k, across_lo, across_hi) {
+            for j in arc(axis_at, r, k, across_lo, across_hi) {
                 let f = 2.0 * PI * (j as f64 + 0.5) / k as f64;
                 let mut x = b;
                 x[axis] = at;

@@ -274,6 +274,7 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         time_step: dt,
         unused_materials,
         estimate,
+        body_samples,
         water,
     } = checked;
     let s: &Scene = &loaded.scene;
@@ -375,25 +376,8 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         systems: schedule.names(),
         unused_materials,
         estimate,
-        bodies: describe_bodies::<D>(s, &grid),
-        water: settings.water.as_ref().map(|w| {
-            let moved: Vec<&str> = s
-                .stages
-                .iter()
-                .filter(|st| st.water.is_some())
-                .map(|st| st.name.as_str())
-                .collect();
-            format!(
-                "γ_w {} N/m³, gravity along axis {}{}",
-                w.unit_weight,
-                w.axis,
-                if moved.is_empty() {
-                    String::new()
-                } else {
-                    format!("; moved by stages {moved:?}")
-                }
-            )
-        }),
+        bodies: describe_bodies(s, &body_samples),
+        water: settings.water.as_ref().map(|w| describe_water(s, w)),
     };
     let state = SolverState {
         control: Control {
@@ -433,14 +417,13 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
     ))
 }
 
-/// Each rigid body as `kdmpm check` prints it: name, parts, samples within reach, control
-/// and travel.
-fn describe_bodies<D: Dim>(s: &Scene, grid: &Grid<D>) -> Vec<String> {
-    let span = (D::vec_to3(grid.origin), D::vec_to3(grid.max_corner()));
+/// Each rigid body as `kdmpm check` prints it: name, parts, its contact samples (`samples`,
+/// counted by the check), control and travel.
+fn describe_bodies(s: &Scene, samples: &[u64]) -> Vec<String> {
     s.rigid_bodies
         .iter()
-        .map(|b| {
-            let samples = b.samples(D::N, grid.cell_size, span).len();
+        .zip(samples)
+        .map(|(b, samples)| {
             let control = match (&b.motion, &b.load) {
                 (Some(m), _) => format!(
                     "moves {} m at {:?} m/s in {} increment(s)",
@@ -459,6 +442,24 @@ fn describe_bodies<D: Dim>(s: &Scene, grid: &Grid<D>) -> Vec<String> {
             )
         })
         .collect()
+}
+
+/// The water as `kdmpm check` prints it: γ_w, gravity's axis and the stages that move it.
+fn describe_water(s: &Scene, w: &crate::water::Water) -> String {
+    let moved: Vec<&str> = s
+        .stages
+        .iter()
+        .filter(|st| st.water.is_some())
+        .map(|st| st.name.as_str())
+        .collect();
+    let stages = match moved.is_empty() {
+        true => String::new(),
+        false => format!("; moved by stages {moved:?}"),
+    };
+    format!(
+        "γ_w {} N/m³, gravity along axis {}{stages}",
+        w.unit_weight, w.axis
+    )
 }
 
 /// The checked grid, with each axis's point half-width (uniform GIMP).

@@ -26,10 +26,9 @@ pub(super) fn check_loads(r: &Rules, table: &[(String, MaterialModel)]) -> Resul
 }
 
 /// A gravity, the scene's or a stage's (`field` its path): one finite entry per axis, a
-/// ramp of at least 0 s; along the axis in an axisymmetric scene (a radial gravity would
-/// pull every ring outwards alike); and, under a water table, down the axis the heights
-/// are measured up (the scene's gravity's) or zero: the water's unit weight follows the
-/// gravity in force (γ_w ∝ |g|, a centrifuge stage included), its surfaces do not turn.
+/// ramp of at least 0 s, and along the axis in an axisymmetric scene (a radial gravity
+/// would pull every ring outwards alike). Under water the water checks it too
+/// ([`crate::water::Water::gravity_fault`]).
 pub(super) fn check_gravity(r: &Rules, field: &str, g: &crate::scene::GravitySpec) -> Result<(), SceneError> {
     let s = &r.loaded.scene;
     let at = format!("{field}.acceleration");
@@ -46,32 +45,6 @@ pub(super) fn check_gravity(r: &Rules, field: &str, g: &crate::scene::GravitySpe
             &at,
             "in an axisymmetric scene gravity acts along the axis (y): its x entry must be 0".into(),
         );
-    }
-    let water_axis = s.water.as_ref().and(s.gravity.as_ref()).and_then(|scene| {
-        let along: Vec<usize> = (0..scene.acceleration.len())
-            .filter(|&a| scene.acceleration[a] != 0.0)
-            .collect();
-        (along.len() == 1).then(|| along[0])
-    });
-    if let Some(axis) = water_axis {
-        let turned = (0..g.acceleration.len()).any(|a| {
-            if a == axis {
-                g.acceleration[a] > 0.0
-            } else {
-                g.acceleration[a] != 0.0
-            }
-        });
-        if turned {
-            return r.bad(
-                &at,
-                format!(
-                    "{:?} under the scene's water: gravity points down axis {axis}, as the \
-                     scene's does, or is 0 (the piezometric surfaces are heights up that axis, \
-                     and γ_w follows |g|)",
-                    g.acceleration
-                ),
-            );
-        }
     }
     Ok(())
 }

@@ -160,10 +160,11 @@ pub fn memory_limit() -> Option<(u64, &'static str)> {
 
 /// Counts points and nodes in checked arithmetic: a count that overflows is an error, not
 /// a different problem.
+/// The bound, and each rigid body's contact samples (in scene order).
 pub(super) fn estimate(
     loaded: &LoadedScene,
     table: &[(String, MaterialModel)],
-) -> Result<Estimate, SceneError> {
+) -> Result<(Estimate, Vec<u64>), SceneError> {
     let s = &loaded.scene;
     let n = s.dimension.axes();
     let too_many =
@@ -212,27 +213,35 @@ pub(super) fn estimate(
             }
         }),
     );
-    let samples: u64 = s
+    let per_body: Vec<u64> = s
         .rigid_bodies
         .iter()
         .map(|b| b.samples(n, s.grid.cell_size, (lo, hi)).len() as u64)
-        .sum();
+        .collect();
+    let samples: u64 = per_body.iter().sum();
     let bytes = samples
         .checked_mul(SAMPLE_BYTES)
         .and_then(|b| bytes.checked_add(b))
         .ok_or_else(|| too_many("rigid_bodies", "the contact samples' memory"))?;
-    Ok(Estimate {
-        points,
-        nodes,
-        samples,
-        bytes,
-    })
+    Ok((
+        Estimate {
+            points,
+            nodes,
+            samples,
+            bytes,
+        },
+        per_body,
+    ))
 }
 
-/// The memory bound against what the process may have.
-pub(super) fn check_memory(r: &Rules, table: &[(String, MaterialModel)]) -> Result<Estimate, SceneError> {
+/// The memory bound against what the process may have, and each rigid body's contact
+/// samples.
+pub(super) fn check_memory(
+    r: &Rules,
+    table: &[(String, MaterialModel)],
+) -> Result<(Estimate, Vec<u64>), SceneError> {
     let loaded = r.loaded;
-    let estimate = estimate(loaded, table)?;
+    let (estimate, samples) = estimate(loaded, table)?;
     if let Some((total, what)) = memory_limit() {
         if estimate.bytes > total {
             return r.bad(
@@ -248,5 +257,5 @@ pub(super) fn check_memory(r: &Rules, table: &[(String, MaterialModel)]) -> Resu
             );
         }
     }
-    Ok(estimate)
+    Ok((estimate, samples))
 }

@@ -63,7 +63,7 @@ pub struct Derived {
     pub estimate: Estimate,
     /// Each rigid body as `kdmpm check` describes it: its name, parts, control and travel.
     pub bodies: Vec<String>,
-    /// The water as `kdmpm check` describes it: γ_w, the saturated points, the stages that
+    /// The water as `kdmpm check` describes it: γ_w, gravity's axis and the stages that
     /// move it.
     pub water: Option<String>,
 }
@@ -92,9 +92,6 @@ impl std::fmt::Display for Derived {
             self.estimate.points,
             self.estimate.nodes
         )?;
-        if self.estimate.samples > 0 {
-            writeln!(f, "  contact samples       {}", self.estimate.samples)?;
-        }
         for b in &self.bodies {
             writeln!(f, "  rigid body            {b}")?;
         }
@@ -132,6 +129,8 @@ pub struct Checked {
     pub unused_materials: Vec<String>,
     /// What the run will hold in memory, at most.
     pub estimate: Estimate,
+    /// Each rigid body's contact samples, in scene order.
+    pub body_samples: Vec<u64>,
     /// The water, if any.
     pub water: Option<crate::water::Water>,
 }
@@ -269,7 +268,7 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
     let step = time_step(&r, &table)?;
     check_increments_span_a_step(&r, step.dt)?;
     let stages = check_stages(&r, &table, step.p_wave_speed)?;
-    let estimate = check_memory(&r, &table)?;
+    let (estimate, body_samples) = check_memory(&r, &table)?;
     let (water, stage_waters) = check_water(&r, &grid, &table, &stages)?;
     let mut stages = stages;
     for (st, w) in stages.iter_mut().zip(stage_waters) {
@@ -284,6 +283,7 @@ pub fn check(loaded: &LoadedScene) -> Result<Checked, SceneError> {
         time_step: step.dt,
         unused_materials: step.unused_materials,
         estimate,
+        body_samples,
         water,
     })
 }

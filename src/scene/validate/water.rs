@@ -49,7 +49,18 @@ pub(super) fn check_water(
         return Ok((None, vec![None; s.stages.len()]));
     };
     let water = spec.checked(&frame).map_err(|e| at("water", e))?;
-    // A stage's dry density stays at most the saturated density, which stages keep.
+    // A stage's gravity keeps to the water's axis; its dry density stays at most the
+    // saturated density, which stages keep.
+    for (k, g) in s
+        .stages
+        .iter()
+        .enumerate()
+        .filter_map(|(k, st)| Some((k, st.gravity.as_ref()?)))
+    {
+        if let Some(rule) = water.gravity_fault(&g.acceleration) {
+            return r.bad(&format!("stages[{k}].gravity.acceleration"), rule);
+        }
+    }
     for (k, st) in checked_stages.iter().enumerate() {
         for (id, m) in &st.materials {
             let name = &table[*id as usize].0;
