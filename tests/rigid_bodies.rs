@@ -624,15 +624,7 @@ fn box_stl(lo: [f64; 3], hi: [f64; 3], drop_one: bool) -> String {
     if drop_one {
         triangles.pop();
     }
-    let mut text = String::from("solid box\n");
-    for t in &triangles {
-        text += "facet normal 0 0 0\nouter loop\n";
-        for c in t {
-            text += &format!("vertex {} {} {}\n", c[0], c[1], c[2]);
-        }
-        text += "endloop\nendfacet\n";
-    }
-    text + "endsolid box\n"
+    common::stl("solid box", &triangles, |x| x.to_string())
 }
 
 /// The scene `text` written into `dir` beside `footing.stl`, and run.

@@ -26,32 +26,6 @@ fn assert_refused(text: &str, expect: &[&str]) {
 
 const FOOTING: &str = "[[-1.0, 4.0], [1.0, 4.0], [1.0, 4.5], [-1.0, 4.5]]";
 
-/// The first stage's changes apply before step 1: a column whose only stage doubles the
-/// density weighs twice as much from the start and settles twice as far as
-/// scenes/soil_column.ron (ρgH²/(2M)). Once the first stage's density was ignored.
-#[test]
-fn a_first_stage_that_doubles_the_density_weighs_the_column_from_the_first_step() {
-    let soil = "MohrCoulomb(density: 3600.0, youngs_modulus: 10.0e6, poisson_ratio: 0.3, cohesion: 0.0, \
-                friction_angle: 30.0, dilatancy_angle: 0.0)";
-    let text = edited(
-        "soil_column.ron",
-        &[(
-            "    solver: (",
-            &format!("    stages: [(name: \"heavy\", materials: {{\"soil\": {soil}}})],\n    solver: ("),
-        )],
-    );
-    let s = common::run_text("heavy.ron", &text);
-    assert!(s.converged, "{:?}", s.error);
-    assert_eq!(s.total_mass, 72_000.0);
-    let m = 10.0e6 * 0.7 / (1.3 * 0.4);
-    let analytic = 3600.0 * 9.81 * 100.0 / (2.0 * m);
-    let top = -s.traced[1].displacement[1];
-    assert!(
-        (top / analytic - 1.0).abs() < 0.01,
-        "top {top} m, analytic {analytic} m"
-    );
-}
-
 /// A body's polygon follows the rule a soil region's does: no two edges cross.
 #[test]
 fn a_self_crossing_body_polygon_is_refused() {
@@ -166,15 +140,7 @@ fn a_base_far_larger_than_the_grid_is_sampled_where_the_grid_reaches() {
 /// The STL of a box `lo`..`hi` (ASCII), its first line `header`, each coordinate written by
 /// `write`.
 fn box_stl(lo: [f64; 3], hi: [f64; 3], header: &str, write: impl Fn(f64) -> String) -> String {
-    let mut text = format!("{header}\n");
-    for t in kdmpm::rigid::mesh::box_triangles(lo, hi) {
-        text += "  facet normal 0 0 0\n    outer loop\n";
-        for c in t {
-            text += &format!("      vertex {} {} {}\n", write(c[0]), write(c[1]), write(c[2]));
-        }
-        text += "    endloop\n  endfacet\n";
-    }
-    text + "endsolid\n"
+    common::stl(header, &kdmpm::rigid::mesh::box_triangles(lo, hi), write)
 }
 
 /// A footing in 3D on a block of clay, its part `Mesh(file: "FILE")`.
@@ -190,17 +156,21 @@ const MESH_FOOTING: &str = r#"Scene(
     solver: (damping: Kinetic, time_step: Courant(0.5), tolerance: 0.01, max_time: 20.0),
 )"#;
 
-/// A footing in 3D (tests/rigid_bodies.rs's square footing) whose part is `Mesh(file)`,
-/// its STL text `stl`, checked: the error, if any.
-fn mesh_check(name: &str, stl: &str) -> Result<(), String> {
-    let dir = common::scratch("robustness_bodies", name);
-    std::fs::write(dir.join("body.stl"), stl).unwrap();
-    let text = MESH_FOOTING.replace("FILE", "body.stl");
+/// The footing of [`MESH_FOOTING`] on the mesh `file`, its scene written into `dir` and
+/// checked: the error, if any.
+fn footing_on(dir: &Path, file: &str) -> Result<(), String> {
     let path = dir.join("scene.ron");
-    std::fs::write(&path, text).unwrap();
+    std::fs::write(&path, MESH_FOOTING.replace("FILE", file)).unwrap();
     kdmpm::scene::LoadedScene::from_file(&path, &[])
         .and_then(|l| kdmpm::scene::build(&l).map(|_| ()))
         .map_err(|e| e.to_string())
+}
+
+/// The footing on `body.stl` of STL text `stl` (scratch case `name`), checked.
+fn mesh_check(name: &str, stl: &str) -> Result<(), String> {
+    let dir = common::scratch("robustness_bodies", name);
+    std::fs::write(dir.join("body.stl"), stl).unwrap();
+    footing_on(&dir, "body.stl")
 }
 
 /// Meshes as CAD tools export them load: an ASCII file whose first line is a bare
@@ -226,15 +196,7 @@ fn stl_meshes_as_cad_tools_write_them_load() {
     let (a, b, c, d) = (top[0][0], top[0][1], top[0][2], top[1][2]);
     let m = [0.5 * (a[0] + c[0]) - 0.5e-7, 0.5 * (a[1] + c[1]) + 0.5e-7, a[2]];
     t.extend([[a, b, c], [a, m, d], [m, c, d], [a, c, m]]);
-    let mut stl = String::from("solid sliver\n");
-    for tri in &t {
-        stl += "facet normal 0 0 0\nouter loop\n";
-        for v in tri {
-            stl += &format!("vertex {:?} {:?} {:?}\n", v[0], v[1], v[2]);
-        }
-        stl += "endloop\nendfacet\n";
-    }
-    stl += "endsolid sliver\n";
+    let stl = common::stl("solid sliver", &t, |x| format!("{x:?}"));
     mesh_check("sliver", &stl).unwrap();
 }
 
@@ -254,13 +216,7 @@ fn overlapping_shells_a_device_or_a_file_that_is_no_stl_are_refused() {
     assert!(e.contains("not an STL file"), "{e}");
     if Path::new("/dev/zero").exists() {
         let dir = common::scratch("robustness_bodies", "device");
-        let text = MESH_FOOTING.replace("FILE", "/dev/zero");
-        let path = dir.join("scene.ron");
-        std::fs::write(&path, text).unwrap();
-        let e = kdmpm::scene::LoadedScene::from_file(&path, &[])
-            .err()
-            .unwrap()
-            .to_string();
+        let e = footing_on(&dir, "/dev/zero").unwrap_err();
         assert!(e.contains("not a regular file"), "{e}");
     }
 }
@@ -289,14 +245,15 @@ fn water_and_axisymmetric_inputs_the_engine_cannot_mean_are_refused() {
         &staged(&format!("materials: {{\"soil\": {soil}}}")),
         &["stages[1].materials.soil.density", "saturated density"],
     );
-    let text = std::fs::read_to_string(common::scene("slope_water.ron")).unwrap();
     let line = "table: Polyline([[0.0, 0.0], [15.0, 0.0], [35.0, 6.0], [55.0, 9.0]])";
-    let high = text.replacen(line, "table: Level(1e306)", 1);
+    let high = edited("slope_water.ron", &[(line, "table: Level(1e306)")]);
     assert_refused(&high, &["water.table", "1e15"]);
-    let twice = text.replacen(
-        "saturated_density: {\"soil\": 2038.74}",
-        "saturated_density: {\"soil\": 2038.74, \"soil\": 3000.0}",
-        1,
+    let twice = edited(
+        "slope_water.ron",
+        &[(
+            "saturated_density: {\"soil\": 2038.74}",
+            "saturated_density: {\"soil\": 2038.74, \"soil\": 3000.0}",
+        )],
     );
     let e = kdmpm::scene::LoadedScene::from_text(Path::new("twice.ron"), &twice, &[])
         .err()
@@ -343,17 +300,20 @@ fn the_waters_unit_weight_follows_a_stages_gravity() {
 /// refused.
 #[test]
 fn a_radial_drive_or_a_traction_on_the_axis_is_refused() {
-    let text = std::fs::read_to_string(common::scene("footing_circular.ron")).unwrap();
-    let radial = text.replacen(
-        "velocity: [None, Some(-0.01)]",
-        "velocity: [Some(0.01), Some(-0.01)]",
-        1,
+    let radial = edited(
+        "footing_circular.ron",
+        &[(
+            "velocity: [None, Some(-0.01)]",
+            "velocity: [Some(0.01), Some(-0.01)]",
+        )],
     );
     assert_refused(&radial, &["motions[0].velocity", "on the axis"]);
-    let traction = text.replacen(
-        "    solver: (",
-        "    tractions: [(name: \"axis\", surface: XMin, min: [0.0, 0.0], max: [0.1, 4.0], traction: [1.0e3, 0.0])],\n    solver: (",
-        1,
+    let traction = edited(
+        "footing_circular.ron",
+        &[(
+            "    solver: (",
+            "    tractions: [(name: \"axis\", surface: XMin, min: [0.0, 0.0], max: [0.1, 4.0], traction: [1.0e3, 0.0])],\n    solver: (",
+        )],
     );
     assert_refused(&traction, &["tractions[0].surface", "on the axis"]);
 }

@@ -80,16 +80,16 @@ fn staged_column(stages: &str) -> String {
     text.replace("    solver: (", &format!("    stages: {stages},\n    solver: ("))
 }
 
-/// The top settles by ρgH²/(2M) (scenes/soil_column.ron): 0.06559 m at 1800 kg/m³, twice
-/// that once a stage doubles the density; the mass doubles with it. Once the stage's
-/// density was ignored and the run converged at the first stage's settlement.
-#[test]
-fn a_stage_that_doubles_the_density_doubles_the_mass_and_the_settlement() {
+/// Runs soil_column.ron whose stage `heavy` (after the stages `before`) doubles the density
+/// to 3600 kg/m³: the mass doubles, and the top settles by ρgH²/(2M) (0.06559 m at
+/// 1800 kg/m³, twice that at 3600) to the column's own discretisation error at
+/// 1800 kg/m³ (tests/robustness.rs): under 1 %.
+fn doubled_density_column(before: &str) {
     let heavy = COLUMN_SOIL.replace("DENSITY", "3600.0");
     let s = common::run_text(
         "heavy.ron",
         &staged_column(&format!(
-            r#"[(name: "a"), (name: "heavy", materials: {{"soil": {heavy}}})]"#
+            r#"[{before}(name: "heavy", materials: {{"soil": {heavy}}})]"#
         )),
     );
     assert!(s.converged, "{:?}", s.error);
@@ -97,11 +97,25 @@ fn a_stage_that_doubles_the_density_doubles_the_mass_and_the_settlement() {
     let m = 10.0e6 * 0.7 / (1.3 * 0.4);
     let analytic = 3600.0 * 9.81 * 100.0 / (2.0 * m);
     let top = -s.traced[1].displacement[1];
-    // The column's own discretisation error at 1800 kg/m³ (tests/robustness.rs): under 1 %.
     assert!(
         (top / analytic - 1.0).abs() < 0.01,
         "top {top} m, analytic {analytic} m"
     );
+}
+
+/// A second stage that doubles the density doubles the mass and the settlement. Once the
+/// stage's density was ignored and the run converged at the first stage's settlement.
+#[test]
+fn a_stage_that_doubles_the_density_doubles_the_mass_and_the_settlement() {
+    doubled_density_column(r#"(name: "a"), "#);
+}
+
+/// The first stage's changes apply before step 1: a column whose only stage doubles the
+/// density weighs twice as much from the start. Once the first stage's density was
+/// ignored (36 000 kg, 0.066 m).
+#[test]
+fn a_first_stage_that_doubles_the_density_weighs_the_column_from_the_first_step() {
+    doubled_density_column("");
 }
 
 /// A stage that takes every load away (gravity 0) relaxes the column back towards its

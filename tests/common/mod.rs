@@ -131,6 +131,20 @@ pub fn scratch(group: &str, name: &str) -> std::path::PathBuf {
     d
 }
 
+/// The ASCII STL text of `triangles` (m): its first line `header` (`solid`, `solid name`),
+/// each coordinate written by `write`.
+pub fn stl(header: &str, triangles: &[[[f64; 3]; 3]], write: impl Fn(f64) -> String) -> String {
+    let mut text = format!("{header}\n");
+    for t in triangles {
+        text += "facet normal 0 0 0\nouter loop\n";
+        for c in t {
+            text += &format!("vertex {} {} {}\n", write(c[0]), write(c[1]), write(c[2]));
+        }
+        text += "endloop\nendfacet\n";
+    }
+    text + "endsolid\n"
+}
+
 /// Relative difference a/b − 1.
 pub fn rel(a: f64, b: f64) -> f64 {
     a / b - 1.0
