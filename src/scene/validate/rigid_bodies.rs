@@ -21,7 +21,6 @@ pub(super) fn check_rigid_bodies(r: &Rules) -> Result<(), SceneError> {
         .map(|a| g.origin[a] + g.cells[a] as f64 * g.cell_size)
         .collect();
     // Each body's box at the start and the box it sweeps.
-    type Boxed = ([f64; 3], [f64; 3]);
     let mut boxes: Vec<(Boxed, Boxed)> = Vec::new();
     for (i, b) in s.rigid_bodies.iter().enumerate() {
         let field = |f: &str| format!("rigid_bodies[{i}].{f}");
@@ -88,46 +87,67 @@ pub(super) fn check_rigid_bodies(r: &Rules) -> Result<(), SceneError> {
                 }
             }
         }
-        // The box the body sweeps: to the end of its travel, or under a load to the grid's
-        // edge along each axis the load acts on (it finds its own travel).
-        let (mut swept_lo, mut swept_hi) = (start_lo, start_hi);
-        for a in 0..n {
-            if let Some(l) = &b.load {
-                let f = l.vector()[a];
-                if f < 0.0 {
-                    swept_lo[a] = swept_lo[a].min(lo[a]);
-                } else if f > 0.0 {
-                    swept_hi[a] = swept_hi[a].max(hi[a]);
-                }
-            }
-            let moved = v[a] * step;
-            swept_lo[a] = swept_lo[a].min(start_lo[a] + moved);
-            swept_hi[a] = swept_hi[a].max(start_hi[a] + moved);
-        }
-        let meet = |(alo, ahi): &([f64; 3], [f64; 3]), (blo, bhi): &([f64; 3], [f64; 3])| {
-            !(0..n).any(|a: usize| ahi[a] <= blo[a] || bhi[a] <= alo[a])
-        };
-        for (j, (start, swept)) in boxes.iter().enumerate() {
-            if meet(&(start_lo, start_hi), start) {
-                return r.bad(
-                    &field("geometry"),
-                    format!(
-                        "the body overlaps rigid_bodies[{j}] (their bounding boxes meet): give them room"
-                    ),
-                );
-            }
-            if meet(&(swept_lo, swept_hi), swept) {
-                return r.bad(
-                    &field("motion"),
-                    format!(
-                        "the body's path crosses rigid_bodies[{j}]'s (the boxes they sweep over \
-                         their travels meet, a load's to the grid's edge): rigid bodies do not \
-                         meet each other, only the soil; give them paths apart"
-                    ),
-                );
+        let start = (start_lo, start_hi);
+        let path = swept(b, n, start, &lo, &hi);
+        apart_from_earlier(r, i, (start, path), &boxes)?;
+        boxes.push((start, path));
+    }
+    Ok(())
+}
+
+/// A box by its lower and upper corners (m).
+type Boxed = ([f64; 3], [f64; 3]);
+
+/// The box body `b` sweeps from its box `start` over its travel, to the end of its motion
+/// or, under a load, to the grid's edge (`lo`..`hi`) along each axis the load acts on (it
+/// finds its own travel).
+fn swept(b: &crate::rigid::RigidBodySpec, n: usize, start: Boxed, lo: &[f64], hi: &[f64]) -> Boxed {
+    let (mut swept_lo, mut swept_hi) = start;
+    for a in 0..n {
+        if let Some(l) = &b.load {
+            let f = l.vector()[a];
+            if f < 0.0 {
+                swept_lo[a] = swept_lo[a].min(lo[a]);
+            } else if f > 0.0 {
+                swept_hi[a] = swept_hi[a].max(hi[a]);
             }
         }
-        boxes.push(((start_lo, start_hi), (swept_lo, swept_hi)));
+        if let Some(m) = &b.motion {
+            let moved = m.vector()[a] * (m.travel / m.speed());
+            swept_lo[a] = swept_lo[a].min(start.0[a] + moved);
+            swept_hi[a] = swept_hi[a].max(start.1[a] + moved);
+        }
+    }
+    (swept_lo, swept_hi)
+}
+
+/// Body `i`'s box at the start and the box it sweeps (`start`, `path`) meet none of the
+/// earlier bodies' (`boxes`): bodies meet the soil, not each other.
+fn apart_from_earlier(
+    r: &Rules,
+    i: usize,
+    (start, path): (Boxed, Boxed),
+    boxes: &[(Boxed, Boxed)],
+) -> Result<(), SceneError> {
+    let n = r.n;
+    let meet = |(alo, ahi): Boxed, (blo, bhi): Boxed| !(0..n).any(|a| ahi[a] <= blo[a] || bhi[a] <= alo[a]);
+    for (j, &(other_start, other_path)) in boxes.iter().enumerate() {
+        if meet(start, other_start) {
+            return r.bad(
+                &format!("rigid_bodies[{i}].geometry"),
+                format!("the body overlaps rigid_bodies[{j}] (their bounding boxes meet): give them room"),
+            );
+        }
+        if meet(path, other_path) {
+            return r.bad(
+                &format!("rigid_bodies[{i}].motion"),
+                format!(
+                    "the body's path crosses rigid_bodies[{j}]'s (the boxes they sweep over \
+                     their travels meet, a load's to the grid's edge): rigid bodies do not \
+                     meet each other, only the soil; give them paths apart"
+                ),
+            );
+        }
     }
     Ok(())
 }
