@@ -29,62 +29,7 @@ pub(super) fn place<D: Dim>(
     let mut followers: Vec<(u32, SurfacePoint)> = Vec::new();
     for (i, t) in s.tractions.iter().enumerate() {
         let (normal, upper) = t.surface.axis_side();
-        // Column key: the point's sub-cell coordinates across the normal.
-        // Key → (how far out, the point, its share); key order keeps set-up deterministic.
-        // (Its sub-cell's edges too, m.)
-        let mut outermost: BTreeMap<Vec<i64>, (f64, Entity, f64, [f64; 3])> = BTreeMap::new();
-        for (e, x, id) in world.query::<(Entity, &Position<D::Vec>, &PointId)>().iter() {
-            if world.get::<&Stress<D::Stress>>(e).is_err() {
-                continue; // a load carrier
-            }
-            let x = D::vec_to3(x.0);
-            if !(0..n).all(|a| x[a] >= t.min[a] && x[a] <= t.max[a]) {
-                continue;
-            }
-            let body = body_ids
-                .iter()
-                .position(|r| r.contains(&id.0))
-                .expect("every point has a body");
-            let ppc = &s.bodies[body].points_per_cell;
-            let sub = |a: usize| s.grid.cell_size / ppc[a] as f64;
-            let key: Vec<i64> = (0..n)
-                .filter(|&a| a != normal)
-                .map(|a| (x[a] / sub(a)).floor() as i64)
-                .collect();
-            // The column's share of the surface; per radian in axisymmetry, times the
-            // surface's radius: the point's own on a face across the axis, the edge of its
-            // sub-cell on a face normal to r.
-            let radius = match (D::AXISYMMETRIC, normal) {
-                (false, _) => 1.0,
-                (true, 0) if upper => x[0] + 0.5 * sub(0),
-                (true, 0) => x[0] - 0.5 * sub(0),
-                (true, _) => x[0],
-            };
-            if radius <= 1e-9 * s.grid.cell_size {
-                return Err(loaded.invalid(
-                    &format!("tractions[{i}].surface"),
-                    format!(
-                        "traction \"{}\" loads points whose face lies on the axis (r = 0), which \
-                         has no area: it would carry nothing; an XMin surface is a hollow body's \
-                         inner face, off the axis",
-                        t.name
-                    ),
-                ));
-            }
-            let share: f64 = (0..n).filter(|&a| a != normal).map(sub).product::<f64>() * radius;
-            let out = if upper { x[normal] } else { -x[normal] };
-            let subs = std::array::from_fn(|a| if a < n { sub(a) } else { 0.0 });
-            let entry = outermost.entry(key).or_insert((out, e, share, subs));
-            if entry.0 < out {
-                *entry = (out, e, share, subs);
-            }
-        }
-        if outermost.is_empty() {
-            return Err(loaded.invalid(
-                &format!("tractions[{i}].min"),
-                format!("traction \"{}\": no point of a body lies in its box", t.name),
-            ));
-        }
+        let outermost = outermost::<D>(world, loaded, body_ids, i)?;
         let pressed = t.pressure.is_some();
         let across: Vec<usize> = (0..n).filter(|&a| a != normal).collect();
         let ids: BTreeMap<&Vec<i64>, u32> = outermost
@@ -112,39 +57,14 @@ pub(super) fn place<D: Dim>(
             points.push((id, D::vec_to3(f)));
             shares.push((id, share));
             if pressed {
-                // Neighbours along the surface: the columns one sub-cell before and after
-                // along each axis across the normal.
-                let mut links = [[NONE; 2]; 2];
-                let (mut spacing, mut reach) = ([0.0; 2], [1; 2]);
-                for (j, &a) in across.iter().enumerate() {
-                    for (side, step) in [-1i64, 1].into_iter().enumerate() {
-                        let mut k = key.clone();
-                        k[j] += step;
-                        if let Some(&neighbour) = ids.get(&k) {
-                            links[j][side] = neighbour;
-                        }
-                    }
-                    spacing[j] = subs[a];
-                    reach[j] = (s.grid.cell_size / subs[a]).round().max(1.0) as u32;
-                }
-                let mut outward = [0.0; 3];
-                outward[normal] = if upper { 1.0 } else { -1.0 };
-                let radius_offset = match (D::AXISYMMETRIC, normal) {
-                    (true, 0) => outward[0] * 0.5 * subs[0],
-                    _ => 0.0,
+                let column = Column {
+                    key,
+                    across: &across,
+                    subs,
+                    share,
+                    axisymmetric: D::AXISYMMETRIC,
                 };
-                followers.push((
-                    id,
-                    SurfacePoint {
-                        across: [across[0], *across.get(1).unwrap_or(&across[0])],
-                        links,
-                        spacing,
-                        reach,
-                        normal: outward,
-                        share,
-                        radius_offset,
-                    },
-                ));
+                followers.push((id, column.surface_point(&ids, normal, upper, s.grid.cell_size)));
             }
         }
         points.sort_by_key(|p| p.0);
@@ -164,6 +84,139 @@ pub(super) fn place<D: Dim>(
         points: followers.into_iter().map(|f| f.1).collect(),
     };
     Ok(placed)
+}
+
+/// Traction `i`'s points in each column across its surface's normal: key (the point's
+/// sub-cell coordinates across the normal; key order keeps set-up deterministic) → (how
+/// far out along the normal, the point, the column's share of the surface, the sub-cell's
+/// edges in m). Refused when the box holds no point or its face lies on the axis.
+type Columns = BTreeMap<Vec<i64>, (f64, Entity, f64, [f64; 3])>;
+
+/// The outermost point of each column of traction `i` ([`Columns`]).
+fn outermost<D: Dim>(
+    world: &World,
+    loaded: &LoadedScene,
+    body_ids: &[std::ops::Range<u32>],
+    i: usize,
+) -> Result<Columns, SceneError> {
+    let s = &loaded.scene;
+    let n = D::N;
+    let t = &s.tractions[i];
+    let (normal, upper) = t.surface.axis_side();
+    let mut outermost = Columns::new();
+    for (e, x, id) in world.query::<(Entity, &Position<D::Vec>, &PointId)>().iter() {
+        if world.get::<&Stress<D::Stress>>(e).is_err() {
+            continue; // a load carrier
+        }
+        let x = D::vec_to3(x.0);
+        if !(0..n).all(|a| x[a] >= t.min[a] && x[a] <= t.max[a]) {
+            continue;
+        }
+        let body = body_ids
+            .iter()
+            .position(|r| r.contains(&id.0))
+            .expect("every point has a body");
+        let ppc = &s.bodies[body].points_per_cell;
+        let sub = |a: usize| s.grid.cell_size / ppc[a] as f64;
+        let key: Vec<i64> = (0..n)
+            .filter(|&a| a != normal)
+            .map(|a| (x[a] / sub(a)).floor() as i64)
+            .collect();
+        // The column's share of the surface; per radian in axisymmetry, times the
+        // surface's radius: the point's own on a face across the axis, the edge of its
+        // sub-cell on a face normal to r.
+        let radius = match (D::AXISYMMETRIC, normal) {
+            (false, _) => 1.0,
+            (true, 0) if upper => x[0] + 0.5 * sub(0),
+            (true, 0) => x[0] - 0.5 * sub(0),
+            (true, _) => x[0],
+        };
+        if radius <= 1e-9 * s.grid.cell_size {
+            return Err(loaded.invalid(
+                &format!("tractions[{i}].surface"),
+                format!(
+                    "traction \"{}\" loads points whose face lies on the axis (r = 0), which \
+                     has no area: it would carry nothing; an XMin surface is a hollow body's \
+                     inner face, off the axis",
+                    t.name
+                ),
+            ));
+        }
+        let share: f64 = (0..n).filter(|&a| a != normal).map(sub).product::<f64>() * radius;
+        let out = if upper { x[normal] } else { -x[normal] };
+        let subs = std::array::from_fn(|a| if a < n { sub(a) } else { 0.0 });
+        let entry = outermost.entry(key).or_insert((out, e, share, subs));
+        if entry.0 < out {
+            *entry = (out, e, share, subs);
+        }
+    }
+    if outermost.is_empty() {
+        return Err(loaded.invalid(
+            &format!("tractions[{i}].min"),
+            format!("traction \"{}\": no point of a body lies in its box", t.name),
+        ));
+    }
+    Ok(outermost)
+}
+
+/// A pressed column of a traction, as [`Column::surface_point`] reads it.
+struct Column<'a> {
+    /// The column's key ([`Columns`]).
+    key: &'a [i64],
+    /// The axes across the surface's normal.
+    across: &'a [usize],
+    /// The column's sub-cell edges (m, per axis).
+    subs: [f64; 3],
+    /// Its share of the surface (m^(D−1), times r in axisymmetry).
+    share: f64,
+    /// Whether the scene is axisymmetric (x the radius).
+    axisymmetric: bool,
+}
+
+impl Column<'_> {
+    /// The column's point as a point of a pressed surface: its neighbours along the
+    /// surface (the columns one sub-cell before and after along each axis across the
+    /// normal, of points `ids`), their spacing and reach in sub-cells of a cell of
+    /// `cell_size` (m), and the outward normal of the face (`normal` axis, `upper` side).
+    fn surface_point(
+        &self,
+        ids: &BTreeMap<&Vec<i64>, u32>,
+        normal: usize,
+        upper: bool,
+        cell_size: f64,
+    ) -> SurfacePoint {
+        let (across, subs) = (self.across, self.subs);
+        let mut links = [[NONE; 2]; 2];
+        let (mut spacing, mut reach) = ([0.0; 2], [1; 2]);
+        for (j, &a) in across.iter().enumerate() {
+            for (side, step) in [-1i64, 1].into_iter().enumerate() {
+                let mut k = self.key.to_vec();
+                k[j] += step;
+                if let Some(&neighbour) = ids.get(&k) {
+                    links[j][side] = neighbour;
+                }
+            }
+            spacing[j] = subs[a];
+            reach[j] = (cell_size / subs[a]).round().max(1.0) as u32;
+        }
+        let mut outward = [0.0; 3];
+        outward[normal] = if upper { 1.0 } else { -1.0 };
+        // In axisymmetry a face normal to r lies half a sub-cell out from the point.
+        let radius_offset = if self.axisymmetric && normal == 0 {
+            outward[0] * 0.5 * subs[0]
+        } else {
+            0.0
+        };
+        SurfacePoint {
+            across: [across[0], *across.get(1).unwrap_or(&across[0])],
+            links,
+            spacing,
+            reach,
+            normal: outward,
+            share: self.share,
+            radius_offset,
+        }
+    }
 }
 
 /// Traction `i` loads a point that traction `j` loads too, and one of them is a pressure.

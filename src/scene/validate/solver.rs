@@ -174,7 +174,21 @@ pub(super) fn time_step(r: &Rules, table: &[(String, MaterialModel)]) -> Result<
             ),
         );
     }
-    let dt = match s.solver.time_step {
+    let dt = chosen_step(r, dt_crit, c_p)?;
+    step_limits(r, dt, dt_crit)?;
+    Ok(StepChoice {
+        p_wave_speed: c_p,
+        critical: dt_crit,
+        dt,
+        unused_materials,
+    })
+}
+
+/// The time step the solver asks for (s): a fixed Δt no longer than the critical step
+/// `dt_crit` (s; `c_p` m/s the P-wave speed that set it), or a Courant fraction of it.
+fn chosen_step(r: &Rules, dt_crit: f64, c_p: f64) -> Result<f64, SceneError> {
+    let s = &r.loaded.scene;
+    Ok(match s.solver.time_step {
         TimeStep::Fixed(dt) => {
             if !positive(dt) {
                 return r.bad(
@@ -203,7 +217,14 @@ pub(super) fn time_step(r: &Rules, table: &[(String, MaterialModel)]) -> Result<
             }
             a * dt_crit
         }
-    };
+    })
+}
+
+/// The limits on a time step `dt` (s) beyond the critical one `dt_crit` (s): mass
+/// scaling's and USL's Courant numbers, viscous damping's βΔt ≤ 1, a step that advances
+/// the clock, and no more than [`MAX_IMPLIED_STEPS`] steps in `max_time`.
+fn step_limits(r: &Rules, dt: f64, dt_crit: f64) -> Result<(), SceneError> {
+    let s = &r.loaded.scene;
     if s.solver.mass_scaling && dt > MASS_SCALING_COURANT_LIMIT * dt_crit * (1.0 + 1e-12) {
         return r.bad(
             "solver.time_step",
@@ -261,10 +282,5 @@ pub(super) fn time_step(r: &Rules, table: &[(String, MaterialModel)]) -> Result<
             );
         }
     }
-    Ok(StepChoice {
-        p_wave_speed: c_p,
-        critical: dt_crit,
-        dt,
-        unused_materials,
-    })
+    Ok(())
 }
