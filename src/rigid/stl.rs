@@ -124,7 +124,7 @@ fn ascii(bytes: &[u8]) -> Result<Vec<[[f64; 3]; 3]>, String> {
 }
 
 /// Welds equal corners (−0.0 as 0.0) into shared vertices.
-fn weld(triangles: &[[[f64; 3]; 3]]) -> Welded {
+pub(super) fn weld(triangles: &[[[f64; 3]; 3]]) -> Welded {
     let mut index: HashMap<[u64; 3], usize> = HashMap::new();
     let mut vertices = Vec::new();
     let faces = triangles
