@@ -188,16 +188,8 @@ pub fn strength_reduction(
     // file of that name, no permission) or that another run holds is bad input.
     let _dir = OutputDir::claim(out).map_err(|e| FosError::OutputDir(e.to_string()))?;
     let mut trials: Vec<Trial> = Vec::new();
-    let mut trial = |f: f64| -> Result<Trial, FosError> {
-        let t = run_trial(loaded, &spec, f, out)?;
-        if t.outcome == Outcome::Interrupted {
-            return Err(FosError::Interrupted(f));
-        }
-        report(&t);
-        trials.push(t.clone());
-        Ok(t)
-    };
-    let [mut lo, mut hi] = [spec.bracket[0], spec.bracket[1]];
+    let mut trial = |f: f64| run_trial(loaded, &spec, f, out, &mut report, &mut trials);
+    let [lo, hi] = [spec.bracket[0], spec.bracket[1]];
     if trial(lo)?.failed {
         return Err(FosError::NotBracketed(format!(
             "the slope fails at F = {lo}, the bracket's low end: its factor of safety is below \
@@ -210,26 +202,14 @@ pub fn strength_reduction(
              {hi}; raise strength_reduction.bracket[1]"
         )));
     }
-    while hi - lo > spec.tolerance {
-        let mid = 0.5 * (lo + hi);
-        if mid <= lo || mid >= hi {
-            // No float between the ends: the bracket is as narrow as f64 allows.
-            break;
-        }
-        if trial(mid)?.failed {
-            hi = mid;
-        } else {
-            lo = mid;
-        }
-    }
-    let mechanism = trial_dir(hi);
+    let [lo, hi] = bisect([lo, hi], spec.tolerance, &mut trial)?;
     let fos = FosReport {
         scene: loaded.path.display().to_string(),
         factor_of_safety: 0.5 * (lo + hi),
         bracket: [lo, hi],
         tolerance: spec.tolerance,
         failure_displacement: spec.failure_displacement,
-        mechanism,
+        mechanism: trial_dir(hi),
         steps: trials.iter().map(|t| t.steps).sum(),
         water: loaded.scene.water.clone(),
         stage_water: loaded
@@ -245,6 +225,62 @@ pub fn strength_reduction(
     Ok(fos)
 }
 
+/// Goes on with the bisection of the analysis `fos` of `loaded` (in `out`) from its
+/// bracket until the bracket is no wider than `tolerance`: its trials are added to the
+/// analysis's, its factor, bracket, mechanism, steps and wall time brought up to date, and
+/// its files written again. `report` sees each new trial as it ends. (`--refine` narrows
+/// two answers that lie closer than their brackets resolve.)
+pub fn narrow(
+    loaded: &LoadedScene,
+    out: &Path,
+    fos: &mut FosReport,
+    tolerance: f64,
+    mut report: impl FnMut(&Trial),
+) -> Result<(), FosError> {
+    let spec = loaded.scene.strength_reduction.clone().ok_or_else(|| {
+        FosError::NotAnAnalysis(format!(
+            "{}: the scene has no `strength_reduction` field",
+            loaded.path.display()
+        ))
+    })?;
+    let start = Instant::now();
+    let _dir = OutputDir::claim(out).map_err(|e| FosError::OutputDir(e.to_string()))?;
+    let mut trials = Vec::new();
+    let [lo, hi] = bisect(fos.bracket, tolerance, &mut |f| {
+        run_trial(loaded, &spec, f, out, &mut report, &mut trials)
+    })?;
+    fos.steps += trials.iter().map(|t| t.steps).sum::<u64>();
+    fos.trials.extend(trials);
+    fos.factor_of_safety = 0.5 * (lo + hi);
+    fos.bracket = [lo, hi];
+    fos.tolerance = tolerance;
+    fos.mechanism = trial_dir(hi);
+    fos.wall_seconds += start.elapsed().as_secs_f64();
+    write_report(fos, out).map_err(|e| FosError::Output(out.to_path_buf(), e))
+}
+
+/// Halves `[lo, hi]` (the slope stands at lo and fails at hi) by a trial at its middle
+/// until it is no wider than `tolerance`, or no float lies between its ends (as narrow as
+/// f64 allows).
+fn bisect(
+    [mut lo, mut hi]: [f64; 2],
+    tolerance: f64,
+    trial: &mut impl FnMut(f64) -> Result<Trial, FosError>,
+) -> Result<[f64; 2], FosError> {
+    while hi - lo > tolerance {
+        let mid = 0.5 * (lo + hi);
+        if mid <= lo || mid >= hi {
+            break;
+        }
+        if trial(mid)?.failed {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    Ok([lo, hi])
+}
+
 /// The folder of the trial at `factor`, relative to the analysis's: the factor's shortest
 /// exact decimal, so that two trials never share a folder however fine the bisection.
 fn trial_dir(factor: f64) -> String {
@@ -252,17 +288,20 @@ fn trial_dir(factor: f64) -> String {
 }
 
 /// Runs the scene at `factor` into its trial folder, stopping early once a point moved
-/// farther than the spec allows.
+/// farther than the spec allows:
+/// `report` sees the trial, and it joins `trials`; a trial a signal stopped ends the analysis.
 fn run_trial(
     loaded: &LoadedScene,
     spec: &StrengthReductionSpec,
     factor: f64,
     out: &Path,
+    report: &mut impl FnMut(&Trial),
+    trials: &mut Vec<Trial>,
 ) -> Result<Trial, FosError> {
     let rel = trial_dir(factor);
     let path = out.join(&rel);
     let start = Instant::now();
-    let report = Run::scene(reduced(loaded, factor))
+    let run = Run::scene(reduced(loaded, factor))
         .into_dir(&path)
         .quiet(true)
         .without_checkpoints()
@@ -275,9 +314,9 @@ fn run_trial(
             RunError::Scene(e) => FosError::Scene(e),
             e => FosError::Trial(factor, e),
         })?;
-    let s = report.summary;
+    let s = run.summary;
     let max_u = s.max_displacement.unwrap_or(0.0);
-    Ok(Trial {
+    let t = Trial {
         factor,
         failed: s.outcome != Outcome::Converged || max_u > spec.failure_displacement,
         outcome: s.outcome,
@@ -285,7 +324,13 @@ fn run_trial(
         steps: s.steps,
         wall_seconds: start.elapsed().as_secs_f64(),
         dir: rel,
-    })
+    };
+    if t.outcome == Outcome::Interrupted {
+        return Err(FosError::Interrupted(factor));
+    }
+    report(&t);
+    trials.push(t.clone());
+    Ok(t)
 }
 
 /// `fos.csv`, `fos.svg` and `summary.json` of the analysis.

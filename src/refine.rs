@@ -135,7 +135,7 @@ pub fn estimate(quantity: &str, unit: &str, levels: Vec<Level>) -> Refinement {
         f.iter().copied().fold(f64::NEG_INFINITY, f64::max) - f.iter().copied().fold(f64::INFINITY, f64::min);
     // What narrows an answer's resolution, for the note.
     let narrower = match quantity {
-        "factor_of_safety" => " (a smaller strength_reduction.tolerance narrows each answer)",
+        "factor_of_safety" => " even bisected to an eighth of strength_reduction.tolerance",
         _ => " (a smaller solver.tolerance narrows each answer)",
     };
     let mut out = Refinement {
@@ -201,10 +201,11 @@ impl Refinement {
         let mut s = String::new();
         for l in &self.levels {
             s += &format!(
-                "  h = {} m: {} {} ({:.1} s)\n",
+                "  h = {} m: {} {} ± {} ({:.1} s)\n",
                 l.cell_size,
                 self.quantity.replace('_', " "),
                 unit(l.value),
+                unit(l.resolution),
                 l.wall_seconds
             );
         }
@@ -315,12 +316,17 @@ type Answer<T> = (T, f64, f64, f64);
 /// Makes the analysis `at` (the scene at a cell size, its folder, the cell size) at
 /// `count` cell sizes (checked by the caller), adds Richardson's estimate of `quantity` (in `unit`) to the
 /// `summary.json` in `out`, and returns the report at the scene's own cell size with it.
+///
+/// Where two neighbouring answers lie closer than they resolve, `narrow` is asked to know
+/// each of them more finely (a factor of safety bisects on); it says whether it could.
+/// They are compared again until they are resolved or neither can narrow.
 fn refine<T>(
     loaded: &LoadedScene,
     out: &Path,
     count: u32,
     (quantity, unit): (&str, &str),
     mut at: impl FnMut(LoadedScene, PathBuf, f64) -> Result<Answer<T>, RefineError>,
+    mut narrow: impl FnMut(&mut T, &mut Level) -> Result<bool, RefineError>,
     mut show: impl FnMut(&Level),
 ) -> Result<(T, Refinement), RefineError> {
     // The finer levels of an earlier analysis into the same folder (`--refine 3`, then
@@ -330,7 +336,7 @@ fn refine<T>(
         Err(e) if e.kind() != std::io::ErrorKind::NotFound => return Err(RefineError::Output(earlier, e)),
         _ => {}
     }
-    let mut first = None;
+    let mut reports = Vec::new();
     let mut levels = Vec::new();
     for k in 0..count {
         let ratio = 1u32 << k;
@@ -347,11 +353,23 @@ fn refine<T>(
         };
         show(&level);
         levels.push(level);
-        first.get_or_insert(report);
+        reports.push(report);
+    }
+    let unresolved = |l: &[Level]| {
+        (1..l.len()).find(|&k| (l[k].value - l[k - 1].value).abs() <= l[k].resolution + l[k - 1].resolution)
+    };
+    while let Some(k) = unresolved(&levels) {
+        let (coarse, fine) = reports.split_at_mut(k);
+        let (lc, lf) = levels.split_at_mut(k);
+        let a = narrow(&mut coarse[k - 1], &mut lc[k - 1])?;
+        let b = narrow(&mut fine[0], &mut lf[0])?;
+        if !(a || b) {
+            break;
+        }
     }
     let refinement = estimate(quantity, unit, levels);
     add_to_summary(out, &refinement)?;
-    Ok((first.expect("at least two levels"), refinement))
+    Ok((reports.swap_remove(0), refinement))
 }
 
 /// `kdmpm run --refine`: the scene's limit pressure (`limit_pressure` of its motions) at
@@ -396,7 +414,17 @@ pub fn limit_pressure(
         let wall = start.elapsed().as_secs_f64();
         Ok((report, value, tolerance * value.abs(), wall))
     };
-    refine(loaded, out, count, ("limit_pressure", "Pa"), run, show)
+    // A limit load is known to the stopping tolerance; a run at a finer one would be a
+    // new run, not a continuation.
+    refine(
+        loaded,
+        out,
+        count,
+        ("limit_pressure", "Pa"),
+        run,
+        |_, _| Ok(false),
+        show,
+    )
 }
 
 /// `kdmpm fos --refine`: the factor of safety at `count` cell sizes, with Richardson's
@@ -406,20 +434,57 @@ pub fn factor_of_safety(
     loaded: &LoadedScene,
     out: &Path,
     count: u32,
-    mut show: impl FnMut(f64, &Trial),
+    show: impl FnMut(f64, &Trial),
 ) -> Result<(FosReport, Refinement), RefineError> {
     check_levels(count)?;
-    let analyse = |scene: LoadedScene, dir: PathBuf, h: f64| {
-        let report = crate::fos::strength_reduction(&scene, &dir, |t| show(h, t)).map_err(|e| match e {
+    let show = std::cell::RefCell::new(show);
+    let fail = |h: f64| {
+        move |e| match e {
             FosError::Interrupted(_) => RefineError::Interrupted(h),
             e => RefineError::Fos(h, Box::new(e)),
-        })?;
+        }
+    };
+    let analyse = |scene: LoadedScene, dir: PathBuf, h: f64| {
+        let report =
+            crate::fos::strength_reduction(&scene, &dir, |t| (show.borrow_mut())(h, t)).map_err(fail(h))?;
         let (value, wall) = (report.factor_of_safety, report.wall_seconds);
         let resolution = 0.5 * (report.bracket[1] - report.bracket[0]);
-        Ok((report, value, resolution, wall))
+        Ok(((report, scene, dir), value, resolution, wall))
     };
-    refine(loaded, out, count, ("factor_of_safety", ""), analyse, |_| {})
+    // Each bisection halved again, to an eighth of the scene's tolerance at most.
+    let floor = loaded
+        .scene
+        .strength_reduction
+        .as_ref()
+        .map_or(0.0, |sr| sr.tolerance / NARROWEST);
+    let narrow = |(report, scene, dir): &mut (FosReport, LoadedScene, PathBuf), level: &mut Level| {
+        let tolerance = 0.5 * report.tolerance;
+        if tolerance < floor * (1.0 - 1e-12) {
+            return Ok(false);
+        }
+        let h = level.cell_size;
+        crate::fos::narrow(scene, dir, report, tolerance, |t| (show.borrow_mut())(h, t)).map_err(fail(h))?;
+        level.value = report.factor_of_safety;
+        level.resolution = 0.5 * (report.bracket[1] - report.bracket[0]);
+        level.wall_seconds = report.wall_seconds;
+        Ok(true)
+    };
+    let ((report, _, _), refinement) = refine(
+        loaded,
+        out,
+        count,
+        ("factor_of_safety", ""),
+        analyse,
+        narrow,
+        |_| {},
+    )?;
+    Ok((report, refinement))
 }
+
+/// How far `--refine` narrows a factor of safety's bisection below the scene's
+/// `strength_reduction.tolerance` (a divisor): two answers closer than their brackets
+/// resolve are bisected on, each halving one trial more, to tolerance/8.
+pub const NARROWEST: f64 = 8.0;
 
 #[cfg(test)]
 mod tests {

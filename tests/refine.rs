@@ -99,6 +99,39 @@ fn two_cell_sizes_of_the_slope_extrapolate_at_first_order() {
     assert!((summary_refinement(&out)["extrapolated"].as_f64().unwrap() - 1.3515625).abs() < 1e-12);
 }
 
+/// The same slope at a tolerance too coarse to tell h from h/2 (0.1: both brackets end
+/// at 1.375–1.4375, the two answers 1.40625): `--refine` bisects each on, a trial at a
+/// time, until they are resolved, here at 1/64 wide, and gives the estimate the scene's
+/// tolerance gives (1.4140625, 1.3828125 as above). Once it said only that the answers
+/// differ by less than they resolve.
+#[test]
+fn answers_closer_than_their_brackets_are_bisected_on_until_resolved() {
+    let out = common::scratch("refine", "narrowed");
+    let l = loaded(
+        "slope_fos.ron",
+        &[
+            "grid.cell_size=1.0",
+            "grid.cells=[55, 12]",
+            "strength_reduction.tolerance=0.1",
+        ],
+    );
+    let (report, r) = factor_of_safety(&l, &out, 2, |_, _| {}).expect("two analyses");
+    assert_eq!(r.levels[0].value, 1.4140625);
+    assert_eq!(r.levels[1].value, 1.3828125);
+    assert_eq!(r.levels[0].resolution, 1.0 / 128.0);
+    assert_eq!(report.factor_of_safety, 1.4140625);
+    assert_eq!(report.tolerance, 0.025);
+    assert!((r.extrapolated.unwrap() - 1.3515625).abs() < 1e-12, "{}", r.note);
+    // The narrowing trials are the analysis's own: in its table and its folders.
+    let table = std::fs::read_to_string(out.join("fos.csv")).unwrap();
+    assert_eq!(table.lines().count(), 1 + report.trials.len());
+    assert!(out.join("trials/F1.421875").is_dir());
+    let fine: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("refine/h0.5/summary.json")).unwrap())
+            .unwrap();
+    assert_eq!(fine["factor_of_safety"], 1.3828125);
+}
+
 #[test]
 fn a_refinement_without_a_limit_pressure_or_with_four_levels_is_bad_input() {
     let out = common::scratch("refine", "refused");
