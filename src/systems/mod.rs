@@ -30,6 +30,7 @@ pub mod nodal_velocity;
 mod node_pairs;
 pub mod p2g;
 pub mod peak_watch;
+pub mod point_forces;
 pub mod point_loads;
 pub mod prescribed_motion;
 pub mod remap;

@@ -10,6 +10,7 @@ use crate::parallel::{scatter, Disjoint};
 use crate::schedule::System;
 use crate::shape::{for_each_node, from_lanes, Shape, StressColumns};
 use crate::systems::exchange::{exchange, MASS, MOMENTUM};
+use crate::systems::point_forces::PointForces;
 use crate::tensor::StoredSym;
 use std::marker::PhantomData;
 
@@ -26,16 +27,11 @@ pub enum P2gPart {
 
 /// Maps point mass m_p, momentum m_p v_p and internal force −V_p σ_p·∇w_ip to the grid.
 ///
-/// With water, the force pass also maps the pore water's load on each point below its
-/// piezometric surface, V_p w_ip (−∇u_p) ([`crate::water::Water::body_force`]: buoyancy,
-/// seepage, and with them the pressure of open water on a submerged surface), to the
-/// nodal force and, as applied load, to the external force. It rides on the stress's pass
-/// because the weights are already at hand there: a pass of its own would cost as much
-/// again as the mapping of the stress.
-///
-/// In axisymmetry (per radian, x = r) the internal force gains the hoop stress's part
-/// −V_p σ_θθ w_ip / r_p along r: the weak form of ∂σ_rr/∂r + ∂σ_rz/∂z + (σ_rr − σ_θθ)/r = 0
-/// with volumes r dr dz, whose (σ_rr/r) term the in-plane divergence of V σ already holds.
+/// The force pass also maps each point's other forces ([`PointForces`]: the pore water's
+/// load, the hoop stress in axisymmetry), w_ip m_p a_p for a force a_p per unit mass, to
+/// the nodal force and their applied part to the external force. They ride on the
+/// stress's pass because the weights are already at hand there: a pass of their own would
+/// cost as much again as the mapping of the stress.
 ///
 /// Points are grouped in slabs of grid rows that scatter in parallel, slabs that share no
 /// node at a time (see `parallel::scatter`).
@@ -85,12 +81,8 @@ impl<D: Dim, S: Shape> P2g<D, S> {
         let mut np = col_mut::<NodeMomentum<D::Vec>>(n);
         let mut nf = col_mut::<NodeForce<D::Vec>>(n);
         let mut ne = col_mut::<NodeExternalForce<D::Vec>>(n);
-        let water = ctx.settings.water.as_ref();
-        // The pore water's load rises with gravity's ramp, as the weight it buoys does.
-        let ramp = ctx
-            .settings
-            .gravity
-            .map_or(1.0, |g| g.step_factor(ctx.state.clock.time, ctx.settings.dt));
+        let sources = PointForces::of::<D>(&ctx.settings, ctx.state.clock.time);
+        let by_material = sources.need_materials();
         let (mass_momentum, force) = match self.part {
             P2gPart::All => (true, true),
             P2gPart::MassMomentum => (true, false),
@@ -105,9 +97,13 @@ impl<D: Dim, S: Shape> P2g<D, S> {
             let volg = arch.get::<&Volume>();
             let stressed = sg.as_deref().zip(volg.as_deref());
             let force = force && stressed.is_some();
-            // The points' materials, where the scene has water.
-            let idg = water.and(arch.get::<&MaterialId>());
-            let wet = water.zip(idg.as_deref());
+            // The points' materials, where a source reads them.
+            let idg = if by_material {
+                arch.get::<&MaterialId>()
+            } else {
+                None
+            };
+            let forces = sources.on(idg.as_deref());
             if !mass_momentum && !force {
                 continue;
             }
@@ -124,6 +120,9 @@ impl<D: Dim, S: Shape> P2g<D, S> {
                 S::SUPPORT,
                 &target,
                 |points, ((nm, np), nf, ne), lo| {
+                    // The sources' few words copied here, so that the loop holds them in
+                    // registers rather than reaching them through the closure's references.
+                    let here = forces;
                     for &p in points {
                         let p = p as usize;
                         let (mp, mv) = (m[p].0, v[p].0 * m[p].0);
@@ -132,27 +131,10 @@ impl<D: Dim, S: Shape> P2g<D, S> {
                             _ => None,
                         };
                         // Forces on the point besides its stress's divergence, per unit of its
-                        // mass (N/kg): all of them, and the applied part. The pore water's
-                        // load is applied; the hoop stress's −V σ_θθ/r (axisymmetry) is
-                        // internal.
-                        let pore = match (wet, f) {
-                            (Some((w, ids)), Some((_, neg_vol))) => {
-                                let vol = -neg_vol;
-                                let b = w.body_force(ids[p].0, D::vec_to3(x[p].0), vol);
-                                (b != [0.0; 3]).then(|| D::vec_from(b) * (vol * ramp / mp))
-                            }
-                            _ => None,
-                        };
+                        // mass (N/kg): all of them, and the applied part.
                         let extra = match f {
-                            Some((s, neg_vol)) if D::AXISYMMETRIC => {
-                                let r = x[p].0.get(0);
-                                let hoop = D::vec_from([neg_vol * s.to_sym3().zz / (r * mp), 0.0, 0.0]);
-                                Some(match pore {
-                                    Some(a) => (a + hoop, a),
-                                    None => (hoop, D::Vec::ZERO),
-                                })
-                            }
-                            _ => pore.map(|a| (a, a)),
+                            Some((s, neg_vol)) => here.at::<D>(p, x[p].0, mp, -neg_vol, s),
+                            _ => None,
                         };
                         // One loop per case, so that the node loop holds no branch.
                         match (mass_momentum, f) {
