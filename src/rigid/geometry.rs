@@ -378,7 +378,7 @@ impl Geometry {
     /// The shape to draw (m, at its starting place): in 2D and axisymmetric scenes its
     /// outline, closed (a polygon's vertices, a circle in 72 pieces, `true`); in 3D the
     /// surface samples every `spacing` m within `reach` as a cloud of points (`false`).
-    pub fn outline(&self, spacing: f64, reach: &super::sampling::Reach) -> (Vec<[f64; 3]>, bool) {
+    pub fn outline(&self, spacing: f64, reach: &super::reach::Reach) -> (Vec<[f64; 3]>, bool) {
         match self {
             Geometry::Polygon { vertices } => (vertices.iter().map(|v| [v[0], v[1], 0.0]).collect(), true),
             Geometry::Circle { centre, radius } => (

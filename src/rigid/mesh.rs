@@ -333,7 +333,7 @@ impl TriangleMesh {
     /// Only the pieces whose centres may lie in `reach` are visited: a face's pieces are
     /// those of the parallelogram a + i u + j v, and the reach's corners, projected on the
     /// face's plane, bound the (i, j) it can hold.
-    pub fn samples(&self, spacing: f64, reach: &super::Reach) -> Vec<(V3, V3, f64)> {
+    pub fn samples(&self, spacing: f64, reach: &super::reach::Reach) -> Vec<(V3, V3, f64)> {
         let mut pools = Pools::new(spacing);
         for (f, face) in self.faces.iter().enumerate() {
             if self.areas[f] <= 0.0 {
@@ -424,7 +424,7 @@ fn piece_range(
     u: V3,
     v: V3,
     k: usize,
-    reach: &super::Reach,
+    reach: &super::reach::Reach,
 ) -> (std::ops::Range<usize>, std::ops::Range<usize>) {
     let all = (0..k, 0..k);
     if (0..3).any(|d| !reach.lo[d].is_finite() || !reach.hi[d].is_finite()) {

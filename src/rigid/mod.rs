@@ -17,12 +17,13 @@
 pub mod contact;
 pub mod geometry;
 pub mod mesh;
+pub mod reach;
 pub mod sampling;
 pub mod stl;
 
 pub use contact::Contact;
 pub use geometry::{Geometry, Sample};
-pub use sampling::Reach;
+pub use reach::Reach;
 
 use serde::{Deserialize, Serialize};
 

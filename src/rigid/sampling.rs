@@ -10,29 +10,8 @@
 //! same samples, in the same order, as before any cut.
 
 use super::geometry::{Geometry, Sample};
+use super::reach::Reach;
 use std::f64::consts::PI;
-
-/// A box (m, x y z) in the body's starting frame: the places its surface can reach the grid
-/// from over its travel, with the shape functions' support around it.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Reach {
-    /// Lower corner.
-    pub lo: [f64; 3],
-    /// Upper corner.
-    pub hi: [f64; 3],
-}
-
-impl Reach {
-    /// Everywhere (tests, and shapes known to be small).
-    pub const ALL: Reach = Reach {
-        lo: [f64::NEG_INFINITY; 3],
-        hi: [f64::INFINITY; 3],
-    };
-
-    fn holds(&self, x: [f64; 3]) -> bool {
-        (0..3).all(|a| x[a] >= self.lo[a] && x[a] <= self.hi[a])
-    }
-}
 
 /// The number of equal pieces of at most `spacing` that cut `length` (at least one).
 pub(crate) fn pieces(length: f64, spacing: f64) -> usize {

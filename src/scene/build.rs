@@ -1,6 +1,7 @@
 //! Building a simulation from a valid scene: grid nodes, material points, loads, tracing
 //! and the schedule. Only what the scene uses is created.
 
+use super::region::{cell_span, region_bounds, region_contains};
 use super::validate::{self, carried_state, Checked, CheckedGrid, CheckedStage, Derived, FaceHold};
 use super::{pad3, Dimension, LoadedScene, Region, Scene};
 use crate::components::*;
@@ -47,39 +48,6 @@ fn visit_support<D: Dim>(grid: &Grid<D>, shape: ShapeKind, x: D::Vec, mut f: imp
         ShapeKind::QuadraticBSpline => for_each_node::<D, QuadraticBSpline>(grid, x, |i, w, _| f(i, w)),
         ShapeKind::UniformGimp => for_each_node::<D, UniformGimp>(grid, x, |i, w, _| f(i, w)),
     }
-}
-
-/// Bounding box of a region (m, x y z; z is 0..0 in 2D).
-pub(super) fn region_bounds(region: &Region, n: usize) -> ([f64; 3], [f64; 3]) {
-    match region {
-        Region::Box { min, max } => (pad3(min), pad3(max)),
-        Region::Polygon { vertices, z } => {
-            let (mut lo, mut hi) = crate::polygon::bounds(vertices);
-            if n == 3 {
-                let z = z.as_ref().expect("validated");
-                (lo[2], hi[2]) = (z[0], z[1]);
-            }
-            (lo, hi)
-        }
-    }
-}
-
-fn region_contains(region: &Region, x: [f64; 3], n: usize) -> bool {
-    match region {
-        Region::Box { min, max } => (0..n).all(|a| x[a] > min[a] && x[a] < max[a]),
-        Region::Polygon { vertices, z } => {
-            crate::polygon::contains(vertices, x[0], x[1])
-                && (n == 2 || z.as_ref().is_some_and(|z| x[2] > z[0] && x[2] < z[1]))
-        }
-    }
-}
-
-/// The cells `first..last` along one axis that the interval `lo..hi` (m) touches, clamped
-/// to the grid's `cells` (origin in m, `inv_h` = 1/h in 1/m).
-pub(super) fn cell_span(lo: f64, hi: f64, origin: f64, inv_h: f64, cells: usize) -> (usize, usize) {
-    let first = ((lo - origin) * inv_h).floor().max(0.0) as usize;
-    let last = (((hi - origin) * inv_h).ceil().max(0.0) as usize).min(cells);
-    (first, last)
 }
 
 /// Positions of the points filling `region`: centres of equal sub-cells of every grid cell,

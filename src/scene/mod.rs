@@ -5,12 +5,12 @@
 
 mod build;
 pub mod locate;
+mod region;
 mod tractions;
 mod validate;
 
 pub use crate::materials::MaterialSpec;
 pub use build::build;
-use build::{cell_span, region_bounds};
 pub use validate::{check, Checked, CheckedGrid, CheckedStage, Derived, Estimate, FaceHold};
 
 use crate::error::SceneError;

@@ -21,7 +21,7 @@ pub(super) fn check_mass_finite(
         let Some((_, model)) = table.iter().find(|(name, _)| *name == body.material) else {
             continue;
         };
-        let (lo, hi) = crate::scene::region_bounds(&body.region, n);
+        let (lo, hi) = crate::scene::region::region_bounds(&body.region, n);
         let volume: f64 = (0..n).map(|a| (hi[a] - lo[a]).abs()).product();
         let mass = model.density() * volume;
         total += mass;

@@ -182,13 +182,13 @@ pub(super) fn estimate(
         .ok_or_else(|| too_many("grid.cells", "the grid's memory"))?;
     for (b, body) in s.bodies.iter().enumerate() {
         let field = format!("bodies[{b}].points_per_cell");
-        let (lo, hi) = crate::scene::region_bounds(&body.region, n);
+        let (lo, hi) = crate::scene::region::region_bounds(&body.region, n);
         let mut count = 1u64;
         for a in 0..n {
             // Cells of the bounding box along the axis, as set-up fills them.
             let inv_h = 1.0 / s.grid.cell_size;
             let (first, last) =
-                crate::scene::cell_span(lo[a], hi[a], s.grid.origin[a], inv_h, s.grid.cells[a]);
+                crate::scene::region::cell_span(lo[a], hi[a], s.grid.origin[a], inv_h, s.grid.cells[a]);
             count = (last.saturating_sub(first) as u64)
                 .checked_mul(body.points_per_cell[a] as u64)
                 .and_then(|c| count.checked_mul(c))
