@@ -262,7 +262,7 @@ fn mapping<D: Dim, S: Shape>() -> Vec<Entry<D>> {
             St::Map,
             Schemes(MUSL_USL),
             &[SORTED],
-            "mass, momentum, internal force (and the pore water's load) to the nodes",
+            "mass, momentum, internal force (and each point's other forces, `point_forces.rs`) to the nodes",
             |_| Box::new(P2g::<D, S>::new(P2gPart::All)),
         ),
         e(
@@ -348,7 +348,7 @@ fn straining<D: Dim, S: Shape>() -> Vec<Entry<D>> {
             St::MapForce,
             Schemes(USF),
             &[("stress_update", "p2g_force maps the updated stress")],
-            "USF: internal force of the updated stress (and the pore water's load)",
+            "USF: internal force of the updated stress (and each point's other forces)",
             |_| Box::new(P2g::<D, S>::new(P2gPart::InternalForce)),
         ),
     ]
