@@ -372,6 +372,22 @@ fn refine<T>(
     Ok((reports.swap_remove(0), refinement))
 }
 
+/// What `kdmpm run --refine` estimates.
+#[derive(Clone, Debug, PartialEq)]
+pub enum RunQuantity {
+    /// The largest pressure of the motions' static states (`limit_pressure`): a footing.
+    LimitPressure,
+    /// The mean pressure of `curve.csv`'s rows named `row` whose displacement is at least
+    /// `from` (m): a penetrometer's steady resistance (a T-bar over its second diameter).
+    MeanPressure {
+        /// The rows' name (a motion, a rigid body, or a body's part as `body.part`, with
+        /// an `area`).
+        row: String,
+        /// The displacement from which rows count (m, ≥ 0).
+        from: f64,
+    },
+}
+
 /// `kdmpm run --refine`: the scene's limit pressure (`limit_pressure` of its motions) at
 /// `count` cell sizes, with Richardson's estimate. Returns the report of the run at the
 /// scene's own cell size (in `out`) and the estimate, which is added to its `summary.json`.
@@ -383,14 +399,45 @@ pub fn limit_pressure(
     quiet: bool,
     show: impl FnMut(&Level),
 ) -> Result<(RunReport, Refinement), RefineError> {
+    pressure(loaded, out, count, quiet, &RunQuantity::LimitPressure, show)
+}
+
+/// `kdmpm run --refine` of `what` ([`RunQuantity`]) at `count` cell sizes, as
+/// [`limit_pressure`]. A limit pressure is known to the stopping tolerance times it; a
+/// mean over static states to that, or to the standard error of their mean where their
+/// swing is wider.
+pub fn pressure(
+    loaded: &LoadedScene,
+    out: &Path,
+    count: u32,
+    quiet: bool,
+    what: &RunQuantity,
+    show: impl FnMut(&Level),
+) -> Result<(RunReport, Refinement), RefineError> {
     check_levels(count)?;
-    if !loaded.scene.has_limit_pressure() {
-        return Err(RefineError::NotRefinable(format!(
-            "{}: --refine estimates the error of a limit pressure, and the scene has no motion \
-             with a loaded `area`",
-            loaded.path.display()
-        )));
-    }
+    let name = loaded.path.display();
+    let quantity = match what {
+        RunQuantity::LimitPressure if !loaded.scene.has_limit_pressure() => {
+            return Err(RefineError::NotRefinable(format!(
+                "{name}: --refine estimates the error of a limit pressure, and the scene has no \
+                 motion with a loaded `area`"
+            )));
+        }
+        RunQuantity::LimitPressure => "limit_pressure",
+        RunQuantity::MeanPressure { from, .. } if !(from.is_finite() && *from >= 0.0) => {
+            return Err(RefineError::NotRefinable(format!(
+                "--mean-from: the displacement from which rows count must be ≥ 0 m, found {from}"
+            )));
+        }
+        RunQuantity::MeanPressure { row, .. } if !loaded.scene.pressure_rows().contains(row) => {
+            return Err(RefineError::NotRefinable(format!(
+                "--mean-from: {name} has no curve row `{row}` with a pressure; the rows with an \
+                 `area` are: {}",
+                loaded.scene.pressure_rows().join(", ")
+            )));
+        }
+        RunQuantity::MeanPressure { .. } => "mean_pressure",
+    };
     let tolerance = loaded.scene.solver.tolerance;
     let run = |scene: LoadedScene, dir: PathBuf, h: f64| {
         let start = Instant::now();
@@ -405,26 +452,54 @@ pub fn limit_pressure(
         if let Some(e) = &report.error {
             return Err(RefineError::NoAnswer(h, e.to_string()));
         }
-        let Some(value) = report.summary.limit_pressure else {
-            return Err(RefineError::NoAnswer(
-                h,
-                "the run reached no static state of its motions: no limit pressure".into(),
-            ));
+        let (value, resolution) = match what {
+            RunQuantity::LimitPressure => {
+                let Some(value) = report.summary.limit_pressure else {
+                    return Err(RefineError::NoAnswer(
+                        h,
+                        "the run reached no static state of its motions: no limit pressure".into(),
+                    ));
+                };
+                (value, tolerance * value.abs())
+            }
+            RunQuantity::MeanPressure { row, from } => {
+                let states: Vec<f64> = report
+                    .summary
+                    .curve
+                    .iter()
+                    .filter(|c| c.name == *row && c.displacement >= *from)
+                    .filter_map(|c| c.pressure)
+                    .collect();
+                mean_and_resolution(&states, tolerance).ok_or_else(|| {
+                    RefineError::NoAnswer(
+                        h,
+                        format!("no static state of `{row}` at a displacement of {from} m or more"),
+                    )
+                })?
+            }
         };
         let wall = start.elapsed().as_secs_f64();
-        Ok((report, value, tolerance * value.abs(), wall))
+        Ok((report, value, resolution, wall))
     };
-    // A limit load is known to the stopping tolerance; a run at a finer one would be a
-    // new run, not a continuation.
-    refine(
-        loaded,
-        out,
-        count,
-        ("limit_pressure", "Pa"),
-        run,
-        |_, _| Ok(false),
-        show,
-    )
+    // A pressure is known to the stopping tolerance; a run at a finer one would be a new
+    // run, not a continuation.
+    refine(loaded, out, count, (quantity, "Pa"), run, |_, _| Ok(false), show)
+}
+
+/// The mean of `states` (Pa) and how finely it is known: the stopping `tolerance` times
+/// it, or the standard error of the mean, s/√n, where the states swing more.
+fn mean_and_resolution(states: &[f64], tolerance: f64) -> Option<(f64, f64)> {
+    let n = states.len() as f64;
+    if states.is_empty() {
+        return None;
+    }
+    let mean = states.iter().sum::<f64>() / n;
+    let spread = if states.len() > 1 {
+        (states.iter().map(|p| (p - mean).powi(2)).sum::<f64>() / (n - 1.0) / n).sqrt()
+    } else {
+        0.0
+    };
+    Some((mean, spread.max(tolerance * mean.abs())))
 }
 
 /// `kdmpm fos --refine`: the factor of safety at `count` cell sizes, with Richardson's

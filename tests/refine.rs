@@ -3,7 +3,7 @@
 
 mod common;
 
-use kdmpm::refine::{factor_of_safety, finer, limit_pressure};
+use kdmpm::refine::{factor_of_safety, finer, limit_pressure, pressure, RunQuantity};
 use kdmpm::scene::{LoadedScene, TimeStep};
 
 fn loaded(name: &str, sets: &[&str]) -> LoadedScene {
@@ -80,6 +80,80 @@ fn a_footing_whose_answers_differ_by_less_than_they_resolve_reports_its_spread()
     assert_eq!(written["levels"][2]["dir"], "refine/h0.125");
     assert!(written.get("extrapolated").is_none());
     assert!(out.join("refine/h0.25/curve.csv").is_file());
+}
+
+/// A penetrometer's answer is its steady resistance, the mean of its static states over a
+/// window of travel, not the largest: `--mean-from ROW=FROM` refines that. `footing.ron`
+/// at h = 0.5 and 0.25 m, the mean pressure of its states from 5 cm on, is each level's
+/// mean of those rows of `curve.csv`, known to the stopping tolerance or to the standard
+/// error of the mean, whichever is larger.
+#[test]
+fn a_mean_pressure_over_a_window_of_travel_is_refined_as_a_limit_pressure_is() {
+    let out = common::scratch("refine", "mean");
+    let l = loaded("footing.ron", &["grid.cell_size=0.5", "grid.cells=[12, 9]"]);
+    let what = RunQuantity::MeanPressure {
+        row: "footing".into(),
+        from: 0.05,
+    };
+    let (_, r) = pressure(&l, &out, 2, true, &what, |_| {}).expect("two runs");
+    assert_eq!(r.quantity, "mean_pressure");
+    for (level, dir) in r.levels.iter().zip([out.clone(), out.join("refine/h0.25")]) {
+        let summary: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+        let states: Vec<f64> = summary["curve"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|c| c["name"] == "footing" && c["displacement"].as_f64().unwrap() >= 0.05)
+            .map(|c| c["pressure"].as_f64().unwrap())
+            .collect();
+        assert_eq!(states.len(), 6, "{dir:?}");
+        let mean = states.iter().sum::<f64>() / 6.0;
+        assert!(
+            (level.value / mean - 1.0).abs() < 1e-12,
+            "{} against {mean}",
+            level.value
+        );
+        assert!(level.resolution >= 0.01 * mean, "{}", level.resolution);
+    }
+    assert_eq!([r.levels[0].value, r.levels[1].value], PINNED_MEANS);
+}
+
+/// The means `a_mean_pressure_over_a_window_…` pins (Pa).
+const PINNED_MEANS: [f64; 2] = [48213.085038001176, 49660.135411108095];
+
+/// A row that has no pressure, a window that is not a displacement, or `--mean-from`
+/// without `--refine`: refused with the reason (exit 2) before anything runs.
+#[test]
+fn a_mean_pressure_of_a_row_without_an_area_or_without_refine_is_refused() {
+    let out = common::scratch("refine", "mean-refused");
+    let footing = common::scene("footing.ron");
+    let f = footing.to_str().unwrap();
+    let o = out.to_str().unwrap();
+    for (args, says) in [
+        (
+            vec!["run", f, "--out", o, "--refine", "2", "--mean-from", "pile=0.1"],
+            "no curve row `pile`",
+        ),
+        (
+            vec!["run", f, "--out", o, "--refine", "2", "--mean-from", "footing=-1"],
+            "must be ≥ 0 m",
+        ),
+        (
+            vec!["run", f, "--out", o, "--refine", "2", "--mean-from", "footing"],
+            "give ROW=FROM",
+        ),
+        (
+            vec!["run", f, "--out", o, "--mean-from", "footing=0.1"],
+            "--refine",
+        ),
+    ] {
+        let r = common::kdmpm(&args);
+        let err = String::from_utf8_lossy(&r.stderr);
+        assert_eq!(r.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(says), "{args:?}: {err}");
+    }
+    assert!(!out.join("summary.json").exists(), "nothing is run");
 }
 
 /// `slope_fos.ron` from h = 1 m with two cell sizes: 1.4141 at h = 1 m, 1.3828 at 0.5 m;

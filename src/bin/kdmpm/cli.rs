@@ -61,6 +61,11 @@ pub enum Command {
         overrides: Vec<String>,
         #[command(flatten)]
         refining: Refining,
+        /// With --refine: estimate the mean pressure of curve row ROW over its static states
+        /// at a displacement of FROM m or more (a penetrometer's steady resistance, e.g.
+        /// `--mean-from tbar=0.5`) instead of the limit pressure.
+        #[arg(long, value_name = "ROW=FROM", requires = "refine")]
+        mean_from: Option<String>,
         #[command(flatten)]
         stepping: Stepping,
         /// Write a Chrome trace (chrome://tracing, Perfetto) of every system call to FILE

@@ -129,13 +129,18 @@ fn command(command: Command, comm: &Arc<Comm>) -> Result<ExitCode, Fault> {
             out,
             overrides,
             refining,
+            mean_from,
             stepping,
             ..
         } => {
             let out = out.unwrap_or_else(|| default_out(&scene, "", "scene"));
+            let what = match mean_from {
+                Some(m) => mean_from_arg(&m)?,
+                None => kdmpm::refine::RunQuantity::LimitPressure,
+            };
             let loaded = LoadedScene::from_file(&scene, &overrides).map_err(Fault::bad)?;
             if let Some(levels) = refining.refine {
-                return run_refined(&loaded, &out, levels, stepping.workers.quiet, comm);
+                return run_refined(&loaded, &out, levels, &what, stepping.workers.quiet, comm);
             }
             let run = Run::scene(loaded).into_dir(out).quiet(stepping.workers.quiet);
             return report(run.over(comm.clone()).go(), stepping, comm);
@@ -201,11 +206,29 @@ fn report(run: Result<RunReport, RunError>, stepping: Stepping, comm: &Comm) -> 
     ))
 }
 
-/// `kdmpm run --refine`: the scene's limit pressure at two or three cell sizes.
+/// `--mean-from ROW=FROM`: the curve row and the displacement (m) from which its static
+/// states count.
+fn mean_from_arg(arg: &str) -> Result<kdmpm::refine::RunQuantity, Fault> {
+    let bad = || {
+        Fault::bad(format!(
+            "--mean-from {arg}: give ROW=FROM, a curve row and a displacement in m (tbar=0.5)"
+        ))
+    };
+    let (row, from) = arg.rsplit_once('=').ok_or_else(bad)?;
+    let from: f64 = from.trim().parse().map_err(|_| bad())?;
+    Ok(kdmpm::refine::RunQuantity::MeanPressure {
+        row: row.trim().to_string(),
+        from,
+    })
+}
+
+/// `kdmpm run --refine`: the scene's limit pressure, or the mean pressure `what` names, at
+/// two or three cell sizes.
 fn run_refined(
     loaded: &LoadedScene,
     out: &Path,
     levels: u32,
+    what: &kdmpm::refine::RunQuantity,
     quiet: bool,
     comm: &Comm,
 ) -> Result<ExitCode, Fault> {
@@ -217,7 +240,7 @@ fn run_refined(
             eprintln!("h = {} m done ({:.1} s)", l.cell_size, l.wall_seconds);
         }
     };
-    let (r, refinement) = kdmpm::refine::limit_pressure(loaded, out, levels, quiet, show)
+    let (r, refinement) = kdmpm::refine::pressure(loaded, out, levels, quiet, what, show)
         .map_err(|e| Fault(e.to_string(), e.ending()))?;
     if !quiet {
         println!("{}\n{}", r.describe(), refinement.describe());
