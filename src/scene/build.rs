@@ -254,19 +254,13 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         next_id,
         full_node_mass,
         initial_energy,
-    } = {
-        // Every water the run will see, to find the points below a surface at set-up.
-        let mut waters: Vec<(String, &crate::water::Water)> = Vec::new();
-        if let Some(w) = &water {
-            waters.push(("water.table".into(), w));
-        }
-        for (k, st) in checked_stages.iter().enumerate() {
-            if let Some(w) = &st.water {
-                waters.push((format!("stages[{k}].water"), w));
-            }
-        }
-        spawn_bodies(loaded, &grid, &table, &waters, &mut world)?
-    };
+    } = spawn_bodies(
+        loaded,
+        &grid,
+        &table,
+        &every_water(&water, &checked_stages),
+        &mut world,
+    )?;
     let touched = touched_nodes(&world, &grid, s.shape);
     validate::check_motion_boxes(loaded, &grid, &touched)?;
     let (load_ids, _) = spawn_point_loads(loaded, &grid, &mut world, &touched, next_id)?;
@@ -318,20 +312,7 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         pressures: placed.pressures,
         virtual_mass_floor: s.solver.virtual_mass_floor * full_node_mass,
     };
-    let needs = Needs {
-        point_loads: !s.point_loads.is_empty() || !s.tractions.is_empty(),
-    };
-    let names: Vec<String> = match &s.solver.schedule {
-        Some(names) => {
-            check_names(names, &settings, needs).map_err(|rule| loaded.invalid("solver.schedule", rule))?;
-            names.clone()
-        }
-        None => default_names(&settings, needs)
-            .into_iter()
-            .map(String::from)
-            .collect(),
-    };
-    let schedule = schedule_from_names::<D>(&names, &settings, s.shape);
+    let schedule = schedule_of::<D>(loaded, &settings)?;
     let derived = Derived {
         p_wave_speed: c_p,
         critical_time_step: dt_crit,
@@ -347,20 +328,7 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         bodies: describe_bodies(s, &body_samples),
         water: settings.water.as_ref().map(|w| describe_water(s, w)),
     };
-    let state = SolverState {
-        control: Control {
-            drives: s.motions.iter().map(MotionSpec::drive).collect(),
-            bodies: {
-                let stages: Vec<&str> = s.stages.iter().map(|t| t.name.as_str()).collect();
-                s.rigid_bodies
-                    .iter()
-                    .map(|b| b.state(b.first_stage(&stages)))
-                    .collect()
-            },
-            ..Control::default()
-        },
-        ..SolverState::default()
-    };
+    let state = initial_state(s);
     let materials = table.into_iter().map(|(_, m)| m).collect();
     let decomposition = Decomposition::whole(grid.axes[grid.slab_axis].cells, s.shape.support());
     let ctx = Context {
@@ -383,6 +351,65 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         },
         derived,
     ))
+}
+
+/// Every water the run will see (the scene's and each stage's that moves it), named by
+/// field, to find the points below a surface at set-up.
+fn every_water<'a>(
+    water: &'a Option<crate::water::Water>,
+    stages: &'a [CheckedStage],
+) -> Vec<(String, &'a crate::water::Water)> {
+    let mut waters = Vec::new();
+    if let Some(w) = water {
+        waters.push(("water.table".into(), w));
+    }
+    for (k, st) in stages.iter().enumerate() {
+        if let Some(w) = &st.water {
+            waters.push((format!("stages[{k}].water"), w));
+        }
+    }
+    waters
+}
+
+/// The schedule the scene names (`solver.schedule`, checked against its settings) or the
+/// default one for its settings.
+fn schedule_of<D: Dim>(
+    loaded: &LoadedScene,
+    settings: &Settings,
+) -> Result<crate::schedule::Schedule<D>, SceneError> {
+    let s = &loaded.scene;
+    let needs = Needs {
+        point_loads: !s.point_loads.is_empty() || !s.tractions.is_empty(),
+    };
+    let names: Vec<String> = match &s.solver.schedule {
+        Some(names) => {
+            check_names(names, settings, needs).map_err(|rule| loaded.invalid("solver.schedule", rule))?;
+            names.clone()
+        }
+        None => default_names(settings, needs)
+            .into_iter()
+            .map(String::from)
+            .collect(),
+    };
+    Ok(schedule_from_names::<D>(&names, settings, s.shape))
+}
+
+/// The solver's state before the first step: each motion's drive and each rigid body at
+/// rest, set off at its stage.
+fn initial_state(s: &Scene) -> SolverState {
+    let stages: Vec<&str> = s.stages.iter().map(|t| t.name.as_str()).collect();
+    SolverState {
+        control: Control {
+            drives: s.motions.iter().map(MotionSpec::drive).collect(),
+            bodies: s
+                .rigid_bodies
+                .iter()
+                .map(|b| b.state(b.first_stage(&stages)))
+                .collect(),
+            ..Control::default()
+        },
+        ..SolverState::default()
+    }
 }
 
 /// Each rigid body as `kdmpm check` prints it: name, parts, its contact samples (`samples`,

@@ -41,6 +41,17 @@ pub struct P2g<D: Dim, S> {
     _marker: PhantomData<fn() -> (D, S)>,
 }
 
+impl P2gPart {
+    /// Whether the pass maps (mass and momentum, internal force).
+    fn maps(self) -> (bool, bool) {
+        match self {
+            P2gPart::All => (true, true),
+            P2gPart::MassMomentum => (true, false),
+            P2gPart::InternalForce => (false, true),
+        }
+    }
+}
+
 impl<D: Dim, S: Shape> P2g<D, S> {
     /// A pass that maps `part`.
     pub fn new(part: P2gPart) -> Self {
@@ -83,11 +94,7 @@ impl<D: Dim, S: Shape> P2g<D, S> {
         let mut ne = col_mut::<NodeExternalForce<D::Vec>>(n);
         let sources = PointForces::of::<D>(&ctx.settings, ctx.state.clock.time);
         let by_material = sources.need_materials();
-        let (mass_momentum, force) = match self.part {
-            P2gPart::All => (true, true),
-            P2gPart::MassMomentum => (true, false),
-            P2gPart::InternalForce => (false, true),
-        };
+        let (mass_momentum, force) = self.part.maps();
         for arch in points_with::<Position<D::Vec>>(&ctx.world) {
             let xg = col::<Position<D::Vec>>(arch);
             let mg = col::<Mass>(arch);
@@ -98,17 +105,12 @@ impl<D: Dim, S: Shape> P2g<D, S> {
             let stressed = sg.as_deref().zip(volg.as_deref());
             let force = force && stressed.is_some();
             // The points' materials, where a source reads them.
-            let idg = if by_material {
-                arch.get::<&MaterialId>()
-            } else {
-                None
-            };
+            let idg = by_material.then(|| arch.get::<&MaterialId>()).flatten();
             let forces = sources.on(idg.as_deref());
             if !mass_momentum && !force {
                 continue;
             }
-            let (x, m): (&[Position<D::Vec>], &[Mass]) = (&xg, &mg);
-            let v: &[Velocity<D::Vec>] = &vg;
+            let (x, m, v) = (&xg[..], &mg[..], &vg[..]);
             let target = (
                 (Disjoint::new(&mut nm), Disjoint::new(&mut np)),
                 Disjoint::new(&mut nf),
