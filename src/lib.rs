@@ -46,7 +46,7 @@ pub mod materials;
 pub mod measure;
 pub mod output;
 pub(crate) mod parallel;
-pub mod polygon;
+pub(crate) mod polygon;
 pub mod refine;
 pub mod rigid;
 pub mod run;
@@ -60,7 +60,7 @@ pub mod systems;
 pub mod tensor;
 #[cfg(test)]
 mod testing;
-pub mod unique_map;
+pub(crate) mod unique_map;
 pub mod water;
 
 pub use context::Context;
