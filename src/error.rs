@@ -29,6 +29,41 @@ impl Ending {
     }
 }
 
+/// Why one part of a scene is refused, before the scene is there to place it: the field
+/// (its path inside the part, or in the scene: `parts[1].geometry`,
+/// `rigid_bodies[0].parts[1].geometry`) and the rule it breaks. The scene's check turns
+/// it into a [`SceneError`] at the field's place in the file.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Refusal {
+    /// The field's path.
+    pub field: String,
+    /// The rule, in words.
+    pub rule: String,
+}
+
+impl Refusal {
+    /// The refusal of `field` for breaking `rule`.
+    pub fn new(field: impl Into<String>, rule: String) -> Self {
+        Refusal {
+            field: field.into(),
+            rule,
+        }
+    }
+
+    /// The same refusal with its field under `prefix` (`rigid_bodies[0]` + `parts[1]`:
+    /// `rigid_bodies[0].parts[1]`).
+    pub fn under(self, prefix: &str) -> Self {
+        Refusal {
+            field: if self.field.is_empty() {
+                prefix.to_string()
+            } else {
+                format!("{prefix}.{}", self.field)
+            },
+            rule: self.rule,
+        }
+    }
+}
+
 /// A scene that cannot be read, parsed or accepted.
 #[derive(Debug, Error)]
 pub enum SceneError {

@@ -1,5 +1,6 @@
 //! Solver-wide state and settings: plain structs outside the ECS world.
 
+use crate::error::Refusal;
 use crate::grid::NodeBox;
 use crate::materials::MaterialModel;
 use serde::{Deserialize, Serialize};
@@ -303,50 +304,56 @@ impl MotionSpec {
         }
     }
 
-    /// Checks the fields for a scene of `dimension`: `Err((field, rule))`.
-    pub fn check(&self, dimension: usize) -> Result<(), (&'static str, String)> {
+    /// Checks the fields for a scene of `dimension`: or the [`Refusal`] of the field.
+    pub fn check(&self, dimension: usize) -> Result<(), Refusal> {
         for (field, v) in [("min", &self.min), ("max", &self.max)] {
             if v.len() != dimension {
-                return Err((field, format!("needs {dimension} entries, one per axis")));
+                return Err(Refusal::new(
+                    field,
+                    format!("needs {dimension} entries, one per axis"),
+                ));
             }
         }
         for (field, v) in [("min", &self.min), ("max", &self.max)] {
             if let Some(k) = v.iter().position(|x| !x.is_finite()) {
-                return Err((
+                return Err(Refusal::new(
                     field,
                     format!("entry {k} must be a finite coordinate (m), found {}", v[k]),
                 ));
             }
         }
         if self.min.iter().zip(&self.max).any(|(lo, hi)| lo > hi) {
-            return Err(("max", "every entry must be at least min's".into()));
+            return Err(Refusal::new("max", "every entry must be at least min's".into()));
         }
         if self.velocity.len() != dimension {
-            return Err((
+            return Err(Refusal::new(
                 "velocity",
                 format!("needs {dimension} entries (Some(m/s) or None)"),
             ));
         }
         if self.velocity.iter().flatten().any(|v| !v.is_finite()) {
-            return Err(("velocity", "must be finite".into()));
+            return Err(Refusal::new("velocity", "must be finite".into()));
         }
         if self.speed() <= 0.0 {
-            return Err((
+            return Err(Refusal::new(
                 "velocity",
                 "must move: at least one entry Some and not zero".into(),
             ));
         }
         if !(self.travel.is_finite() && self.travel > 0.0) {
-            return Err(("travel", "must be above 0 (m)".into()));
+            return Err(Refusal::new("travel", "must be above 0 (m)".into()));
         }
         if let Some(inc) = self.increment {
             if !(inc.is_finite() && inc > 0.0 && inc <= self.travel) {
-                return Err(("increment", "must be above 0 and at most travel (m)".into()));
+                return Err(Refusal::new(
+                    "increment",
+                    "must be above 0 and at most travel (m)".into(),
+                ));
             }
         }
         if let Some(a) = self.area {
             if !(a.is_finite() && a > 0.0) {
-                return Err(("area", "must be above 0".into()));
+                return Err(Refusal::new("area", "must be above 0".into()));
             }
         }
         Ok(())

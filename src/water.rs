@@ -23,6 +23,7 @@
 //! crosses ([`Water::density_ratio`]). A point that moves keeps its mass: soil that settles
 //! below a table is buoyed up, but not wetted.
 
+use crate::error::Refusal;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::sync::Arc;
@@ -352,13 +353,10 @@ impl Water {
     }
 }
 
-/// Why a surface cannot be used: (field under the surface, rule).
-type Refusal = (String, String);
-
 /// Checks `surface` for a grid spanning `lo..hi` across gravity (`across` axes, `n` of them)
 /// and turns it into a [`Head`].
 fn head(surface: &Surface, n: usize, lo: [f64; 2], hi: [f64; 2]) -> Result<Head, Refusal> {
-    let bad = |f: &str, r: String| Err((f.to_string(), r));
+    let bad = |f: &str, r: String| Err(Refusal::new(f.to_string(), r));
     match surface {
         Surface::Level(h) if h.is_finite() => Ok(Head::Level(*h)),
         Surface::Level(h) => bad("", format!("must be a finite height (m), found {h}")),
@@ -470,7 +468,7 @@ impl Frame<'_> {
     /// Gravity's axis: gravity must point down one axis.
     fn axis(&self) -> Result<usize, Refusal> {
         let Some(g) = self.gravity else {
-            return Err((
+            return Err(Refusal::new(
                 String::new(),
                 "pore pressure is hydrostatic: the scene needs gravity".into(),
             ));
@@ -478,8 +476,8 @@ impl Frame<'_> {
         let along: Vec<usize> = (0..g.len()).filter(|&a| g[a] != 0.0).collect();
         match along[..] {
             [axis] if g[axis] < 0.0 => Ok(axis),
-            _ => Err((
-                "gravity.acceleration".into(),
+            _ => Err(Refusal::new(
+                "gravity.acceleration",
                 "with water, gravity points down one axis (a negative entry, the others 0): \
                  heights are measured up that axis"
                     .into(),
@@ -502,14 +500,7 @@ impl Frame<'_> {
         for (k, &a) in across.iter().enumerate() {
             (lo[k], hi[k]) = (self.lo[a], self.hi[a]);
         }
-        let within = |f: &str, (g, r): Refusal| {
-            let field = if g.is_empty() {
-                f.to_string()
-            } else {
-                format!("{f}.{g}")
-            };
-            (field, r)
-        };
+        let within = |f: &str, e: Refusal| e.under(f);
         // Pore pressures and seepage forces a run can hold: γ_w |h − z| and γ_w |∇h| at
         // most 1e15 (a table 1e306 m up would write pore pressures of inf).
         let bounded = |f: &str, h: Head| -> Result<Head, Refusal> {
@@ -519,7 +510,7 @@ impl Frame<'_> {
             let (pressure, seepage) = (unit_weight * depth, unit_weight * steep);
             let within = |v: f64| v.is_finite() && v <= MOST_PRESSURE;
             if !within(pressure) || !within(seepage) {
-                return Err((
+                return Err(Refusal::new(
                     f.to_string(),
                     format!(
                         "a pore pressure γ_w |h − z| or seepage force γ_w |∇h| above 1e15 (the \
@@ -537,7 +528,10 @@ impl Frame<'_> {
         for (name, surface) in material_tables {
             let field = format!("material_tables.{name}");
             let Some(m) = self.materials.iter().position(|(n, _)| n == name) else {
-                return Err((field, format!("the scene has no material \"{name}\"")));
+                return Err(Refusal::new(
+                    field,
+                    format!("the scene has no material \"{name}\""),
+                ));
             };
             of_material[m] = heads.len() as u16;
             let h = head(surface, n - 1, lo, hi).map_err(|e| within(&field, e))?;
@@ -558,12 +552,12 @@ impl Frame<'_> {
 }
 
 impl WaterSpec {
-    /// The checked water of a scene framed by `frame`. As (field under `water`, rule) on
-    /// failure; a field that starts with `gravity` is the scene's own.
+    /// The checked water of a scene framed by `frame`, or the [`Refusal`] of a field under
+    /// `water` (one that starts with `gravity` is the scene's own).
     pub fn checked(&self, frame: &Frame) -> Result<Water, Refusal> {
         if !(self.unit_weight.is_finite() && self.unit_weight > 0.0) {
-            return Err((
-                "unit_weight".into(),
+            return Err(Refusal::new(
+                "unit_weight",
                 format!("must be above 0 N/m³, found {}", self.unit_weight),
             ));
         }
@@ -573,11 +567,14 @@ impl WaterSpec {
         for (name, &rho) in &self.saturated_density {
             let field = format!("saturated_density.{name}");
             let Some(m) = frame.materials.iter().position(|(n, _)| n == name) else {
-                return Err((field, format!("the scene has no material \"{name}\"")));
+                return Err(Refusal::new(
+                    field,
+                    format!("the scene has no material \"{name}\""),
+                ));
             };
             let dry = frame.materials[m].1;
             if !(rho.is_finite() && rho >= dry) {
-                return Err((
+                return Err(Refusal::new(
                     field,
                     format!("must be at least the material's dry density ({dry} kg/m³), found {rho}"),
                 ));
@@ -603,8 +600,8 @@ impl WaterSpec {
 }
 
 impl StageWaterSpec {
-    /// The scene's `water` with this stage's surfaces. As (field under the stage's `water`,
-    /// rule) on failure.
+    /// The scene's `water` with this stage's surfaces, or the [`Refusal`] of a field under
+    /// the stage's `water`.
     pub fn checked(&self, water: &Water, frame: &Frame) -> Result<Water, Refusal> {
         let (heads, of_material) = frame.heads(
             water.axis,
@@ -703,14 +700,14 @@ mod tests {
             vec![11.0, 4.0],
             vec![20.0, 4.0],
         ]));
-        let (field, rule) = back.checked(&f).unwrap_err();
+        let Refusal { field, rule } = back.checked(&f).unwrap_err();
         assert_eq!(field, "table");
         assert!(rule.contains("not a function of x"), "{rule}");
         let short = spec(Surface::Polyline(vec![vec![0.0, 5.0], vec![15.0, 5.0]]));
         assert!(short
             .checked(&f)
             .unwrap_err()
-            .1
+            .rule
             .contains("reach across the whole grid"));
     }
 }

@@ -1,6 +1,7 @@
 //! Linear isotropic elasticity (Hooke's law in rate form).
 
 use super::{Elasticity, Material, SceneMaterial};
+use crate::error::Refusal;
 use crate::infra::lanes::LANES;
 use crate::tensor::{Sym3, Sym3x4};
 use serde::{Deserialize, Serialize};
@@ -19,7 +20,7 @@ pub struct LinearElasticSpec {
 
 impl SceneMaterial for LinearElasticSpec {
     type Model = LinearElastic;
-    fn model(&self, at: &dyn Fn(&str) -> String) -> Result<LinearElastic, (String, String)> {
+    fn model(&self, at: &dyn Fn(&str) -> String) -> Result<LinearElastic, Refusal> {
         let elasticity = Elasticity::checked(at, self.density, self.youngs_modulus, self.poisson_ratio)?;
         Ok(LinearElastic {
             density: self.density,

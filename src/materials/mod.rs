@@ -20,6 +20,7 @@ pub use linear_elastic::{LinearElastic, LinearElasticSpec};
 pub use mohr_coulomb::{MohrCoulomb, MohrCoulombSpec, PlasticStrain, Return};
 pub use mohr_coulomb_softening::{MohrCoulombSoftening, MohrCoulombSofteningSpec, SofteningStrain};
 
+use crate::error::Refusal;
 use crate::infra::lanes::{Lanes, LANES};
 use crate::tensor::{Sym, Sym3, Sym3x4};
 use hecs::Archetype;
@@ -88,7 +89,7 @@ pub trait SceneMaterial: Clone + PartialEq + Debug + Serialize + DeserializeOwne
     type Model: Material + Clone + PartialEq + Debug;
     /// The model, each field checked; an error names the field (through `at`, which makes a
     /// field's dotted path) and the rule it breaks.
-    fn model(&self, at: &dyn Fn(&str) -> String) -> Result<Self::Model, (String, String)>;
+    fn model(&self, at: &dyn Fn(&str) -> String) -> Result<Self::Model, Refusal>;
     /// Divides the strength by `factor` for a strength-reduction analysis (c and tan φ, and
     /// what else the model holds as strength); false for a model without strength.
     fn reduce_strength(&mut self, _factor: f64) -> bool {
@@ -190,7 +191,7 @@ macro_rules! define_materials {
         impl MaterialSpec {
             /// The model, each field checked, and its wave speed; an error names the field
             /// (through `at`) and the rule.
-            pub fn model(&self, at: &dyn Fn(&str) -> String) -> Result<MaterialModel, (String, String)> {
+            pub fn model(&self, at: &dyn Fn(&str) -> String) -> Result<MaterialModel, Refusal> {
                 let model = match self {
                     $(MaterialSpec::$variant(s) => MaterialModel::$variant(s.model(at)?),)*
                 };
@@ -199,7 +200,7 @@ macro_rules! define_materials {
                 // M/ρ).
                 let speed = (model.p_wave_modulus() / model.density()).sqrt();
                 if !(speed > 0.0 && speed.is_finite()) {
-                    return Err((
+                    return Err(Refusal::new(
                         at("youngs_modulus"),
                         format!(
                             "M = {} Pa with ρ = {} kg/m³ gives a P-wave speed of {speed} m/s, not \
@@ -348,19 +349,22 @@ impl Elasticity {
         density: f64,
         youngs_modulus: f64,
         poisson_ratio: f64,
-    ) -> Result<Self, (String, String)> {
+    ) -> Result<Self, Refusal> {
         let positive = |x: f64| x > 0.0 && x.is_finite();
         if !positive(density) {
-            return Err((at("density"), format!("must be > 0 kg/m³, found {density}")));
+            return Err(Refusal::new(
+                at("density"),
+                format!("must be > 0 kg/m³, found {density}"),
+            ));
         }
         if !(positive(youngs_modulus) && youngs_modulus <= MAX_MODULUS) {
-            return Err((
+            return Err(Refusal::new(
                 at("youngs_modulus"),
                 format!("must be > 0 Pa and at most {MAX_MODULUS:e} Pa, found {youngs_modulus:e}"),
             ));
         }
         if !(0.0..0.5).contains(&poisson_ratio) {
-            return Err((
+            return Err(Refusal::new(
                 at("poisson_ratio"),
                 format!("must be in [0, 0.5), found {poisson_ratio}"),
             ));

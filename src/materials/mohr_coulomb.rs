@@ -16,6 +16,7 @@
 //! σ1' = σ3' (1 + sin φ)/(1 − sin φ) + 2c cos φ/(1 − sin φ).
 
 use super::{update_lane_by_lane, Elasticity, Material, MaterialState, SceneMaterial};
+use crate::error::Refusal;
 use crate::infra::lanes::{gather, F64x4, Lanes, LANES};
 use crate::tensor::{Sym, Sym3, Sym3x4};
 use glam::DVec3;
@@ -50,33 +51,33 @@ pub(super) fn check_strength(
     at: &dyn Fn(&str) -> String,
     (c, phi, psi): (f64, f64, f64),
     tension_cutoff: Option<f64>,
-) -> Result<(), (String, String)> {
+) -> Result<(), Refusal> {
     let non_negative = |x: f64| x >= 0.0 && x.is_finite();
     if !non_negative(c) {
-        return Err((at("cohesion"), format!("must be ≥ 0 Pa, found {c}")));
+        return Err(Refusal::new(at("cohesion"), format!("must be ≥ 0 Pa, found {c}")));
     }
     if !(0.0..90.0).contains(&phi) {
-        return Err((
+        return Err(Refusal::new(
             at("friction_angle"),
             format!("must be in [0°, 90°), found {phi}°"),
         ));
     }
     if !(non_negative(psi) && psi <= phi) {
-        return Err((
+        return Err(Refusal::new(
             at("dilatancy_angle"),
             format!("must be in [0°, φ = {phi}°], found {psi}°"),
         ));
     }
     if let Some(t) = tension_cutoff {
         if !non_negative(t) {
-            return Err((
+            return Err(Refusal::new(
                 at("tension_cutoff"),
                 format!("must be a finite stress ≥ 0 Pa (at most c·cot φ), found {t}"),
             ));
         }
     }
     if phi == 0.0 && c == 0.0 {
-        return Err((
+        return Err(Refusal::new(
             at("cohesion"),
             "with φ = 0 the cohesion must be > 0 (no strength at all)".into(),
         ));
@@ -91,7 +92,7 @@ pub(super) fn reduce_angle(deg: f64, factor: f64) -> f64 {
 
 impl SceneMaterial for MohrCoulombSpec {
     type Model = MohrCoulomb;
-    fn model(&self, at: &dyn Fn(&str) -> String) -> Result<MohrCoulomb, (String, String)> {
+    fn model(&self, at: &dyn Fn(&str) -> String) -> Result<MohrCoulomb, Refusal> {
         Elasticity::checked(at, self.density, self.youngs_modulus, self.poisson_ratio)?;
         let strength = (self.cohesion, self.friction_angle, self.dilatancy_angle);
         check_strength(at, strength, self.tension_cutoff)?;

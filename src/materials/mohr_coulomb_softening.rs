@@ -14,6 +14,7 @@ use super::mohr_coulomb::{check_strength, reduce_angle};
 use super::{
     update_lane_by_lane, Elasticity, Material, MaterialState, MohrCoulomb, PlasticStrain, SceneMaterial,
 };
+use crate::error::Refusal;
 use crate::infra::lanes::LANES;
 use crate::tensor::{Sym3, Sym3x4};
 use serde::{Deserialize, Serialize};
@@ -55,7 +56,7 @@ pub struct MohrCoulombSofteningSpec {
 
 impl SceneMaterial for MohrCoulombSofteningSpec {
     type Model = MohrCoulombSoftening;
-    fn model(&self, at: &dyn Fn(&str) -> String) -> Result<MohrCoulombSoftening, (String, String)> {
+    fn model(&self, at: &dyn Fn(&str) -> String) -> Result<MohrCoulombSoftening, Refusal> {
         let elasticity = Elasticity::checked(at, self.density, self.youngs_modulus, self.poisson_ratio)?;
         let peak = (self.cohesion, self.friction_angle, self.dilatancy_angle);
         check_strength(at, peak, self.tension_cutoff)?;
@@ -67,20 +68,23 @@ impl SceneMaterial for MohrCoulombSofteningSpec {
         let residual_at = |f: &str| at(&format!("residual_{f}"));
         check_strength(&residual_at, residual, None)?;
         if residual.0 > peak.0 {
-            return Err((
+            return Err(Refusal::new(
                 at("residual_cohesion"),
                 format!("must be at most the peak c = {} Pa, found {}", peak.0, residual.0),
             ));
         }
         if residual.1 > peak.1 {
-            return Err((
+            return Err(Refusal::new(
                 at("residual_friction_angle"),
                 format!("must be at most the peak φ = {}°, found {}°", peak.1, residual.1),
             ));
         }
         let k = self.softening_strain;
         if !(k > 0.0 && k.is_finite()) {
-            return Err((at("softening_strain"), format!("must be > 0, found {k}")));
+            return Err(Refusal::new(
+                at("softening_strain"),
+                format!("must be > 0, found {k}"),
+            ));
         }
         Ok(MohrCoulombSoftening {
             density: self.density,
@@ -350,11 +354,11 @@ mod tests {
     fn a_residual_above_the_peak_is_refused_by_field() {
         let mut s = spec();
         s.residual_friction_angle = 35.0;
-        let (field, rule) = s.model(&|f| format!("materials.soil.{f}")).unwrap_err();
+        let crate::error::Refusal { field, rule } = s.model(&|f| format!("materials.soil.{f}")).unwrap_err();
         assert_eq!(field, "materials.soil.residual_friction_angle");
         assert!(rule.contains("peak φ = 30°"), "{rule}");
         let mut s = spec();
         s.softening_strain = 0.0;
-        assert_eq!(s.model(&|f| f.to_string()).unwrap_err().0, "softening_strain");
+        assert_eq!(s.model(&|f| f.to_string()).unwrap_err().field, "softening_strain");
     }
 }

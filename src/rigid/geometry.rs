@@ -6,6 +6,7 @@
 //! soil's mass gradient, so a flat face pushes straight and a circle pushes radially.
 
 use super::mesh::TriangleMesh;
+use crate::error::Refusal;
 use serde::{Deserialize, Serialize};
 use std::sync::Arc;
 
@@ -138,9 +139,9 @@ impl Geometry {
 
     /// Reads a mesh's STL file, `dir` the scene file's directory; other shapes have nothing
     /// to read. An error names the field and what is wrong with the file.
-    pub fn read(&mut self, dir: &std::path::Path) -> Result<(), (String, String)> {
+    pub fn read(&mut self, dir: &std::path::Path) -> Result<(), Refusal> {
         if let Geometry::Mesh { file, mesh } = self {
-            let m = TriangleMesh::read(&dir.join(&*file)).map_err(|e| ("geometry.file".to_string(), e))?;
+            let m = TriangleMesh::read(&dir.join(&*file)).map_err(|e| Refusal::new("geometry.file", e))?;
             *mesh = Some(Arc::new(m));
         }
         Ok(())
@@ -164,9 +165,10 @@ impl Geometry {
 
 impl Geometry {
     /// The rules a shape holds in `n` dimensions (`axisymmetric`: in (r, z), where a
-    /// polygon turns about the axis and a circle centred on it is a ball), as (field, rule).
-    pub fn check(&self, n: usize, axisymmetric: bool) -> Result<(), (String, String)> {
-        let bad = |f: &str, r: String| Err((f.to_string(), r));
+    /// polygon turns about the axis and a circle centred on it is a ball), or the
+    /// [`Refusal`] of the field.
+    pub fn check(&self, n: usize, axisymmetric: bool) -> Result<(), Refusal> {
+        let bad = |f: &str, r: String| Err(Refusal::new(f.to_string(), r));
         let finite = |v: &[f64]| v.iter().all(|c| c.is_finite());
         let plane = matches!(self, Geometry::Circle { .. } | Geometry::Polygon { .. });
         if axisymmetric && !plane {

@@ -25,6 +25,7 @@ pub use contact::Contact;
 pub use geometry::{Geometry, Sample};
 pub use reach::Reach;
 
+use crate::error::Refusal;
 use serde::{Deserialize, Serialize};
 
 /// A rigid body as the scene gives it.
@@ -232,11 +233,11 @@ impl RigidBodySpec {
         (lo, hi)
     }
 
-    /// The rules a body holds by itself in `n` dimensions (`axisymmetric`: (r, z)), as
-    /// (field, rule). Its place in the grid is checked with the grid
+    /// The rules a body holds by itself in `n` dimensions (`axisymmetric`: (r, z)), or the
+    /// [`Refusal`] of the field. Its place in the grid is checked with the grid
     /// (`scene::validate::rigid_bodies`).
-    pub fn check(&self, n: usize, axisymmetric: bool) -> Result<(), (String, String)> {
-        let bad = |f: &str, r: String| Err((f.to_string(), r));
+    pub fn check(&self, n: usize, axisymmetric: bool) -> Result<(), Refusal> {
+        let bad = |f: &str, r: String| Err(Refusal::new(f.to_string(), r));
         if self.parts.is_empty() {
             return bad("parts", "a body needs at least one part".into());
         }
@@ -257,9 +258,10 @@ impl RigidBodySpec {
             }
             p.geometry
                 .check(n, axisymmetric)
-                .map_err(|(f, r)| (format!("parts[{k}].{f}"), r))?;
+                .map_err(|r| r.under(&format!("parts[{k}]")))?;
             if let Some(i) = p.interface {
-                i.check().map_err(|r| (format!("parts[{k}].interface"), r))?;
+                i.check()
+                    .map_err(|r| Refusal::new(format!("parts[{k}].interface"), r))?;
             }
         }
         self.check_interface_and_motion(n, axisymmetric)
@@ -268,8 +270,8 @@ impl RigidBodySpec {
     /// The interface, the area and the control; in an axisymmetric scene the body, a solid
     /// of revolution, moves along the axis only (a radial motion of its section would open
     /// it into a ring, which no rigid body does).
-    fn check_interface_and_motion(&self, n: usize, axisymmetric: bool) -> Result<(), (String, String)> {
-        let bad = |f: &str, r: String| Err((f.to_string(), r));
+    fn check_interface_and_motion(&self, n: usize, axisymmetric: bool) -> Result<(), Refusal> {
+        let bad = |f: &str, r: String| Err(Refusal::new(f.to_string(), r));
         let finite = |v: &[f64]| v.iter().all(|c| c.is_finite());
         // The radial entry `along_r` (in `unit`) of a control: none in an axisymmetric scene.
         let radial = |field: &str, along_r: f64, unit: &str| {
@@ -284,7 +286,7 @@ impl RigidBodySpec {
             }
             Ok(())
         };
-        self.interface.check().map_err(|r| ("interface".to_string(), r))?;
+        self.interface.check().map_err(|r| Refusal::new("interface", r))?;
         if let Some(a) = self.area {
             if !(a.is_finite() && a > 0.0) {
                 return bad("area", format!("must be above 0, found {a}"));
@@ -430,13 +432,13 @@ impl RigidBodySpec {
             .collect()
     }
 
-    /// Reads its parts' STL meshes (`dir`: the scene file's directory), as (field, rule) on
-    /// failure.
-    pub fn read_meshes(&mut self, dir: &std::path::Path) -> Result<(), (String, String)> {
+    /// Reads its parts' STL meshes (`dir`: the scene file's directory), or the
+    /// [`Refusal`] of the file's field.
+    pub fn read_meshes(&mut self, dir: &std::path::Path) -> Result<(), Refusal> {
         for (k, p) in self.parts.iter_mut().enumerate() {
             p.geometry
                 .read(dir)
-                .map_err(|(f, r)| (format!("parts[{k}].{f}"), r))?;
+                .map_err(|r| r.under(&format!("parts[{k}]")))?;
         }
         Ok(())
     }

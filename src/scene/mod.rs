@@ -13,7 +13,7 @@ pub use crate::materials::MaterialSpec;
 pub use build::build;
 pub use validate::{check, Checked, CheckedGrid, CheckedStage, Derived, Estimate, FaceHold};
 
-use crate::error::SceneError;
+use crate::error::{Refusal, SceneError};
 use crate::grid::Face;
 use crate::shape::ShapeKind;
 use crate::state::{Damping, ForceNorm, MotionSpec, Scheme, StaticCheck};
@@ -671,7 +671,7 @@ impl LoadedScene {
         // The rigid bodies' STL meshes, beside the scene file.
         let dir = path.parent().unwrap_or(Path::new("."));
         for i in 0..loaded.scene.rigid_bodies.len() {
-            if let Err((f, rule)) = loaded.scene.rigid_bodies[i].read_meshes(dir) {
+            if let Err(Refusal { field: f, rule }) = loaded.scene.rigid_bodies[i].read_meshes(dir) {
                 return Err(loaded.invalid(&format!("rigid_bodies[{i}].{f}"), rule));
             }
         }

@@ -1,6 +1,7 @@
 //! The grid: origin, cell size and counts, the shape's needs, and the face conditions.
 
 use super::*;
+use crate::error::Refusal;
 use crate::error::SceneError;
 use crate::rigid::check_friction_angle;
 use crate::scene::{pad3, BoundarySpec, Condition};
@@ -39,11 +40,11 @@ pub struct FaceHold {
 
 /// In an axisymmetric scene the lower x face is the axis, a symmetry face: a `Roller`
 /// (u_r = 0 and free along it), and nothing else. `field`: where the faces are.
-pub(super) fn check_axis(faces: &[FaceHold], field: &str) -> Result<(), (String, String)> {
+pub(super) fn check_axis(faces: &[FaceHold], field: &str) -> Result<(), Refusal> {
     let axis = faces.iter().find(|f| f.axis == 0 && !f.upper);
     match axis {
         Some(f) if f.mask == 1 && f.friction.is_none() => Ok(()),
-        _ => Err((
+        _ => Err(Refusal::new(
             field.to_string(),
             "the axis of an axisymmetric scene (the XMin face, r = 0) is a symmetry face: give it \
              `(face: XMin, condition: Roller)`, and no other condition"
@@ -54,22 +55,18 @@ pub(super) fn check_axis(faces: &[FaceHold], field: &str) -> Result<(), (String,
 
 /// Checks a list of face conditions (`field`: where it is in the scene): faces of the
 /// grid's dimension `n`, one condition a face. Returns them as the nodes hold them.
-pub(super) fn check_faces(
-    list: &[BoundarySpec],
-    field: &str,
-    n: usize,
-) -> Result<Vec<FaceHold>, (String, String)> {
+pub(super) fn check_faces(list: &[BoundarySpec], field: &str, n: usize) -> Result<Vec<FaceHold>, Refusal> {
     let mut holds = Vec::with_capacity(list.len());
     for (i, bc) in list.iter().enumerate() {
         if bc.face.axis_side().0 >= n {
-            return Err((
+            return Err(Refusal::new(
                 format!("{field}[{i}].face"),
                 format!("{:?} does not exist in {n}D", bc.face),
             ));
         }
         // One condition a face: two would leave the reader to guess which one holds.
         if let Some(j) = list[..i].iter().position(|o| o.face == bc.face) {
-            return Err((
+            return Err(Refusal::new(
                 format!("{field}[{i}].face"),
                 format!(
                     "{:?} already has a condition ({field}[{j}]): give each face one condition \
@@ -83,7 +80,8 @@ pub(super) fn check_faces(
             Condition::Fixed => ((1u8 << n) - 1, None),
             Condition::Roller => (1u8 << axis, None),
             Condition::Friction(angle) => {
-                check_friction_angle(angle).map_err(|r| (format!("{field}[{i}].condition"), r))?;
+                check_friction_angle(angle)
+                    .map_err(|r| Refusal::new(format!("{field}[{i}].condition"), r))?;
                 (1u8 << axis, Some(angle.to_radians().tan()))
             }
         };
@@ -152,7 +150,7 @@ pub(super) fn check_grid(r: &Rules) -> Result<CheckedGrid, SceneError> {
         );
     }
     let faces = check_faces(&s.boundaries, "boundaries", n)
-        .map_err(|(field, rule)| r.loaded.invalid(&field, rule))?;
+        .map_err(|Refusal { field, rule }| r.loaded.invalid(&field, rule))?;
     if s.dimension == crate::scene::Dimension::Axisymmetric {
         if s.grid.origin[0] != 0.0 {
             return r.bad(
@@ -164,7 +162,7 @@ pub(super) fn check_grid(r: &Rules) -> Result<CheckedGrid, SceneError> {
                 ),
             );
         }
-        check_axis(&faces, "boundaries").map_err(|(field, rule)| r.loaded.invalid(&field, rule))?;
+        check_axis(&faces, "boundaries").map_err(|Refusal { field, rule }| r.loaded.invalid(&field, rule))?;
     }
     let mut cells = [0usize; 3];
     cells[..n].copy_from_slice(&s.grid.cells);

@@ -84,7 +84,7 @@ pub(super) fn check_materials(r: &Rules) -> Result<Vec<(String, MaterialModel)>,
         let at = |f: &str| format!("materials.{name}.{f}");
         let model = m
             .model(&at)
-            .map_err(|(field, rule)| loaded.invalid(&field, rule))?;
+            .map_err(|Refusal { field, rule }| loaded.invalid(&field, rule))?;
         table.push((name.clone(), model));
     }
     Ok(table)

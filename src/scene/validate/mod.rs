@@ -22,6 +22,7 @@ pub use memory::Estimate;
 pub(crate) use motions::check_motion_boxes;
 pub use stages::CheckedStage;
 
+use crate::error::Refusal;
 use bodies::check_bodies;
 use grid::check_grid;
 use loads::{check_has_load, check_loads, check_tractions_and_traced};
@@ -138,7 +139,7 @@ pub struct Checked {
 /// Names that label output (columns of `history.csv`, rows of `curve.csv` and
 /// `stages.csv`) are unique within their list: two traced points called "top" would give
 /// two columns of one name.
-fn unique_names(s: &super::Scene) -> Result<(), (String, String)> {
+fn unique_names(s: &super::Scene) -> Result<(), Refusal> {
     let lists: [(&str, Vec<&str>); 5] = [
         ("traced", s.traced.iter().map(|t| t.name.as_str()).collect()),
         (
@@ -152,7 +153,7 @@ fn unique_names(s: &super::Scene) -> Result<(), (String, String)> {
     for (field, names) in lists {
         for (i, name) in names.iter().enumerate() {
             if let Some(j) = names[..i].iter().position(|m| m == name) {
-                return Err((
+                return Err(Refusal::new(
                     format!("{field}[{i}].name"),
                     format!("\"{name}\" is also the name of {field}[{j}]: each needs its own name"),
                 ));

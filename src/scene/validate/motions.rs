@@ -27,9 +27,9 @@ pub(super) fn check_motions_and_analyses(r: &Rules) -> Result<(), SceneError> {
     }
     for (i, m) in s.motions.iter().enumerate() {
         m.check(s.dimension.axes())
-            .map_err(|(field, rule)| loaded.invalid(&format!("motions[{i}].{field}"), rule))?;
+            .map_err(|Refusal { field, rule }| loaded.invalid(&format!("motions[{i}].{field}"), rule))?;
     }
-    unique_names(s).map_err(|(field, rule)| loaded.invalid(&field, rule))?;
+    unique_names(s).map_err(|Refusal { field, rule }| loaded.invalid(&field, rule))?;
     if let Some(spec) = &s.strength_reduction {
         let ok =
             matches!(spec.bracket[..], [lo, hi] if lo.is_finite() && hi.is_finite() && 0.0 < lo && lo < hi);

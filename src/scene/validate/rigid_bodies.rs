@@ -4,6 +4,7 @@
 //! travel: it is stopped if it leaves the grid), and that no two overlap.
 
 use super::*;
+use crate::error::Refusal;
 use crate::error::SceneError;
 
 /// Every rigid body, then the rules between bodies and with the grid.
@@ -25,7 +26,7 @@ pub(super) fn check_rigid_bodies(r: &Rules) -> Result<(), SceneError> {
     for (i, b) in s.rigid_bodies.iter().enumerate() {
         let field = |f: &str| format!("rigid_bodies[{i}].{f}");
         b.check(n, s.dimension == crate::scene::Dimension::Axisymmetric)
-            .map_err(|(f, rule)| loaded.invalid(&field(&f), rule))?;
+            .map_err(|Refusal { field: f, rule }| loaded.invalid(&field(&f), rule))?;
         if let Some(j) = s.motions.iter().position(|m| m.name == b.name) {
             return r.bad(
                 &field("name"),

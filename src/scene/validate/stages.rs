@@ -75,7 +75,7 @@ fn stage_materials(
         let at = |f: &str| format!("stages[{k}].materials.{name}.{f}");
         let model = spec
             .model(&at)
-            .map_err(|(field, rule)| loaded.invalid(&field, rule))?;
+            .map_err(|Refusal { field, rule }| loaded.invalid(&field, rule))?;
         // A point carries one model's state for the whole run.
         if let Some(carried) = carried_state(loaded, table, name) {
             if let (Some(a), Some(b)) = (carried.state_name(), model.state_name()) {
@@ -161,13 +161,13 @@ fn stage_faces(r: &Rules, k: usize) -> Result<Option<Vec<FaceHold>>, SceneError>
     let faces = match &st.boundaries {
         Some(b) => Some(
             check_faces(b, &format!("stages[{k}].boundaries"), n)
-                .map_err(|(field, rule)| loaded.invalid(&field, rule))?,
+                .map_err(|Refusal { field, rule }| loaded.invalid(&field, rule))?,
         ),
         None => None,
     };
     if let (Some(f), crate::scene::Dimension::Axisymmetric) = (&faces, s.dimension) {
         check_axis(f, &format!("stages[{k}].boundaries"))
-            .map_err(|(field, rule)| loaded.invalid(&field, rule))?;
+            .map_err(|Refusal { field, rule }| loaded.invalid(&field, rule))?;
     }
     if let Some(i) = faces.iter().flatten().position(|f| f.friction.is_some()) {
         return r.bad(

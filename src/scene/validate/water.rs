@@ -4,6 +4,7 @@
 
 use super::grid::CheckedGrid;
 use super::*;
+use crate::error::Refusal;
 use crate::error::SceneError;
 use crate::materials::MaterialModel;
 use crate::water::{Frame, Water};
@@ -29,7 +30,7 @@ pub(super) fn check_water(
         materials: &materials,
         axisymmetric: s.dimension == crate::scene::Dimension::Axisymmetric,
     };
-    let at = |prefix: &str, (field, rule): (String, String)| {
+    let at = |prefix: &str, Refusal { field, rule }: Refusal| {
         let field = match field.as_str() {
             "" => prefix.to_string(),
             f if f.starts_with("gravity") => f.to_string(),
