@@ -716,14 +716,11 @@ fn a_smooth_ball_in_confined_tresca_clay_has_the_flow_round_factor() {
     assert!(ball.deepest_entry < 0.1 * 0.25, "{ball:?}");
 }
 
-/// The same ball read from STL files of 528 and 3 480 triangles (UV spheres of 24 × 12
-/// and 60 × 30 pieces): over the first 0.2 D its mean N is the smooth `Sphere`'s, 12.06
-/// (the test above), within 2 % (12.10, +0.4 %; 11.83, −1.9 %), pinned. A sample on
-/// every piece of every triangle once made the fine file's samples many times as dense
-/// and bore +6 % and +17 % more than the sphere (docs/verification.md).
-#[test]
-fn a_faceted_ball_bears_as_the_smooth_one_whatever_its_facets() {
-    let dir = common::scratch("rigid_bodies", "faceted_ball");
+/// `scenes/ball_3d.ron`'s ball read from an STL file, a UV sphere of `around` × `rings`
+/// pieces, over its first 0.2 D: the mean N, checked within 2 % of the smooth `Sphere`'s
+/// 12.06 (the test above) and returned.
+fn faceted_ball(around: usize, rings: usize) -> f64 {
+    let dir = common::scratch("rigid_bodies", &format!("faceted_ball_{around}"));
     let text = std::fs::read_to_string(common::scene("ball_3d.ron"))
         .unwrap()
         .replace(
@@ -732,23 +729,35 @@ fn a_faceted_ball_bears_as_the_smooth_one_whatever_its_facets() {
         )
         .replace("travel: 2.0", "travel: 0.2");
     let sphere = (12.247583251817822 + 11.868216445944032) / 2.0;
-    for ((around, rings), pinned) in [((24, 12), 12.100199609349708), ((60, 30), 11.829122937870535)] {
-        let t = kdmpm::rigid::mesh::sphere_triangles([0.0, 0.0, 4.0], 0.5, around, rings);
-        std::fs::write(
-            dir.join("ball.stl"),
-            common::stl("solid ball", &t, |x| format!("{x:?}")),
-        )
-        .unwrap();
-        let s = run_beside(&dir, &text).unwrap();
-        let n = factors(&s, 10.0e3);
-        let mean = n.iter().sum::<f64>() / n.len() as f64;
-        assert!(
-            rel(mean, sphere).abs() < 0.02,
-            "{} triangles: N {n:?} against {sphere}",
-            t.len()
-        );
-        assert_eq!(mean, pinned, "{} triangles", t.len());
-    }
+    let t = kdmpm::rigid::mesh::sphere_triangles([0.0, 0.0, 4.0], 0.5, around, rings);
+    std::fs::write(
+        dir.join("ball.stl"),
+        common::stl("solid ball", &t, |x| format!("{x:?}")),
+    )
+    .unwrap();
+    let s = run_beside(&dir, &text).unwrap();
+    let n = factors(&s, 10.0e3);
+    let mean = n.iter().sum::<f64>() / n.len() as f64;
+    assert!(
+        rel(mean, sphere).abs() < 0.02,
+        "{} triangles: N {n:?} against {sphere}",
+        t.len()
+    );
+    mean
+}
+
+/// The ball as 528 triangles (24 × 12): 12.10 (+0.4 % on the sphere), pinned. A sample
+/// on every piece of every triangle once made a mesh's samples denser than a smooth
+/// shape's, and this file bore +14 % over 0.3 D (docs/verification.md).
+#[test]
+fn a_coarsely_faceted_ball_bears_as_the_smooth_one() {
+    assert_eq!(faceted_ball(24, 12), 12.100199609349708);
+}
+
+/// The ball as 3 480 triangles (60 × 30): 11.83 (−1.9 %), pinned; once +6 % over 0.3 D.
+#[test]
+fn a_finely_faceted_ball_bears_as_the_smooth_one() {
+    assert_eq!(faceted_ball(60, 30), 11.829122937870535);
 }
 
 /// A body whose increment finds no static state before `max_time` (the footing's third
