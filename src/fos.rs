@@ -288,8 +288,8 @@ fn trial_dir(factor: f64) -> String {
 }
 
 /// Runs the scene at `factor` into its trial folder, stopping early once a point moved
-/// farther than the spec allows:
-/// `report` sees the trial, and it joins `trials`; a trial a signal stopped ends the analysis.
+/// farther than the spec allows; `report` sees the trial and it joins `trials`. A trial a
+/// signal stopped ends the analysis.
 fn run_trial(
     loaded: &LoadedScene,
     spec: &StrengthReductionSpec,

@@ -424,19 +424,10 @@ pub fn pressure(
             )));
         }
         RunQuantity::LimitPressure => "limit_pressure",
-        RunQuantity::MeanPressure { from, .. } if !(from.is_finite() && *from >= 0.0) => {
-            return Err(RefineError::NotRefinable(format!(
-                "--mean-from: the displacement from which rows count must be ≥ 0 m, found {from}"
-            )));
-        }
-        RunQuantity::MeanPressure { row, .. } if !loaded.scene.pressure_rows().contains(row) => {
-            return Err(RefineError::NotRefinable(format!(
-                "--mean-from: {name} has no curve row `{row}` with a pressure; the rows with an \
-                 `area` are: {}",
-                loaded.scene.pressure_rows().join(", ")
-            )));
-        }
-        RunQuantity::MeanPressure { .. } => "mean_pressure",
+        RunQuantity::MeanPressure { row, from } => match loaded.scene.pressure_window_fault(row, *from) {
+            Some(rule) => return Err(RefineError::NotRefinable(format!("{name}: --mean-from: {rule}"))),
+            None => "mean_pressure",
+        },
     };
     let tolerance = loaded.scene.solver.tolerance;
     let run = |scene: LoadedScene, dir: PathBuf, h: f64| {
@@ -519,11 +510,18 @@ pub fn factor_of_safety(
             e => RefineError::Fos(h, Box::new(e)),
         }
     };
+    // An analysis's answer, how finely its bracket knows it, and its wall time.
+    let answer = |r: &FosReport| {
+        (
+            r.factor_of_safety,
+            0.5 * (r.bracket[1] - r.bracket[0]),
+            r.wall_seconds,
+        )
+    };
     let analyse = |scene: LoadedScene, dir: PathBuf, h: f64| {
         let report =
             crate::fos::strength_reduction(&scene, &dir, |t| (show.borrow_mut())(h, t)).map_err(fail(h))?;
-        let (value, wall) = (report.factor_of_safety, report.wall_seconds);
-        let resolution = 0.5 * (report.bracket[1] - report.bracket[0]);
+        let (value, resolution, wall) = answer(&report);
         Ok(((report, scene, dir), value, resolution, wall))
     };
     // Each bisection halved again, to an eighth of the scene's tolerance at most.
@@ -539,9 +537,7 @@ pub fn factor_of_safety(
         }
         let h = level.cell_size;
         crate::fos::narrow(scene, dir, report, tolerance, |t| (show.borrow_mut())(h, t)).map_err(fail(h))?;
-        level.value = report.factor_of_safety;
-        level.resolution = 0.5 * (report.bracket[1] - report.bracket[0]);
-        level.wall_seconds = report.wall_seconds;
+        (level.value, level.resolution, level.wall_seconds) = answer(report);
         Ok(true)
     };
     let ((report, _, _), refinement) = refine(

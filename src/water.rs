@@ -500,7 +500,6 @@ impl Frame<'_> {
         for (k, &a) in across.iter().enumerate() {
             (lo[k], hi[k]) = (self.lo[a], self.hi[a]);
         }
-        let within = |f: &str, e: Refusal| e.under(f);
         // Pore pressures and seepage forces a run can hold: γ_w |h − z| and γ_w |∇h| at
         // most 1e15 (a table 1e306 m up would write pore pressures of inf).
         let bounded = |f: &str, h: Head| -> Result<Head, Refusal> {
@@ -522,7 +521,7 @@ impl Frame<'_> {
             }
             Ok(h)
         };
-        let first = head(table, n - 1, lo, hi).map_err(|e| within("table", e))?;
+        let first = head(table, n - 1, lo, hi).map_err(|e| e.under("table"))?;
         let mut heads = vec![bounded("table", first)?];
         let mut of_material = vec![0u16; self.materials.len()];
         for (name, surface) in material_tables {
@@ -534,7 +533,7 @@ impl Frame<'_> {
                 ));
             };
             of_material[m] = heads.len() as u16;
-            let h = head(surface, n - 1, lo, hi).map_err(|e| within(&field, e))?;
+            let h = head(surface, n - 1, lo, hi).map_err(|e| e.under(&field))?;
             heads.push(bounded(&field, h)?);
         }
         Ok((heads, of_material))

@@ -578,6 +578,25 @@ impl Scene {
         });
         motions.chain(bodies).collect()
     }
+
+    /// Why the mean pressure of `curve.csv`'s rows `row` from a displacement of `from` (m)
+    /// on cannot be measured, if it cannot: the window starts at a displacement ≥ 0 and the
+    /// row carries a pressure ([`Self::pressure_rows`]). For `kdmpm study`'s and
+    /// `--refine`'s mean pressures alike.
+    pub fn pressure_window_fault(&self, row: &str, from: f64) -> Option<String> {
+        if !(from.is_finite() && from >= 0.0) {
+            return Some(format!(
+                "the displacement from which rows count must be ≥ 0 m, found {from}"
+            ));
+        }
+        let rows = self.pressure_rows();
+        (!rows.iter().any(|r| r == row)).then(|| {
+            format!(
+                "no curve row `{row}` has a pressure: the rows with an `area` are {}",
+                rows.join(", ")
+            )
+        })
+    }
 }
 
 impl LoadedScene {

@@ -446,21 +446,8 @@ fn check_quantities(
                 ));
             }
             Quantity::MeanPressure { name, from } => {
-                if !(from.is_finite() && *from >= 0.0) {
-                    return Err(at.invalid(
-                        &field,
-                        format!("`from` must be a displacement ≥ 0 m, found {from}"),
-                    ));
-                }
-                let rows = base.scene.pressure_rows();
-                if !rows.contains(name) {
-                    return Err(at.invalid(
-                        &field,
-                        format!(
-                            "no curve row `{name}` has a pressure: the rows with an `area` are {}",
-                            rows.join(", ")
-                        ),
-                    ));
+                if let Some(rule) = base.scene.pressure_window_fault(name, *from) {
+                    return Err(at.invalid(&field, rule));
                 }
             }
             Quantity::LimitPressure if !base.scene.has_limit_pressure() => {

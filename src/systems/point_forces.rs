@@ -1,8 +1,8 @@
 //! Forces on a point besides its stress's divergence, which particle-to-grid maps with the
 //! internal force. Each source is its own type here; [`PointForces`] holds those that act
 //! in a step and [`crate::systems::p2g`] asks it point by point, knowing none of them. A
-//! new source is its own type, a field of [`PointForces`] and its term in
-//! [`OnColumns::at`].
+//! new source is its own type, a field of [`PointForces`] (unless the dimension decides
+//! it, as the hoop stress's) and its term in [`OnColumns::at`].
 //!
 //! - [`PoreWater`]: the pore water's load V_p (−∇u_p) on a point below its piezometric
 //!   surface ([`crate::water::Water::body_force`]: buoyancy, seepage, and with them the
@@ -21,29 +21,22 @@ use crate::state::Settings;
 use crate::tensor::StoredSym;
 use crate::water::Water;
 
-/// The sources that act in one step.
+/// The sources that act in one step. The hoop source is no field: it acts exactly when
+/// the dimension is axisymmetric, which [`OnColumns::at`] asks of `D`.
 pub struct PointForces<'a> {
     water: Option<PoreWater<'a>>,
-    hoop: Option<Hoop>,
 }
 
 impl<'a> PointForces<'a> {
-    /// The sources of a simulation of `settings` (in `D`) in the step that ends at `time`
-    /// (s).
-    pub fn of<D: Dim>(settings: &'a Settings, time: f64) -> Self {
+    /// The sources of a simulation of `settings` in the step that ends at `time` (s).
+    pub fn of(settings: &'a Settings, time: f64) -> Self {
         PointForces {
             water: settings.water.as_ref().map(|water| PoreWater {
                 water,
                 // The pore water's load rises with gravity's ramp, as the weight it buoys does.
                 ramp: settings.gravity.map_or(1.0, |g| g.step_factor(time, settings.dt)),
             }),
-            hoop: D::AXISYMMETRIC.then_some(Hoop),
         }
-    }
-
-    /// True when no source acts.
-    pub fn is_empty(&self) -> bool {
-        self.water.is_none() && self.hoop.is_none()
     }
 
     /// Whether a source reads the points' materials (the archetype's `MaterialId` column).

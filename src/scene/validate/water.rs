@@ -30,13 +30,14 @@ pub(super) fn check_water(
         materials: &materials,
         axisymmetric: s.dimension == crate::scene::Dimension::Axisymmetric,
     };
-    let at = |prefix: &str, Refusal { field, rule }: Refusal| {
-        let field = match field.as_str() {
-            "" => prefix.to_string(),
-            f if f.starts_with("gravity") => f.to_string(),
-            f => format!("{prefix}.{f}"),
+    // A refusal of the scene's gravity is the scene's own field, not the water's.
+    let at = |prefix: &str, r: Refusal| {
+        let r = if r.field.starts_with("gravity") {
+            r
+        } else {
+            r.under(prefix)
         };
-        loaded.invalid(&field, rule)
+        loaded.invalid(&r.field, r.rule)
     };
     let Some(spec) = &s.water else {
         if let Some(k) = s.stages.iter().position(|st| st.water.is_some()) {
