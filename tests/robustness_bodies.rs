@@ -17,6 +17,15 @@ fn edited(name: &str, edits: &[(&str, &str)]) -> String {
     text
 }
 
+/// The text of shipped scene `name` with `fields` (RON, one or more lines) put before its
+/// `solver`.
+fn before_solver(name: &str, fields: &str) -> String {
+    edited(
+        name,
+        &[("    solver: (", &format!("    {fields}\n    solver: ("))],
+    )
+}
+
 fn assert_refused(text: &str, expect: &[&str]) {
     let e = common::refusal(text);
     for x in expect {
@@ -228,12 +237,9 @@ fn overlapping_shells_a_device_or_a_file_that_is_no_stl_are_refused() {
 #[test]
 fn water_and_axisymmetric_inputs_the_engine_cannot_mean_are_refused() {
     let staged = |stage: &str| {
-        edited(
+        before_solver(
             "slope_water.ron",
-            &[(
-                "    solver: (",
-                &format!("    stages: [(name: \"a\"), (name: \"b\", {stage})],\n    solver: ("),
-            )],
+            &format!("stages: [(name: \"a\"), (name: \"b\", {stage})],"),
         )
     };
     assert_refused(
@@ -260,12 +266,9 @@ fn water_and_axisymmetric_inputs_the_engine_cannot_mean_are_refused() {
         .unwrap()
         .to_string();
     assert!(e.contains("\"soil\" is given twice"), "{e}");
-    let axi = edited(
+    let axi = before_solver(
         "footing_circular.ron",
-        &[(
-            "    solver: (",
-            "    gravity: (acceleration: [0.0, 0.0]),\n    stages: [(name: \"a\"), (name: \"b\", gravity: (acceleration: [1.0, -9.81]))],\n    solver: (",
-        )],
+        "gravity: (acceleration: [0.0, 0.0]),\n    stages: [(name: \"a\"), (name: \"b\", gravity: (acceleration: [1.0, -9.81]))],",
     );
     assert_refused(&axi, &["stages[1].gravity.acceleration", "x entry must be 0"]);
 }
@@ -276,13 +279,11 @@ fn water_and_axisymmetric_inputs_the_engine_cannot_mean_are_refused() {
 #[test]
 fn the_waters_unit_weight_follows_a_stages_gravity() {
     let column = |g: f64| {
-        let text = edited(
+        let text = before_solver(
             "soil_column.ron",
-            &[
-                ("    solver: (", &format!(
-                    "    water: (table: Level(10.0), saturated_density: {{\"soil\": 2000.0}}),\n    stages: [(name: \"g\", gravity: (acceleration: [0.0, {g}]))],\n    solver: ("
-                )),
-            ],
+            &format!(
+                "water: (table: Level(10.0), saturated_density: {{\"soil\": 2000.0}}),\n    stages: [(name: \"g\", gravity: (acceleration: [0.0, {g}]))],"
+            ),
         );
         let s = common::run_text("wet.ron", &text);
         assert!(s.converged, "{:?}", s.error);
@@ -308,12 +309,9 @@ fn a_radial_drive_or_a_traction_on_the_axis_is_refused() {
         )],
     );
     assert_refused(&radial, &["motions[0].velocity", "on the axis"]);
-    let traction = edited(
+    let traction = before_solver(
         "footing_circular.ron",
-        &[(
-            "    solver: (",
-            "    tractions: [(name: \"axis\", surface: XMin, min: [0.0, 0.0], max: [0.1, 4.0], traction: [1.0e3, 0.0])],\n    solver: (",
-        )],
+        "tractions: [(name: \"axis\", surface: XMin, min: [0.0, 0.0], max: [0.1, 4.0], traction: [1.0e3, 0.0])],",
     );
     assert_refused(&traction, &["tractions[0].surface", "on the axis"]);
 }
