@@ -115,6 +115,12 @@ pub trait Dim: Copy + Send + Sync + Debug + Default + 'static {
     fn volume_ratio(l: &Self::Mat, dt: f64) -> f64;
     /// `m += k·I`.
     fn add_identity(m: &mut Self::Mat, k: f64);
+    /// tr(L): the rate of volume change of a velocity gradient (1/s), the hoop rate
+    /// v_r/r included in axisymmetry; `add_identity(l, k)` raises it by `STRAIN_AXES`·k.
+    #[inline(always)]
+    fn volumetric_rate(l: &Self::Mat) -> f64 {
+        Self::strain_spin(|i, j| Self::mat_entry(l, i, j), 1.0).0.trace()
+    }
     /// The matrix whose column j is `c[j]`, for the first `N` columns.
     fn mat_from_cols(c: [Self::Vec; 3]) -> Self::Mat;
     /// Completes a point's velocity gradient `l` from its place `x` and velocity `v`: the

@@ -41,6 +41,20 @@ pub enum Damping {
     },
 }
 
+/// How the points' volume change is discretised, against volumetric locking.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum AntiLocking {
+    /// Each point strains and is stressed on its own: the plain method.
+    #[default]
+    Off,
+    /// The volumetric strain rate smoothed through the nodes (`volumetric_smoothing.rs`):
+    /// for isochoric plastic flow only (ψ = 0), refused on a dilatant material.
+    StrainSmoothing,
+    /// Cell means of the volumetric strain rate and of the mean stress (`cell_mean.rs`):
+    /// consistent in the nodal forces' power, for any plastic flow.
+    CellMean,
+}
+
 /// Which norm of the out-of-balance force the stopping rule reads (both are always reported).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub enum ForceNorm {
@@ -132,8 +146,8 @@ pub struct Settings {
     pub gravity: Option<Gravity>,
     /// FLIP fraction α of the point velocity update (1 = FLIP, 0 = PIC).
     pub flip: f64,
-    /// Smooth the volumetric strain rate through the grid before each stress update.
-    pub volumetric_smoothing: bool,
+    /// The volumetric treatment against locking.
+    pub anti_locking: AntiLocking,
     /// Put the points back in cell order every this many steps (0: never).
     pub sort_every: u64,
     /// Mass scaling's inertia factor s_m of each material, by

@@ -36,6 +36,8 @@ fn run(threads: usize, overrides: &[&str], regroup: bool) -> Vec<u64> {
                 "p2g_force",
                 "remap",
                 "volumetric_smoothing",
+                "cell_mean_strain",
+                "cell_mean_stress",
             ] {
                 let forget = |ctx: &mut Context<Dim2>| -> Result<(), StepError> {
                     ctx.slabs.invalidate();
@@ -80,14 +82,32 @@ fn plastic_slope_is_bitwise_identical_on_one_and_two_threads() {
 }
 
 #[test]
+fn the_slope_with_cell_means_is_bitwise_identical_on_one_and_two_threads() {
+    let overrides = [
+        "solver.max_steps=400",
+        "solver.sort_every=50",
+        "solver.anti_locking=CellMean",
+    ];
+    let (one, two) = (run(1, &overrides, false), run(2, &overrides, false));
+    let differing = one.iter().zip(&two).filter(|(a, b)| a != b).count();
+    assert_eq!(differing, 0, "{differing} of {} values differ", one.len());
+}
+
+#[test]
 fn scatters_sharing_their_slabs_give_the_bits_of_slabs_built_for_every_scatter() {
-    // MUSL (remap reuses p2g's slabs) with volumetric smoothing (p2g reuses the smoothing's),
-    // and USF (the force pass reuses the momentum pass's); sorts every 25 steps.
-    for scheme in ["Musl", "Usf"] {
+    // MUSL (remap reuses p2g's slabs) with volumetric smoothing (p2g reuses the smoothing's)
+    // or cell means (the stress's reuses the strain's), and USF (the force pass reuses the
+    // momentum pass's); sorts every 25 steps.
+    for (scheme, locking) in [
+        ("Musl", "StrainSmoothing"),
+        ("Usf", "StrainSmoothing"),
+        ("Musl", "CellMean"),
+        ("Usf", "CellMean"),
+    ] {
         let overrides = [
             "solver.max_steps=300",
             "solver.sort_every=25",
-            "solver.volumetric_smoothing=true",
+            &format!("solver.anti_locking={locking}"),
             &format!("solver.scheme={scheme}"),
         ];
         let shared = run(2, &overrides, false);
@@ -96,7 +116,7 @@ fn scatters_sharing_their_slabs_give_the_bits_of_slabs_built_for_every_scatter()
         assert_eq!(
             differing,
             0,
-            "{scheme}: {differing} of {} values differ",
+            "{scheme}, {locking}: {differing} of {} values differ",
             shared.len()
         );
     }

@@ -51,7 +51,7 @@ const SEEDS: &[&str] = &[
     bodies: [(material: "sand", region: Polygon(vertices: [[0.0, 0.0], [10.0, 0.0], [10.0, 4.0], [4.0, 4.0]]), points_per_cell: [2, 2])],
     boundaries: [(face: YMin, condition: Fixed), (face: XMin, condition: Roller)],
     gravity: (acceleration: [0.0, -9.81]),
-    solver: (scheme: Usf, time_step: Courant(0.3), max_steps: 20, volumetric_smoothing: true, force_norm: Mean, sort_every: 0,
+    solver: (scheme: Usf, time_step: Courant(0.3), max_steps: 20, anti_locking: StrainSmoothing, force_norm: Mean, sort_every: 0,
              schedule: ["grid_reset", "p2g_momentum", "nodal_velocity", "velocity_gradient", "volumetric_smoothing", "stress_update", "volume_update", "p2g_force", "gravity", "boundary", "integrate", "g2p", "peak_watch", "move_points", "convergence"]),
     output: (surface_angle: true, displacements: false),
 )"#,

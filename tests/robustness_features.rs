@@ -615,10 +615,10 @@ fn volumetric_smoothing_on_a_dilatant_soil_is_refused() {
     refused(
         "footing.ron",
         &[
-            "solver.volumetric_smoothing=true",
+            "solver.anti_locking=StrainSmoothing",
             "materials.clay=MohrCoulomb(density: 2000.0, youngs_modulus: 10.0e6, poisson_ratio: 0.3, \
              cohesion: 10.0e3, friction_angle: 30.0, dilatancy_angle: 30.0)",
         ],
-        &["solver.volumetric_smoothing", "\"clay\" dilates", "ψ = 0"],
+        &["solver.anti_locking", "\"clay\" dilates", "ψ = 0"],
     );
 }

@@ -81,6 +81,12 @@ pub trait Material: Send + Sync {
     fn update4(&self, stress: &mut Sym3x4, de: &Sym3x4, state: [&mut Self::State; LANES]) {
         update_lane_by_lane(stress, de, state, |_, s, de, st| self.update(s, de, st));
     }
+    /// Whether the model's strength admits `stress` (Pa) at a point of state `state`: inside
+    /// or on its yield surface. Always, for a model without strength. The cell means against
+    /// locking ask it after they move a point's mean stress (`systems/cell_mean.rs`).
+    fn admits(&self, _stress: &Sym3, _state: &Self::State) -> bool {
+        true
+    }
 }
 
 /// A material as a scene gives it: the serde struct is its schema.
@@ -293,6 +299,17 @@ macro_rules! define_materials {
                     $(MaterialModel::$variant(m) => match same_type(state) {
                         Some(own) => m.update(stress, de, own),
                         None => m.update(stress, de, &mut stateless::<<$spec as SceneMaterial>::Model>()),
+                    },)*
+                }
+            }
+
+            /// [`Material::admits`] for a point whose state column is of type `S`.
+            pub fn admits<S: MaterialState>(&self, stress: &Sym3, state: &S) -> bool {
+                let mut own = *state;
+                match self {
+                    $(MaterialModel::$variant(m) => match same_type(&mut own) {
+                        Some(own) => m.admits(stress, own),
+                        None => m.admits(stress, &stateless::<<$spec as SceneMaterial>::Model>()),
                     },)*
                 }
             }

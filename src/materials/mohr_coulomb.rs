@@ -444,6 +444,15 @@ impl Material for MohrCoulomb {
     // Always: with a hint alone the one-point update was not inlined into its callers,
     // which costs a plastic point time (docs/performance.md).
     #[inline(always)]
+    fn admits(&self, stress: &Sym3, _: &PlasticStrain) -> bool {
+        let p = if stress.has_principal_z() {
+            stress.principal_values()
+        } else {
+            stress.eigen().0
+        };
+        self.admissible(p)
+    }
+    #[inline(always)]
     fn update(&self, stress: &mut Sym3, de: &Sym3, plastic: &mut PlasticStrain) {
         let (settled, correction) = self.settle(*stress + self.elasticity.stress_increment(de));
         *stress = settled;

@@ -202,6 +202,9 @@ impl Material for MohrCoulombSoftening {
     fn p_wave_modulus(&self) -> f64 {
         self.elasticity.p_wave()
     }
+    fn admits(&self, stress: &Sym3, state: &SofteningStrain) -> bool {
+        self.with_strength(state.0, |mc| mc.admits(stress, &PlasticStrain(state.0)))
+    }
     #[inline(always)]
     fn update(&self, stress: &mut Sym3, de: &Sym3, state: &mut SofteningStrain) {
         self.with_strength(state.0, |mc| {

@@ -29,8 +29,8 @@ pub fn unsupported<D: Dim>(sim: &Simulation<D>) -> Option<&'static str> {
         Some("surface pressures (a loaded point's neighbours along its surface may be on another rank)")
     } else if !s.load_steps.is_empty() {
         Some("tractions applied in increments")
-    } else if s.volumetric_smoothing {
-        Some("volumetric smoothing (its cell averages are not yet summed over the ranks)")
+    } else if s.anti_locking != crate::state::AntiLocking::Off {
+        Some("solver.anti_locking (its nodal or cell means are not yet summed over the ranks)")
     } else if s.inertia_factors.iter().any(|&f| f != 1.0) {
         Some("mass scaling")
     } else {

@@ -280,7 +280,7 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         max_steps: s.solver.max_steps,
         max_time: s.solver.max_time,
         static_check: s.solver.static_check,
-        volumetric_smoothing: s.solver.volumetric_smoothing,
+        anti_locking: s.solver.anti_locking,
         sort_every: s.solver.sort_every,
         peak_interpolation: s.solver.peak_interpolation,
         inertia_factors: if s.solver.mass_scaling {

@@ -16,7 +16,7 @@ pub use validate::{check, Checked, CheckedGrid, CheckedStage, Derived, Estimate,
 use crate::error::{Refusal, SceneError};
 use crate::grid::Face;
 use crate::shape::ShapeKind;
-use crate::state::{Damping, ForceNorm, MotionSpec, Scheme, StaticCheck};
+use crate::state::{AntiLocking, Damping, ForceNorm, MotionSpec, Scheme, StaticCheck};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -405,9 +405,11 @@ pub struct SolverSpec {
     /// damps the velocity noise of the points.
     #[serde(default = "default_flip")]
     pub flip: f64,
-    /// Smooth the volumetric strain rate through the grid (against volumetric locking).
+    /// The volumetric treatment against locking (default `Off`): `StrainSmoothing`
+    /// smooths the volumetric strain rate through the nodes (isochoric flow only),
+    /// `CellMean` takes cell means of it and of the mean stress (any flow).
     #[serde(default)]
-    pub volumetric_smoothing: bool,
+    pub anti_locking: AntiLocking,
     /// Put the points back in cell order every this many steps so that neighbours in space
     /// stay neighbours in memory (default 100; 0 never sorts).
     #[serde(default = "default_sort_every")]

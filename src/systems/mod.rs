@@ -15,6 +15,7 @@
 //! (`p2g_force`) and moves the points at the end (`move_points`).
 
 pub mod boundary;
+pub mod cell_mean;
 pub mod convergence;
 pub mod exchange;
 pub mod g2p;
@@ -43,6 +44,7 @@ pub mod volume_update;
 pub mod volumetric_smoothing;
 
 pub use boundary::Boundary;
+pub use cell_mean::{CellMean, CellMeanPart};
 pub use convergence::Convergence;
 pub use g2p::G2p;
 pub use gravity::Gravity;
@@ -68,7 +70,7 @@ pub use volumetric_smoothing::VolumetricSmoothing;
 use crate::dim::{Dim, Dim2};
 use crate::schedule::{Schedule, System};
 use crate::shape::{Linear, QuadraticBSpline, Shape, ShapeKind, UniformGimp};
-use crate::state::{Damping, Scheme, Settings};
+use crate::state::{AntiLocking, Damping, Scheme, Settings};
 
 /// What a scene contains that decides which optional systems it needs.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -95,6 +97,8 @@ pub enum Stage {
     Smooth,
     /// The material law.
     Stress,
+    /// Project the updated stress (the cell means of the mean stress).
+    Project,
     /// Point volumes.
     Volume,
     /// USF: map the internal force of the updated stress.
@@ -139,6 +143,7 @@ pub fn scheme_stages(scheme: Scheme) -> &'static [Stage] {
             Strain,
             Smooth,
             Stress,
+            Project,
             Volume,
             Monitor,
             Control,
@@ -151,6 +156,7 @@ pub fn scheme_stages(scheme: Scheme) -> &'static [Stage] {
             Strain,
             Smooth,
             Stress,
+            Project,
             Volume,
             MapForce,
             Forces,
@@ -316,12 +322,23 @@ fn straining<D: Dim, S: Shape>() -> Vec<Entry<D>> {
             "volumetric_smoothing",
             St::Smooth,
             Needed(
-                |s, _| s.volumetric_smoothing,
-                "solver.volumetric_smoothing is true",
+                |s, _| s.anti_locking == AntiLocking::StrainSmoothing,
+                "solver.anti_locking is StrainSmoothing",
             ),
             &[("kinematics", SMOOTHED), ("velocity_gradient", SMOOTHED)],
-            "cell-averaged volumetric strain rate",
+            "volumetric strain rate smoothed through the nodes",
             |_| Box::new(VolumetricSmoothing::<D, S>::default()),
+        ),
+        e(
+            "cell_mean_strain",
+            St::Smooth,
+            Needed(
+                |s, _| s.anti_locking == AntiLocking::CellMean,
+                "solver.anti_locking is CellMean",
+            ),
+            &[("kinematics", SMOOTHED), ("velocity_gradient", SMOOTHED)],
+            "cell mean of the volumetric strain rate",
+            |_| Box::new(CellMean::<D, S>::new(CellMeanPart::Strain)),
         ),
         e(
             "stress_update",
@@ -331,9 +348,21 @@ fn straining<D: Dim, S: Shape>() -> Vec<Entry<D>> {
                 ("kinematics", STRAINED),
                 ("velocity_gradient", STRAINED),
                 ("volumetric_smoothing", "the stress must see the smoothed strain"),
+                ("cell_mean_strain", "the stress must see the cell's strain"),
             ],
             "Jaumann rotation + material law",
             |_| Box::new(StressUpdate),
+        ),
+        e(
+            "cell_mean_stress",
+            St::Project,
+            Needed(
+                |s, _| s.anti_locking == AntiLocking::CellMean,
+                "solver.anti_locking is CellMean",
+            ),
+            &[("stress_update", "it projects the updated stress")],
+            "cell mean of the mean stress",
+            |_| Box::new(CellMean::<D, S>::new(CellMeanPart::Stress)),
         ),
         e(
             "volume_update",
@@ -347,7 +376,10 @@ fn straining<D: Dim, S: Shape>() -> Vec<Entry<D>> {
             "p2g_force",
             St::MapForce,
             Schemes(USF),
-            &[("stress_update", "p2g_force maps the updated stress")],
+            &[
+                ("stress_update", "p2g_force maps the updated stress"),
+                ("cell_mean_stress", "p2g_force maps the projected stress"),
+            ],
             "USF: internal force of the updated stress (and each point's other forces)",
             |_| Box::new(P2g::<D, S>::new(P2gPart::InternalForce)),
         ),
@@ -731,7 +763,7 @@ mod tests {
                 ramp_time: 0.0,
                 start: 0.0,
             }),
-            volumetric_smoothing: false,
+            anti_locking: AntiLocking::Off,
             sort_every: 100,
             peak_interpolation: false,
             inertia_factors: Vec::new(),
@@ -772,7 +804,7 @@ mod tests {
     #[test]
     fn default_schedules_run_the_stages_of_each_scheme_in_order() {
         let mut st = settings(Scheme::Musl, Damping::Kinetic, true);
-        st.volumetric_smoothing = true;
+        st.anti_locking = AntiLocking::StrainSmoothing;
         let needs = Needs { point_loads: true };
         assert_eq!(
             default_names(&st, needs),

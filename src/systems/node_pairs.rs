@@ -1,6 +1,7 @@
 //! Two sums a node, scattered from the points through the shape functions: the numerator
 //! and denominator of a weighted nodal average (volumetric smoothing), or a weighted sum
-//! and a maximum (mass scaling). Shared by the systems that need such a field for one step.
+//! and a maximum (mass scaling); or two sums a cell, kept at the cell's lowest node (the
+//! cell means against locking). Shared by the systems that need such a field for one step.
 
 use crate::components::Position;
 use crate::dim::Dim;
@@ -44,6 +45,42 @@ impl NodePairs {
             },
         );
         self.active = self.active.union(reached);
+    }
+
+    /// Adds the points at `x` (a column of one archetype) cell by cell: `value(p)` goes into
+    /// the pair of the lowest node of the cell that holds point p, whole. Deterministic as
+    /// [`NodePairs::scatter`]: the slabs fix each cell's order of contributions, and a cell's
+    /// lowest node lies in the node range of its point's slab whatever the shape.
+    pub(crate) fn scatter_cells<D: Dim, S: Shape>(
+        &mut self,
+        slabs: &mut SlabCache,
+        grid: &Grid<D>,
+        x: &[Position<D::Vec>],
+        value: impl Fn(usize) -> [f64; 2] + Sync,
+    ) {
+        self.sums.resize(grid.node_count(), [0.0; 2]);
+        let reached = scatter(
+            slabs.slabs(grid, x),
+            grid,
+            S::SUPPORT,
+            &Disjoint::new(&mut self.sums),
+            |points, sums, lo| {
+                for &p in points {
+                    let p = p as usize;
+                    let [a, b] = value(p);
+                    let pair = &mut sums[grid.cell_key(x[p].0) - lo];
+                    pair[0] += a;
+                    pair[1] += b;
+                }
+            },
+        );
+        self.active = self.active.union(reached);
+    }
+
+    /// The pair of the cell that holds `x`, after [`NodePairs::scatter_cells`].
+    #[inline(always)]
+    pub(crate) fn of_cell<D: Dim>(&self, grid: &Grid<D>, x: D::Vec) -> [f64; 2] {
+        self.sums[grid.cell_key(x)]
     }
 
     /// Replaces the pair of every node the points reached by `f(pair)`.

@@ -39,12 +39,6 @@ impl<D: Dim, S> Default for VolumetricSmoothing<D, S> {
     }
 }
 
-/// Trace of a velocity gradient through the volume ratio's first-order term.
-#[inline(always)]
-fn trace<D: Dim>(l: &D::Mat) -> f64 {
-    D::strain_spin(|i, j| D::mat_entry(l, i, j), 1.0).0.trace()
-}
-
 impl<D: Dim, S: Shape> System<D> for VolumetricSmoothing<D, S> {
     fn name(&self) -> &str {
         "volumetric_smoothing"
@@ -66,7 +60,7 @@ impl<D: Dim, S: Shape> System<D> for VolumetricSmoothing<D, S> {
                 &mut ctx.slabs,
                 grid,
                 &xg,
-                |p| (vol[p].0, trace::<D>(&l[p].0)),
+                |p| (vol[p].0, D::volumetric_rate(&l[p].0)),
                 |node, w, &(v, t)| {
                     node[0] += w * v * t;
                     node[1] += w * v;
@@ -84,7 +78,7 @@ impl<D: Dim, S: Shape> System<D> for VolumetricSmoothing<D, S> {
                 for (k, lp) in l.iter_mut().enumerate() {
                     let mut theta = 0.0;
                     for_each_node::<D, S>(grid, x[c * CHUNK + k].0, |i, w, _| theta += w * nodal[i][0]);
-                    let shift = (theta - trace::<D>(&lp.0)) / n;
+                    let shift = (theta - D::volumetric_rate(&lp.0)) / n;
                     D::add_identity(&mut lp.0, shift);
                 }
             });

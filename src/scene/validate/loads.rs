@@ -13,7 +13,7 @@ pub(super) fn check_loads(r: &Rules, table: &[(String, MaterialModel)]) -> Resul
         check_gravity(r, "gravity", g)?;
     }
     check_mass_finite(loaded, table, n)?;
-    if s.solver.volumetric_smoothing {
+    if s.solver.anti_locking == crate::state::AntiLocking::StrainSmoothing {
         check_smoothing(loaded)?;
     }
     for (i, l) in s.point_loads.iter().enumerate() {

@@ -61,11 +61,11 @@ pub(super) fn check_smoothing(loaded: &LoadedScene) -> Result<(), SceneError> {
         let psi = m.dilatancy_angle();
         if psi > 0.0 {
             return Err(loaded.invalid(
-                "solver.volumetric_smoothing",
+                "solver.anti_locking",
                 format!(
                     "material \"{name}\" dilates (ψ = {psi}°): volumetric smoothing is for plastic \
                      flow without volume change (ψ = 0) and makes a run with dilatant flow \
-                     unstable (docs/verification.md); set it false, or ψ = 0"
+                     unstable (docs/verification.md); use CellMean, or ψ = 0"
                 ),
             ));
         }

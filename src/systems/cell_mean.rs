@@ -1,0 +1,334 @@
+//! Cell means of the volumetric strain rate and of the mean stress: a volumetric treatment
+//! against locking that holds for dilatant plastic flow.
+//!
+//! A point of a low-order grid that must flow at a set rate of volume change (ψ = 0: none;
+//! ψ > 0: sin ψ times its shear rate) is one constraint on the nodal velocities; four
+//! points a cell in 2D (eight in 3D) are twice (three times) the velocity degrees of freedom
+//! a cell has, and the grid locks: a limit load grows with the stiffness. Here each
+//! background cell holds one volumetric strain rate and one mean stress, the constraint
+//! count of the Q1/P0 element (Hughes 1980, B-bar; Mast et al. 2012, "Mitigating kinematic
+//! locking in the material point method", J. Comput. Phys. 231, the cell-based
+//! Hu–Washizu averaging):
+//!
+//! θ_c = Σ_{p∈c} V_p tr(L_p) / Σ_{p∈c} V_p,   L_p ← L_p + (θ_c − tr L_p) I / n   (before the stress update),
+//!
+//! m̄_c = Σ_{p∈c} V_p m_p / Σ_{p∈c} V_p,      σ_p ← σ_p + (m̄_c − m_p) I_n        (after it),
+//!
+//! with n = `Dim::STRAIN_AXES` (2 in plane strain, where m_p = (σ_xx + σ_yy)/2 and the
+//! out-of-plane σ_zz keeps its own; 3 in 3D and axisymmetry, the hoop components
+//! included). Both are needed, and in this pairing:
+//!
+//! - *Power.* With the mean stress constant over a cell, the nodal forces' power
+//!   Σ_p V_p σ_p : ∇v equals the points' stress power Σ_p V_p σ_p : D̄_p exactly, since
+//!   Σ_{p∈c} V_p m̄_c tr D_p = m̄_c V_c θ_c. Smoothing the strain alone (the nodal
+//!   smoothing) leaves Σ_p V_p m_p (θ − tr D_p), which dilatant flow feeds into the kinetic
+//!   energy until the run fails (docs/verification.md).
+//! - *Strength.* Projecting the mean stress only in the nodal forces (the classical B-bar)
+//!   leaves each point's own m_p free to drift in modes no force resists; a frictional
+//!   point whose strength follows its m_p then weakens, and a point by a footing's edge
+//!   heaves out of the grid. Projecting the points' stress itself keeps the strength on the
+//!   stress the forces carry.
+//!
+//! Where the shift of its mean takes a point outside its yield surface, its deviator is
+//! scaled down to the surface at the new mean ([`Material::admits`]; see `scale_deviator`
+//! for why not the material's own return). Both systems group the points by the cell
+//! that holds them when they run: in USL and MUSL after the points moved, in USF before,
+//! the same cells in both, and those of the next particle-to-grid.
+//!
+//! [`Material::admits`]: crate::materials::Material::admits
+
+use crate::components::*;
+use crate::context::Context;
+use crate::dim::Dim;
+use crate::error::StepError;
+use crate::grid::Grid;
+use crate::infra::columns::{col, col_mut, points_with};
+use crate::materials::{visit_states, MaterialModel, MaterialState, StateVisitor};
+use crate::parallel::CHUNK;
+use crate::schedule::System;
+use crate::shape::Shape;
+use crate::systems::node_pairs::NodePairs;
+use crate::tensor::{StoredSym, Sym3};
+use hecs::Archetype;
+use rayon::prelude::*;
+use std::marker::PhantomData;
+
+/// Which of the two cell means a [`CellMean`] system takes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CellMeanPart {
+    /// The volumetric strain rate, before the stress update.
+    Strain,
+    /// The mean stress, after it.
+    Stress,
+}
+
+/// One of the two cell means (see the module's text).
+#[derive(Debug)]
+pub struct CellMean<D: Dim, S> {
+    part: CellMeanPart,
+    /// Per cell, at its lowest node: Σ V q, Σ V; then the mean in the first entry.
+    sums: NodePairs,
+    _marker: PhantomData<fn() -> (D, S)>,
+}
+
+impl<D: Dim, S> CellMean<D, S> {
+    /// The system that takes `part`'s cell mean.
+    pub fn new(part: CellMeanPart) -> Self {
+        CellMean {
+            part,
+            sums: NodePairs::default(),
+            _marker: PhantomData,
+        }
+    }
+}
+
+/// The mean of a stress over the strain axes (Pa): in plane strain the in-plane mean,
+/// whose power the in-plane strain rate's trace takes.
+#[inline(always)]
+fn mean_stress<D: Dim>(s: &D::Stress) -> f64 {
+    let t = s.to_sym3();
+    if D::STRAIN_AXES == 2 {
+        0.5 * (t.xx + t.yy)
+    } else {
+        (t.xx + t.yy + t.zz) / 3.0
+    }
+}
+
+/// `s` with `k` (Pa) added to its normal components on the strain axes.
+#[inline(always)]
+fn shift_mean<D: Dim>(s: &D::Stress, k: f64) -> D::Stress {
+    let mut t = s.to_sym3();
+    t.xx += k;
+    t.yy += k;
+    if D::STRAIN_AXES == 3 {
+        t.zz += k;
+    }
+    D::Stress::from_sym3(&t)
+}
+
+impl<D: Dim, S: Shape> System<D> for CellMean<D, S> {
+    fn name(&self) -> &str {
+        match self.part {
+            CellMeanPart::Strain => "cell_mean_strain",
+            CellMeanPart::Stress => "cell_mean_stress",
+        }
+    }
+
+    fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
+        // A reset step neither strains nor moves the points: the means stand.
+        if ctx.motion_dt().is_none() {
+            return Ok(());
+        }
+        match self.part {
+            CellMeanPart::Strain => self.strain(ctx),
+            CellMeanPart::Stress => self.stress(ctx),
+        }
+        self.sums.clear(&ctx.grid);
+        Ok(())
+    }
+}
+
+impl<D: Dim, S: Shape> CellMean<D, S> {
+    /// Σ_{p∈c} V_p q_p and Σ_{p∈c} V_p over every stressed point, then their ratio.
+    fn means<Q: Send + Sync + 'static>(&mut self, ctx: &mut Context<D>, q: impl Fn(&Q) -> f64 + Sync + Copy) {
+        let grid = &ctx.grid;
+        for arch in points_with::<Volume>(&ctx.world) {
+            let (xg, vg, qg) = (col::<Position<D::Vec>>(arch), col::<Volume>(arch), col::<Q>(arch));
+            let (vol, qs): (&[Volume], &[Q]) = (&vg, &qg);
+            self.sums
+                .scatter_cells::<D, S>(&mut ctx.slabs, grid, &xg, |p| [vol[p].0 * q(&qs[p]), vol[p].0]);
+        }
+        // Every cell a point is in has Σ V > 0; the others are never read.
+        self.sums
+            .map(grid, |s| [if s[1] > 0.0 { s[0] / s[1] } else { 0.0 }, s[1]]);
+    }
+
+    /// L_p ← L_p + (θ_c − tr L_p) I / n.
+    fn strain(&mut self, ctx: &mut Context<D>) {
+        self.means::<VelocityGradient<D::Mat>>(ctx, |l| D::volumetric_rate(&l.0));
+        let (grid, sums) = (&ctx.grid, &self.sums);
+        let n = D::STRAIN_AXES as f64;
+        for arch in points_with::<Volume>(&ctx.world) {
+            let xg = col::<Position<D::Vec>>(arch);
+            let x: &[Position<D::Vec>] = &xg;
+            let mut lg = col_mut::<VelocityGradient<D::Mat>>(arch);
+            lg.par_chunks_mut(CHUNK).enumerate().for_each(|(c, l)| {
+                for (k, lp) in l.iter_mut().enumerate() {
+                    let theta = sums.of_cell(grid, x[c * CHUNK + k].0)[0];
+                    let shift = (theta - D::volumetric_rate(&lp.0)) / n;
+                    D::add_identity(&mut lp.0, shift);
+                }
+            });
+        }
+    }
+
+    /// σ_p ← σ_p + (m̄_c − m_p) I_n, and where the point's strength does not admit that,
+    /// the return that makes it so: see [`RETURNS`].
+    fn stress(&mut self, ctx: &mut Context<D>) {
+        for round in 0..=RETURNS {
+            if round > 0 {
+                self.sums.clear(&ctx.grid);
+            }
+            self.means::<Stress<D::Stress>>(ctx, |s| mean_stress::<D>(&s.0));
+            let mut returned = 0;
+            for arch in points_with::<Volume>(&ctx.world) {
+                let mut project = Project::<D> {
+                    arch,
+                    grid: &ctx.grid,
+                    sums: &self.sums,
+                    materials: &ctx.materials,
+                    last: round == RETURNS,
+                    returned: None,
+                };
+                visit_states(&mut project);
+                returned += match project.returned {
+                    Some(n) => n,
+                    None => project.run::<()>(None),
+                };
+            }
+            if returned == 0 {
+                break;
+            }
+        }
+    }
+}
+
+/// How many times a step returns the points that the shift of their mean took outside
+/// their yield surface, before it scales their deviators instead.
+///
+/// The points of a cell share one mean stress, so a plastic return at one point (which
+/// moves its mean: dilatancy) is shared by the others at the next projection, which may
+/// take one of them outside in turn. The cell's stress is the fixed point of the pair
+/// "project, return": the mixed formulation's local problem, each point on or inside its
+/// surface at the cell's mean (Simo, Taylor & Pister 1985). Left to the next steps, the pair
+/// relaxes the stress step after step with no strain, and a footing never comes to rest (K_F
+/// held at 1.7e-3); scaling the deviator at once instead holds the mean but dissipates
+/// strength (the c–φ footing 4–9 % under Prandtl–Reissner). A few rounds settle a step;
+/// what is left after them is scaled.
+const RETURNS: usize = 8;
+
+/// The projection of one archetype's stresses, with the state column it carries (the
+/// strength of a softening soil is in its state, and a return adds to it).
+struct Project<'a, D: Dim> {
+    arch: &'a Archetype,
+    grid: &'a Grid<D>,
+    sums: &'a NodePairs,
+    materials: &'a [MaterialModel],
+    /// The last round: scale the deviators of the points still outside.
+    last: bool,
+    /// How many points were returned, once the archetype's state column was found.
+    returned: Option<usize>,
+}
+
+impl<D: Dim> StateVisitor for Project<'_, D> {
+    fn visit<S: MaterialState>(&mut self) {
+        if self.returned.is_none() && std::mem::size_of::<S>() > 0 {
+            if let Some(states) = self.arch.get::<&mut S>() {
+                self.returned = Some(self.run(Some(states)));
+            }
+        }
+    }
+}
+
+impl<D: Dim> Project<'_, D> {
+    /// Projects every point, `states` its state column (`None` for points without state);
+    /// returns how many points were returned to their yield surface.
+    fn run<S: MaterialState>(&self, states: Option<hecs::ArchetypeColumnMut<'_, S>>) -> usize {
+        let (grid, sums, materials, last) = (self.grid, self.sums, self.materials, self.last);
+        let (xg, mg) = (col::<Position<D::Vec>>(self.arch), col::<MaterialId>(self.arch));
+        let (x, mat): (&[Position<D::Vec>], &[MaterialId]) = (&xg, &mg);
+        let mut sg = col_mut::<Stress<D::Stress>>(self.arch);
+        let kernel = |c: usize, s: &mut [Stress<D::Stress>], st: &mut [S]| {
+            let mut returned = 0;
+            for (k, (sp, state)) in s.iter_mut().zip(st).enumerate() {
+                let p = c * CHUNK + k;
+                let mean = sums.of_cell(grid, x[p].0)[0];
+                let mut t = shift_mean::<D>(&sp.0, mean - mean_stress::<D>(&sp.0)).to_sym3();
+                let model = &materials[mat[p].0 as usize];
+                if !model.admits(&t, state) {
+                    if last {
+                        t = scale_deviator(&t, mean, |t| model.admits(t, state));
+                    }
+                    // A mean beyond the strength in tension (a cell at a free surface pulled
+                    // apart) admits no deviator at all: the material's return takes the point
+                    // to its tension limit, which no cell mean may pass.
+                    if !last || !model.admits(&t, state) {
+                        model.update(&mut t, &Sym3::ZERO, state);
+                        returned += 1;
+                    }
+                }
+                sp.0 = D::Stress::from_sym3(&t);
+            }
+            returned
+        };
+        match states {
+            Some(mut states) => sg
+                .par_chunks_mut(CHUNK)
+                .zip(states.par_chunks_mut(CHUNK))
+                .enumerate()
+                .map(|(c, (s, st))| kernel(c, s, st))
+                .sum(),
+            // A state of no size: the slice costs no memory.
+            None => sg
+                .par_chunks_mut(CHUNK)
+                .enumerate()
+                .map(|(c, s)| kernel(c, s, &mut vec![S::default(); s.len()]))
+                .sum(),
+        }
+    }
+}
+
+/// m I + α (σ − m I) with the largest α in [0, 1] (to 2⁻⁴⁰) that `admits` takes; α = 0
+/// where none does (a mean beyond the tension cut-off, which the caller then returns). The mean over the strain axes stays
+/// m: in plane strain σ_zz − m scales with the rest, and σ_xx + σ_yy stays 2m.
+///
+/// The last resort of [`RETURNS`]: it holds the mean, so the projection is done.
+fn scale_deviator(sigma: &Sym3, m: f64, admits: impl Fn(&Sym3) -> bool) -> Sym3 {
+    let at = |a: f64| Sym3 {
+        xx: m + a * (sigma.xx - m),
+        yy: m + a * (sigma.yy - m),
+        zz: m + a * (sigma.zz - m),
+        xy: a * sigma.xy,
+        yz: a * sigma.yz,
+        zx: a * sigma.zx,
+    };
+    let (mut lo, mut hi) = (0.0, 1.0);
+    for _ in 0..40 {
+        let mid = 0.5 * (lo + hi);
+        if admits(&at(mid)) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    at(lo)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The last resort keeps the mean of the strain axes and ends on the surface: here a
+    /// Tresca-like cap on the in-plane radius, 10 kPa.
+    #[test]
+    fn scaling_the_deviator_keeps_the_mean_and_ends_on_the_surface() {
+        let sigma = Sym3 {
+            xx: -50.0e3,
+            yy: -10.0e3,
+            zz: -20.0e3,
+            xy: 15.0e3,
+            yz: 0.0,
+            zx: 0.0,
+        };
+        let m = 0.5 * (sigma.xx + sigma.yy);
+        let radius = |t: &Sym3| (0.25 * (t.xx - t.yy).powi(2) + t.xy * t.xy).sqrt();
+        let capped = scale_deviator(&sigma, m, |t| radius(t) <= 10.0e3);
+        assert_eq!(0.5 * (capped.xx + capped.yy), m);
+        assert!(radius(&capped) <= 10.0e3 && radius(&capped) > 10.0e3 * (1.0 - 1e-11));
+        // σ_zz scales about the same mean.
+        assert!((capped.zz - m) / (sigma.zz - m) > 0.0);
+        // Nothing admitted: the mean alone.
+        let none = scale_deviator(&sigma, m, |_| false);
+        assert_eq!((none.xx, none.yy, none.zz, none.xy), (m, m, m, 0.0));
+    }
+}
