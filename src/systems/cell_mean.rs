@@ -68,6 +68,9 @@ pub struct CellMean<D: Dim, S> {
     part: CellMeanPart,
     /// Per cell, at its lowest node: Σ V q, Σ V; then the mean in the first entry.
     sums: NodePairs,
+    /// Per cell, at its lowest node: whether a point in it was returned this round (all
+    /// false between rounds).
+    dirty: Vec<bool>,
     _marker: PhantomData<fn() -> (D, S)>,
 }
 
@@ -77,6 +80,7 @@ impl<D: Dim, S> CellMean<D, S> {
         CellMean {
             part,
             sums: NodePairs::default(),
+            dirty: Vec::new(),
             _marker: PhantomData,
         }
     }
@@ -163,33 +167,83 @@ impl<D: Dim, S: Shape> CellMean<D, S> {
     }
 
     /// σ_p ← σ_p + (m̄_c − m_p) I_n, and where the point's strength does not admit that,
-    /// the return that makes it so: see [`RETURNS`].
+    /// the return that makes it so: see [`RETURNS`]. The first round visits every point;
+    /// the later ones only the cells where a point was returned, whose means alone moved.
     fn stress(&mut self, ctx: &mut Context<D>) {
-        for round in 0..=RETURNS {
-            if round > 0 {
-                self.sums.clear(&ctx.grid);
+        self.means::<Stress<D::Stress>>(ctx, |s| mean_stress::<D>(&s.0));
+        let mut returned = self.project(ctx, None, RETURNS == 0);
+        for round in 1..=RETURNS {
+            if returned.iter().all(Vec::is_empty) {
+                break;
             }
-            self.means::<Stress<D::Stress>>(ctx, |s| mean_stress::<D>(&s.0));
-            let mut returned = 0;
-            for arch in points_with::<Volume>(&ctx.world) {
+            // The cells a returned point is in (emptied), and every point in them,
+            // archetype by archetype in point order.
+            let grid = &ctx.grid;
+            let (dirty, sums) = (&mut self.dirty, &mut self.sums);
+            dirty.resize(grid.node_count(), false);
+            for (arch, points) in points_with::<Volume>(&ctx.world).zip(&returned) {
+                let x = col::<Position<D::Vec>>(arch);
+                for &p in points {
+                    let key = grid.cell_key(x[p as usize].0);
+                    dirty[key] = true;
+                    *sums.at_mut(key) = [0.0; 2];
+                }
+            }
+            let active: Vec<Vec<u32>> = points_with::<Volume>(&ctx.world)
+                .map(|arch| {
+                    let x = col::<Position<D::Vec>>(arch);
+                    (0..x.len() as u32)
+                        .filter(|&p| dirty[grid.cell_key(x[p as usize].0)])
+                        .collect()
+                })
+                .collect();
+            // Their means afresh, summed in that order.
+            for (arch, points) in points_with::<Volume>(&ctx.world).zip(&active) {
+                let (x, vol) = (col::<Position<D::Vec>>(arch), col::<Volume>(arch));
+                let s = col::<Stress<D::Stress>>(arch);
+                for &p in points {
+                    let p = p as usize;
+                    let pair = sums.at_mut(grid.cell_key(x[p].0));
+                    pair[0] += vol[p].0 * mean_stress::<D>(&s[p].0);
+                    pair[1] += vol[p].0;
+                }
+            }
+            for (arch, points) in points_with::<Volume>(&ctx.world).zip(&returned) {
+                let x = col::<Position<D::Vec>>(arch);
+                for &p in points {
+                    let key = grid.cell_key(x[p as usize].0);
+                    if std::mem::take(&mut dirty[key]) {
+                        let pair = sums.at_mut(key);
+                        pair[0] /= pair[1];
+                    }
+                }
+            }
+            returned = self.project(ctx, Some(&active), round == RETURNS);
+        }
+    }
+
+    /// One round of the projection over every archetype: all their points, or `only` those
+    /// listed; the points returned, by archetype.
+    fn project(&self, ctx: &Context<D>, only: Option<&[Vec<u32>]>, last: bool) -> Vec<Vec<u32>> {
+        points_with::<Volume>(&ctx.world)
+            .enumerate()
+            .map(|(a, arch)| {
                 let mut project = Project::<D> {
                     arch,
                     grid: &ctx.grid,
                     sums: &self.sums,
                     materials: &ctx.materials,
-                    last: round == RETURNS,
+                    only: only.map(|o| &o[a][..]),
+                    last,
                     returned: None,
                 };
                 visit_states(&mut project);
-                returned += match project.returned {
-                    Some(n) => n,
+                match project.returned {
+                    Some(r) => r,
                     None => project.run::<()>(None),
-                };
-            }
-            if returned == 0 {
-                break;
-            }
-        }
+                }
+            })
+            .collect()
     }
 }
 
@@ -214,10 +268,12 @@ struct Project<'a, D: Dim> {
     grid: &'a Grid<D>,
     sums: &'a NodePairs,
     materials: &'a [MaterialModel],
+    /// The points to visit, all when `None`.
+    only: Option<&'a [u32]>,
     /// The last round: scale the deviators of the points still outside.
     last: bool,
-    /// How many points were returned, once the archetype's state column was found.
-    returned: Option<usize>,
+    /// The points returned, once the archetype's state column was found.
+    returned: Option<Vec<u32>>,
 }
 
 impl<D: Dim> StateVisitor for Project<'_, D> {
@@ -231,49 +287,70 @@ impl<D: Dim> StateVisitor for Project<'_, D> {
 }
 
 impl<D: Dim> Project<'_, D> {
-    /// Projects every point, `states` its state column (`None` for points without state);
-    /// returns how many points were returned to their yield surface.
-    fn run<S: MaterialState>(&self, states: Option<hecs::ArchetypeColumnMut<'_, S>>) -> usize {
+    /// Projects the points, `states` their state column (`None` for points without
+    /// state); gives the points returned to their yield surface, in point order.
+    fn run<S: MaterialState>(&self, states: Option<hecs::ArchetypeColumnMut<'_, S>>) -> Vec<u32> {
         let (grid, sums, materials, last) = (self.grid, self.sums, self.materials, self.last);
         let (xg, mg) = (col::<Position<D::Vec>>(self.arch), col::<MaterialId>(self.arch));
         let (x, mat): (&[Position<D::Vec>], &[MaterialId]) = (&xg, &mg);
         let mut sg = col_mut::<Stress<D::Stress>>(self.arch);
-        let kernel = |c: usize, s: &mut [Stress<D::Stress>], st: &mut [S]| {
-            let mut returned = 0;
-            for (k, (sp, state)) in s.iter_mut().zip(st).enumerate() {
-                let p = c * CHUNK + k;
-                let mean = sums.of_cell(grid, x[p].0)[0];
-                let mut t = shift_mean::<D>(&sp.0, mean - mean_stress::<D>(&sp.0)).to_sym3();
-                let model = &materials[mat[p].0 as usize];
-                if !model.admits(&t, state) {
-                    if last {
-                        t = scale_deviator(&t, mean, |t| model.admits(t, state));
-                    }
-                    // A mean beyond the strength in tension (a cell at a free surface pulled
-                    // apart) admits no deviator at all: the material's return takes the point
-                    // to its tension limit, which no cell mean may pass.
-                    if !last || !model.admits(&t, state) {
-                        model.update(&mut t, &Sym3::ZERO, state);
-                        returned += 1;
-                    }
+        // One point: true when it was returned.
+        let point = |p: usize, sp: &mut Stress<D::Stress>, state: &mut S| {
+            let mean = sums.of_cell(grid, x[p].0)[0];
+            let mut t = shift_mean::<D>(&sp.0, mean - mean_stress::<D>(&sp.0)).to_sym3();
+            let model = &materials[mat[p].0 as usize];
+            let mut returned = false;
+            if !model.admits(&t, state) {
+                if last {
+                    t = scale_deviator(&t, mean, |t| model.admits(t, state));
                 }
-                sp.0 = D::Stress::from_sym3(&t);
+                // A mean beyond the strength in tension (a cell at a free surface pulled
+                // apart) admits no deviator at all: the material's return takes the point
+                // to its tension limit, which no cell mean may pass.
+                if !last || !model.admits(&t, state) {
+                    model.update(&mut t, &Sym3::ZERO, state);
+                    returned = !last;
+                }
             }
+            sp.0 = D::Stress::from_sym3(&t);
             returned
         };
-        match states {
-            Some(mut states) => sg
+        let mut spare = S::default();
+        match (self.only, states) {
+            // A later round: the few points of the cells that moved, one by one.
+            (Some(only), mut states) => only
+                .iter()
+                .copied()
+                .filter(|&p| {
+                    let state = states.as_mut().map_or(&mut spare, |st| &mut st[p as usize]);
+                    point(p as usize, &mut sg[p as usize], state)
+                })
+                .collect(),
+            (None, Some(mut states)) => sg
                 .par_chunks_mut(CHUNK)
                 .zip(states.par_chunks_mut(CHUNK))
                 .enumerate()
-                .map(|(c, (s, st))| kernel(c, s, st))
-                .sum(),
-            // A state of no size: the slice costs no memory.
-            None => sg
+                .flat_map_iter(|(c, (s, st))| {
+                    let hit: Vec<u32> = (0..s.len())
+                        .filter(|&k| point(c * CHUNK + k, &mut s[k], &mut st[k]))
+                        .map(|k| (c * CHUNK + k) as u32)
+                        .collect();
+                    hit
+                })
+                .collect(),
+            // A state of no size: the throw-away one costs no memory.
+            (None, None) => sg
                 .par_chunks_mut(CHUNK)
                 .enumerate()
-                .map(|(c, s)| kernel(c, s, &mut vec![S::default(); s.len()]))
-                .sum(),
+                .flat_map_iter(|(c, s)| {
+                    let mut spare = S::default();
+                    let hit: Vec<u32> = (0..s.len())
+                        .filter(|&k| point(c * CHUNK + k, &mut s[k], &mut spare))
+                        .map(|k| (c * CHUNK + k) as u32)
+                        .collect();
+                    hit
+                })
+                .collect(),
         }
     }
 }

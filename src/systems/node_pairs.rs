@@ -83,6 +83,12 @@ impl NodePairs {
         self.sums[grid.cell_key(x)]
     }
 
+    /// The pair of node `node`, to change by hand (a node the points reached since the
+    /// last [`NodePairs::clear`], or it is not cleared).
+    pub(crate) fn at_mut(&mut self, node: usize) -> &mut [f64; 2] {
+        &mut self.sums[node]
+    }
+
     /// Replaces the pair of every node the points reached by `f(pair)`.
     pub(crate) fn map<D: Dim>(&mut self, grid: &Grid<D>, f: impl Fn([f64; 2]) -> [f64; 2] + Sync) {
         for_each_box_node(grid, self.active, &Disjoint::new(&mut self.sums), |_, k, sums| {
