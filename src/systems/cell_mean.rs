@@ -3,7 +3,7 @@
 //!
 //! A point of a low-order grid that must flow at a set rate of volume change (ψ = 0: none;
 //! ψ > 0: sin ψ times its shear rate) is one constraint on the nodal velocities; four
-//! points a cell in 2D (eight in 3D) are twice (three times) the velocity degrees of freedom
+//! points a cell in 2D (eight in 3D) are twice (2.7 times) the velocity degrees of freedom
 //! a cell has, and the grid locks: a limit load grows with the stiffness. Here each
 //! background cell holds one volumetric strain rate and one mean stress, the constraint
 //! count of the Q1/P0 element (Hughes 1980, B-bar; Mast et al. 2012, "Mitigating kinematic
@@ -29,10 +29,11 @@
 //!   heaves out of the grid. Projecting the points' stress itself keeps the strength on the
 //!   stress the forces carry.
 //!
-//! Where the shift of its mean takes a point outside its yield surface, its deviator is
-//! scaled down to the surface at the new mean ([`Material::admits`]; see `scale_deviator`
-//! for why not the material's own return). Both systems group the points by the cell
-//! that holds them when they run: in USL and MUSL after the points moved, in USF before,
+//! Where the shift of its mean takes a point outside its yield surface ([`Material::admits`]),
+//! the point's own material returns it and its cell is projected again, for a few rounds
+//! (`RETURNS`), the last of which scales the deviator at the cell's mean instead. Both
+//! systems group the points by the cell that holds them when they run: in USL and MUSL
+//! after the points moved, in USF before,
 //! the same cells in both, and those of the next particle-to-grid.
 //!
 //! [`Material::admits`]: crate::materials::Material::admits
