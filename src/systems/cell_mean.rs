@@ -48,7 +48,7 @@ use crate::materials::{visit_states, MaterialModel, MaterialState, StateVisitor}
 use crate::parallel::CHUNK;
 use crate::schedule::System;
 use crate::shape::Shape;
-use crate::systems::node_pairs::NodePairs;
+use crate::systems::node_pairs::{set_volumetric_rates, NodePairs};
 use crate::tensor::{StoredSym, Sym3};
 use hecs::Archetype;
 use rayon::prelude::*;
@@ -135,7 +135,7 @@ impl<D: Dim, S: Shape> System<D> for CellMean<D, S> {
 
 impl<D: Dim, S: Shape> CellMean<D, S> {
     /// Σ_{p∈c} V_p q_p and Σ_{p∈c} V_p over every stressed point, then their ratio.
-    fn means<Q: Send + Sync + 'static>(&mut self, ctx: &mut Context<D>, q: impl Fn(&Q) -> f64 + Sync + Copy) {
+    fn means<Q: Send + Sync + 'static>(&mut self, ctx: &mut Context<D>, q: impl Fn(&Q) -> f64 + Sync) {
         let grid = &ctx.grid;
         for arch in points_with::<Volume>(&ctx.world) {
             let (xg, vg, qg) = (col::<Position<D::Vec>>(arch), col::<Volume>(arch), col::<Q>(arch));
@@ -152,19 +152,7 @@ impl<D: Dim, S: Shape> CellMean<D, S> {
     fn strain(&mut self, ctx: &mut Context<D>) {
         self.means::<VelocityGradient<D::Mat>>(ctx, |l| D::volumetric_rate(&l.0));
         let (grid, sums) = (&ctx.grid, &self.sums);
-        let n = D::STRAIN_AXES as f64;
-        for arch in points_with::<Volume>(&ctx.world) {
-            let xg = col::<Position<D::Vec>>(arch);
-            let x: &[Position<D::Vec>] = &xg;
-            let mut lg = col_mut::<VelocityGradient<D::Mat>>(arch);
-            lg.par_chunks_mut(CHUNK).enumerate().for_each(|(c, l)| {
-                for (k, lp) in l.iter_mut().enumerate() {
-                    let theta = sums.of_cell(grid, x[c * CHUNK + k].0)[0];
-                    let shift = (theta - D::volumetric_rate(&lp.0)) / n;
-                    D::add_identity(&mut lp.0, shift);
-                }
-            });
-        }
+        set_volumetric_rates::<D>(&ctx.world, |x| sums.of_cell(grid, x)[0]);
     }
 
     /// σ_p ← σ_p + (m̄_c − m_p) I_n, and where the point's strength does not admit that,
@@ -182,12 +170,15 @@ impl<D: Dim, S: Shape> CellMean<D, S> {
             let grid = &ctx.grid;
             let (dirty, sums) = (&mut self.dirty, &mut self.sums);
             dirty.resize(grid.node_count(), false);
+            let mut cells = Vec::new();
             for (arch, points) in points_with::<Volume>(&ctx.world).zip(&returned) {
                 let x = col::<Position<D::Vec>>(arch);
                 for &p in points {
                     let key = grid.cell_key(x[p as usize].0);
-                    dirty[key] = true;
-                    *sums.at_mut(key) = [0.0; 2];
+                    if !std::mem::replace(&mut dirty[key], true) {
+                        *sums.at_mut(key) = [0.0; 2];
+                        cells.push(key);
+                    }
                 }
             }
             let active: Vec<Vec<u32>> = points_with::<Volume>(&ctx.world)
@@ -209,15 +200,10 @@ impl<D: Dim, S: Shape> CellMean<D, S> {
                     pair[1] += vol[p].0;
                 }
             }
-            for (arch, points) in points_with::<Volume>(&ctx.world).zip(&returned) {
-                let x = col::<Position<D::Vec>>(arch);
-                for &p in points {
-                    let key = grid.cell_key(x[p as usize].0);
-                    if std::mem::take(&mut dirty[key]) {
-                        let pair = sums.at_mut(key);
-                        pair[0] /= pair[1];
-                    }
-                }
+            for key in cells {
+                let pair = sums.at_mut(key);
+                pair[0] /= pair[1];
+                dirty[key] = false;
             }
             returned = self.project(ctx, Some(&active), round == RETURNS);
         }
@@ -317,6 +303,13 @@ impl<D: Dim> Project<'_, D> {
             returned
         };
         let mut spare = S::default();
+        // The points of one chunk of CHUNK rows, c its number.
+        let chunk = |c: usize, s: &mut [Stress<D::Stress>], st: &mut [S]| -> Vec<u32> {
+            (0..s.len())
+                .filter(|&k| point(c * CHUNK + k, &mut s[k], &mut st[k]))
+                .map(|k| (c * CHUNK + k) as u32)
+                .collect()
+        };
         match (self.only, states) {
             // A later round: the few points of the cells that moved, one by one.
             (Some(only), mut states) => only
@@ -331,34 +324,22 @@ impl<D: Dim> Project<'_, D> {
                 .par_chunks_mut(CHUNK)
                 .zip(states.par_chunks_mut(CHUNK))
                 .enumerate()
-                .flat_map_iter(|(c, (s, st))| {
-                    let hit: Vec<u32> = (0..s.len())
-                        .filter(|&k| point(c * CHUNK + k, &mut s[k], &mut st[k]))
-                        .map(|k| (c * CHUNK + k) as u32)
-                        .collect();
-                    hit
-                })
+                .flat_map_iter(|(c, (s, st))| chunk(c, s, st))
                 .collect(),
-            // A state of no size: the throw-away one costs no memory.
+            // A state of no size: the slice costs no memory.
             (None, None) => sg
                 .par_chunks_mut(CHUNK)
                 .enumerate()
-                .flat_map_iter(|(c, s)| {
-                    let mut spare = S::default();
-                    let hit: Vec<u32> = (0..s.len())
-                        .filter(|&k| point(c * CHUNK + k, &mut s[k], &mut spare))
-                        .map(|k| (c * CHUNK + k) as u32)
-                        .collect();
-                    hit
-                })
+                .flat_map_iter(|(c, s)| chunk(c, s, &mut vec![S::default(); s.len()]))
                 .collect(),
         }
     }
 }
 
 /// m I + α (σ − m I) with the largest α in [0, 1] (to 2⁻⁴⁰) that `admits` takes; α = 0
-/// where none does (a mean beyond the tension cut-off, which the caller then returns). The mean over the strain axes stays
-/// m: in plane strain σ_zz − m scales with the rest, and σ_xx + σ_yy stays 2m.
+/// where none does (a mean beyond the tension cut-off, which the caller then returns).
+/// The mean over the strain axes stays m: in plane strain σ_zz − m scales with the rest,
+/// and σ_xx + σ_yy stays 2m.
 ///
 /// The last resort of [`RETURNS`]: it holds the mean, so the projection is done.
 fn scale_deviator(sigma: &Sym3, m: f64, admits: impl Fn(&Sym3) -> bool) -> Sym3 {

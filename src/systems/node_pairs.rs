@@ -3,11 +3,15 @@
 //! and a maximum (mass scaling); or two sums a cell, kept at the cell's lowest node (the
 //! cell means against locking). Shared by the systems that need such a field for one step.
 
-use crate::components::Position;
+use crate::components::{Position, VelocityGradient, Volume};
 use crate::dim::Dim;
 use crate::grid::{Grid, NodeBox};
+use crate::infra::columns::{col, col_mut, points_with};
+use crate::parallel::CHUNK;
 use crate::parallel::{fill_box, for_each_box_node, scatter, Disjoint, SlabCache};
 use crate::shape::{for_each_node, Shape};
+use hecs::World;
+use rayon::prelude::*;
 
 /// Per node a pair `[f64; 2]`, zero outside the box the points reached since the last
 /// [`NodePairs::clear`], so a step pays only for the nodes in use.
@@ -30,21 +34,10 @@ impl NodePairs {
         value: impl Fn(usize) -> V + Sync,
         add: impl Fn(&mut [f64; 2], f64, &V) + Sync,
     ) {
-        self.sums.resize(grid.node_count(), [0.0; 2]);
-        let reached = scatter(
-            slabs.slabs(grid, x),
-            grid,
-            S::SUPPORT,
-            &Disjoint::new(&mut self.sums),
-            |points, sums, lo| {
-                for &p in points {
-                    let p = p as usize;
-                    let v = value(p);
-                    for_each_node::<D, S>(grid, x[p].0, |i, w, _| add(&mut sums[i - lo], w, &v));
-                }
-            },
-        );
-        self.active = self.active.union(reached);
+        self.each_point::<D, S>(slabs, grid, x, |p, sums, lo| {
+            let v = value(p);
+            for_each_node::<D, S>(grid, x[p].0, |i, w, _| add(&mut sums[i - lo], w, &v));
+        });
     }
 
     /// Adds the points at `x` (a column of one archetype) cell by cell: `value(p)` goes into
@@ -58,6 +51,23 @@ impl NodePairs {
         x: &[Position<D::Vec>],
         value: impl Fn(usize) -> [f64; 2] + Sync,
     ) {
+        self.each_point::<D, S>(slabs, grid, x, |p, sums, lo| {
+            let [a, b] = value(p);
+            let pair = &mut sums[grid.cell_key(x[p].0) - lo];
+            pair[0] += a;
+            pair[1] += b;
+        });
+    }
+
+    /// The scatter both sums share: `add(p, pairs, first_node)` for every point p at `x`,
+    /// slab by slab, with the pairs of the slab's node range starting at `first_node`.
+    fn each_point<D: Dim, S: Shape>(
+        &mut self,
+        slabs: &mut SlabCache,
+        grid: &Grid<D>,
+        x: &[Position<D::Vec>],
+        add: impl Fn(usize, &mut [[f64; 2]], usize) + Sync,
+    ) {
         self.sums.resize(grid.node_count(), [0.0; 2]);
         let reached = scatter(
             slabs.slabs(grid, x),
@@ -66,11 +76,7 @@ impl NodePairs {
             &Disjoint::new(&mut self.sums),
             |points, sums, lo| {
                 for &p in points {
-                    let p = p as usize;
-                    let [a, b] = value(p);
-                    let pair = &mut sums[grid.cell_key(x[p].0) - lo];
-                    pair[0] += a;
-                    pair[1] += b;
+                    add(p as usize, sums, lo);
                 }
             },
         );
@@ -105,5 +111,23 @@ impl NodePairs {
     pub(crate) fn clear<D: Dim>(&mut self, grid: &Grid<D>) {
         fill_box(grid, self.active, &mut self.sums, [0.0; 2]);
         self.active = NodeBox::default();
+    }
+}
+
+/// L_p ← L_p + (θ_p − tr L_p) I / n for every point with a volume, θ_p = `theta(x_p)`: the
+/// point's rate of volume change replaced, its deviatoric rate and spin kept (the nodal
+/// smoothing and the cell means, n = `Dim::STRAIN_AXES`).
+pub(crate) fn set_volumetric_rates<D: Dim>(world: &World, theta: impl Fn(D::Vec) -> f64 + Sync) {
+    let n = D::STRAIN_AXES as f64;
+    for arch in points_with::<Volume>(world) {
+        let xg = col::<Position<D::Vec>>(arch);
+        let x: &[Position<D::Vec>] = &xg;
+        let mut lg = col_mut::<VelocityGradient<D::Mat>>(arch);
+        lg.par_chunks_mut(CHUNK).enumerate().for_each(|(c, l)| {
+            for (k, lp) in l.iter_mut().enumerate() {
+                let shift = (theta(x[c * CHUNK + k].0) - D::volumetric_rate(&lp.0)) / n;
+                D::add_identity(&mut lp.0, shift);
+            }
+        });
     }
 }

@@ -5,12 +5,10 @@ use crate::components::*;
 use crate::context::Context;
 use crate::dim::Dim;
 use crate::error::StepError;
-use crate::infra::columns::{col, col_mut, points_with};
-use crate::parallel::CHUNK;
+use crate::infra::columns::{col, points_with};
 use crate::schedule::System;
 use crate::shape::{for_each_node, Shape};
-use crate::systems::node_pairs::NodePairs;
-use rayon::prelude::*;
+use crate::systems::node_pairs::{set_volumetric_rates, NodePairs};
 use std::marker::PhantomData;
 
 /// Replaces each point's volumetric strain rate tr(L_p) by its volume-weighted nodal
@@ -69,20 +67,11 @@ impl<D: Dim, S: Shape> System<D> for VolumetricSmoothing<D, S> {
         }
         sums.map(grid, |s| [if s[1] > 0.0 { s[0] / s[1] } else { 0.0 }, 0.0]);
         let nodal = sums.pairs();
-        let n = D::STRAIN_AXES as f64;
-        for arch in points_with::<Volume>(&ctx.world) {
-            let xg = col::<Position<D::Vec>>(arch);
-            let x: &[Position<D::Vec>] = &xg;
-            let mut lg = col_mut::<VelocityGradient<D::Mat>>(arch);
-            lg.par_chunks_mut(CHUNK).enumerate().for_each(|(c, l)| {
-                for (k, lp) in l.iter_mut().enumerate() {
-                    let mut theta = 0.0;
-                    for_each_node::<D, S>(grid, x[c * CHUNK + k].0, |i, w, _| theta += w * nodal[i][0]);
-                    let shift = (theta - D::volumetric_rate(&lp.0)) / n;
-                    D::add_identity(&mut lp.0, shift);
-                }
-            });
-        }
+        set_volumetric_rates::<D>(&ctx.world, |x| {
+            let mut theta = 0.0;
+            for_each_node::<D, S>(grid, x, |i, w, _| theta += w * nodal[i][0]);
+            theta
+        });
         sums.clear(grid);
         Ok(())
     }
