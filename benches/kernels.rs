@@ -105,21 +105,21 @@ fn kernels(c: &mut Criterion) {
 fn water(c: &mut Criterion) {
     let mut sim = after_200_steps("scenes/slope_water.ron");
     let mut p2g = P2g::<Dim2, QuadraticBSpline>::new(P2gPart::All);
-    let water = sim.ctx.settings.water.clone();
+    let water = sim.ctx.model.water.clone();
     c.bench_function("p2g (slope_water, with its water)", |b| {
         b.iter(|| {
             GridReset.run(&mut sim.ctx).unwrap();
             p2g.run(&mut sim.ctx).unwrap();
         })
     });
-    sim.ctx.settings.water = None;
+    sim.ctx.model.water = None;
     c.bench_function("p2g (slope_water, the same points dry)", |b| {
         b.iter(|| {
             GridReset.run(&mut sim.ctx).unwrap();
             p2g.run(&mut sim.ctx).unwrap();
         })
     });
-    sim.ctx.settings.water = water;
+    sim.ctx.model.water = water;
     c.bench_function("step (slope_water)", |b| b.iter(|| sim.step().unwrap()));
 }
 

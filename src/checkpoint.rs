@@ -19,13 +19,11 @@ use crate::components::*;
 use crate::dim::Dim;
 use crate::grid::NodeBox;
 use crate::infra::columns::points_with;
+use crate::model::{Control, CurvePoint, Drive, StageResult};
 use crate::parallel::SlabCache;
 use crate::rigid::BodyState;
 use crate::simulation::Simulation;
-use crate::state::{
-    Clock, Control, Convergence, CurvePoint, Drive, EnergyWindow, Peak, RankCounters, Resets, SolverState,
-    StageResult, StaticWindow,
-};
+use crate::state::{Clock, Convergence, EnergyWindow, Peak, RankCounters, Resets, SolverState, StaticWindow};
 use hecs::Archetype;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
@@ -233,36 +231,34 @@ fn check_ids<D: Dim>(sim: &Simulation<D>, state: &SolverState) -> Result<(), Str
             }
         }
     }
-    let settings = &sim.ctx.settings;
-    if state.control.drives.len() != settings.motions.len() {
+    let model = &sim.ctx.model;
+    if state.control.drives.len() != model.motions.len() {
         return Err(format!(
             "{} motions saved, the scene has {}",
             state.control.drives.len(),
-            settings.motions.len()
+            model.motions.len()
         ));
     }
-    if state.control.bodies.len() != settings.bodies.len() {
+    if state.control.bodies.len() != model.bodies.len() {
         return Err(format!(
             "{} rigid bodies saved, the scene has {}",
             state.control.bodies.len(),
-            settings.bodies.len()
+            model.bodies.len()
         ));
     }
-    if state.control.stage >= settings.stages.len().max(1)
-        || state.control.stages.len() > settings.stages.len()
-    {
+    if state.control.stage >= model.stages.len().max(1) || state.control.stages.len() > model.stages.len() {
         return Err(format!(
             "stage {} saved, the scene has {} stages",
             state.control.stage,
-            settings.stages.len()
+            model.stages.len()
         ));
     }
-    if state.control.load_increments.len() > settings.load_steps.len()
+    if state.control.load_increments.len() > model.load_steps.len()
         || state
             .control
             .load_increments
             .iter()
-            .zip(&settings.load_steps)
+            .zip(&model.load_steps)
             .any(|(&k, l)| k > l.increments)
     {
         return Err("the loads' increments saved do not fit the scene's loads".into());

@@ -91,7 +91,7 @@ pub struct NodeVelocity<V>(pub V);
 
 /// Constrained velocity components of a node: bit `a` (0–2) set means axis `a` is held,
 /// at zero, or, when the high four bits name a prescribed motion (its index + 1 in
-/// [`crate::state::Control::drives`]) that drives the axis, at its velocity. Bit 3
+/// [`crate::model::Control::drives`]) that drives the axis, at its velocity. Bit 3
 /// ([`NodeFixity::FRICTION`]) marks a node on a `Friction` face.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub struct NodeFixity(pub u8);
@@ -100,7 +100,7 @@ impl NodeFixity {
     /// Most prescribed motions a scene may have.
     pub const MAX_DRIVES: usize = 15;
 
-    /// The bit of a node on a `Friction` face ([`crate::state::Settings::friction_faces`]).
+    /// The bit of a node on a `Friction` face ([`crate::model::Model::friction_faces`]).
     pub const FRICTION: u8 = 0b1000;
 
     /// True when axis `a` is held.
@@ -119,7 +119,7 @@ impl NodeFixity {
     }
 
     /// Held on the axes of `mask` with prescribed motion `drive` (< [`Self::MAX_DRIVES`]);
-    /// the motion's own axes ([`crate::state::Drive::axes`]) move with it, the others stay
+    /// the motion's own axes ([`crate::model::Drive::axes`]) move with it, the others stay
     /// fixed.
     pub fn driven(mask: u8, drive: usize) -> NodeFixity {
         debug_assert!(drive < Self::MAX_DRIVES);

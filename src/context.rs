@@ -5,14 +5,15 @@ use crate::grid::Grid;
 use crate::infra::comm::Comm;
 use crate::infra::decomposition::Decomposition;
 use crate::materials::MaterialModel;
+use crate::model::Model;
 use crate::parallel::SlabCache;
-use crate::state::{Settings, SolverState};
+use crate::state::{Numerics, SolverState};
 use hecs::World;
 use std::ops::Range;
 use std::sync::Arc;
 
 /// Everything the systems read and write: the world (points and nodes), the grid, the
-/// material table and the solver-wide state.
+/// material table, the numerics, the model and the solver-wide state.
 pub struct Context<D: Dim> {
     /// Points and nodes.
     pub world: World,
@@ -20,8 +21,10 @@ pub struct Context<D: Dim> {
     pub grid: Grid<D>,
     /// Materials, indexed by [`MaterialId`](crate::components::MaterialId).
     pub materials: Vec<MaterialModel>,
-    /// Fixed settings.
-    pub settings: Settings,
+    /// How the model is solved: time step, scheme, damping, stopping rule.
+    pub numerics: Numerics,
+    /// What is solved: gravity, water, rigid bodies, motions, stages, loads.
+    pub model: Model,
     /// Quantities updated every step.
     pub state: SolverState,
     /// Points grouped by slab of cells for the scatters, kept until points move.
@@ -40,7 +43,7 @@ impl<D: Dim> Context<D> {
     /// a fraction of it at an interpolated kinetic-damping reset, `None` at a plain reset
     /// ([`crate::state::Resets::motion_dt`]).
     pub fn motion_dt(&self) -> Option<f64> {
-        self.state.resets.motion_dt(self.settings.dt)
+        self.state.resets.motion_dt(self.numerics.dt)
     }
 
     /// The node ids this rank owns when the run has several ranks (each node is owned by

@@ -44,6 +44,7 @@ pub mod infra;
 pub mod interrupt;
 pub mod materials;
 pub mod measure;
+pub mod model;
 pub mod output;
 pub(crate) mod parallel;
 pub(crate) mod polygon;

@@ -100,7 +100,7 @@ impl<D: Dim> Simulation<D> {
         let s = &mut self.ctx.state;
         s.clock.step += 1;
         // time = n·Δt rather than a running sum, so long runs do not drift.
-        s.clock.time = s.clock.step as f64 * self.ctx.settings.dt;
+        s.clock.time = s.clock.step as f64 * self.ctx.numerics.dt;
         s.resets.this_step = false;
         s.control.milestone = false;
         let result = self.schedule.run(&mut self.ctx);

@@ -1,8 +1,7 @@
-//! Solver-wide state and settings: plain structs outside the ECS world.
+//! The solver's numerics and its state through a run: plain structs outside the ECS world.
 
-use crate::error::Refusal;
 use crate::grid::NodeBox;
-use crate::materials::MaterialModel;
+use crate::model::Control;
 use serde::{Deserialize, Serialize};
 
 /// Where the stress update sits in the step.
@@ -82,34 +81,6 @@ pub enum StopReason {
     DisplacementLimit,
 }
 
-/// Gravity acting on all points (m/s²), applied at once or ramped linearly.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Gravity {
-    /// Full gravitational acceleration (m/s², x y z).
-    pub acceleration: [f64; 3],
-    /// Time over which it rises linearly from zero (s); 0 applies it at once.
-    pub ramp_time: f64,
-    /// When the ramp starts (s): 0, or the start of the loading stage that set it.
-    pub start: f64,
-}
-
-impl Gravity {
-    /// The fraction of full gravity at time `t` (s).
-    pub fn factor(&self, t: f64) -> f64 {
-        if self.ramp_time > 0.0 {
-            ((t - self.start) / self.ramp_time).clamp(0.0, 1.0)
-        } else {
-            1.0
-        }
-    }
-
-    /// The fraction of full gravity applied in the step that ends at `time` (s): the load
-    /// of a step acts over [t − Δt, t], so a ramp uses its start.
-    pub fn step_factor(&self, time: f64, dt: f64) -> f64 {
-        self.factor(time - dt)
-    }
-}
-
 /// A confirmation that a state meeting K_F and K_E is really static: the run goes on for
 /// `window` seconds and stops only if no point moved more than `max_displacement` in that
 /// time (and both ratios are still met). A creeping slope meets K_F and K_E between
@@ -123,9 +94,11 @@ pub struct StaticCheck {
     pub max_displacement: f64,
 }
 
-/// Settings fixed for the whole run (but for what a loading stage changes: gravity).
-#[derive(Clone, Debug, PartialEq)]
-pub struct Settings {
+/// The numerics of a run: how the model is solved (time step, scheme, damping, the
+/// stopping rule, the treatments of the grid), fixed for the run and `Copy`, as rapier's
+/// `IntegrationParameters`. What is solved is the [`Model`](crate::model::Model).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Numerics {
     /// Time step Δt (s), from the scene (`solver.time_step`).
     pub dt: f64,
     /// Update scheme.
@@ -142,17 +115,12 @@ pub struct Settings {
     pub max_time: Option<f64>,
     /// Confirmation that a converged state is static, if asked for.
     pub static_check: Option<StaticCheck>,
-    /// Gravity, if any.
-    pub gravity: Option<Gravity>,
     /// FLIP fraction α of the point velocity update (1 = FLIP, 0 = PIC).
     pub flip: f64,
     /// The volumetric treatment against locking.
     pub anti_locking: AntiLocking,
     /// Put the points back in cell order every this many steps (0: never).
     pub sort_every: u64,
-    /// Mass scaling's inertia factor s_m of each material, by
-    /// [`MaterialId`](crate::components::MaterialId); empty without mass scaling.
-    pub inertia_factors: Vec<f64>,
     /// Kinetic damping places each reset at the peak of a parabola through the last three
     /// kinetic energies instead of at the step where the drop was seen.
     pub peak_interpolation: bool,
@@ -165,75 +133,9 @@ pub struct Settings {
     /// Leaving a node out drops its share of Σ_i ∇w_ip = 0, which acts as a spurious force
     /// V_p σ_p ∇w_ip: keep this tiny and tame light nodes with `virtual_mass_floor`.
     pub min_node_mass: f64,
-    /// The water table, if any.
-    pub water: Option<crate::water::Water>,
-    /// Prescribed motions (displacement control), in scene order.
-    pub motions: Vec<MotionSpec>,
-    /// Rigid bodies, in scene order.
-    pub bodies: Vec<crate::rigid::RigidBodySpec>,
     /// Strain energy the points' initial stress may give up, at most (J; J/m in 2D, J/rad
     /// axisymmetric): the energy guard counts it beside the external work.
     pub initial_energy: f64,
-    /// The scene's `Friction` faces: (normal axis, upper face, tan δ).
-    pub friction_faces: Vec<(usize, bool, f64)>,
-    /// Loading stages, in order; the first is the scene as built.
-    pub stages: Vec<LoadStage>,
-    /// Loads applied in increments (load control), each increment to its static stop.
-    pub load_steps: Vec<LoadSteps>,
-    /// The points whose traction is a pressure that follows the surface.
-    pub pressures: crate::surface_pressure::SurfacePressures,
-}
-
-/// A load applied in equal increments, each relaxed to its static state and recorded as a
-/// row of the load–displacement curve.
-#[derive(Clone, Debug, PartialEq)]
-pub struct LoadSteps {
-    /// Name given in the scene.
-    pub name: String,
-    /// The points that carry it (ids) and the force each carries at full load (N; N/m in
-    /// 2D, x y z).
-    pub points: Vec<(u32, [f64; 3])>,
-    /// Number of increments.
-    pub increments: u32,
-    /// The full load as a pressure (Pa): the traction's size.
-    pub pressure: f64,
-}
-
-/// A loading stage: what changes when it begins; it runs to the static stop.
-#[derive(Clone, Debug, PartialEq)]
-pub struct LoadStage {
-    /// Name given in the scene.
-    pub name: String,
-    /// Materials it replaces, by material index.
-    pub materials: Vec<(u16, MaterialModel)>,
-    /// Point loads it sets (carriers' and traction points'), by point id in ascending
-    /// order (force: N; N/m in 2D, x y z).
-    pub loads: Vec<(u32, [f64; 3])>,
-    /// The face conditions it sets: each node's held axes (`NodeFixity` bits 0–2).
-    pub fixity: Option<Vec<u8>>,
-    /// Gravity it sets (its ramp starts with the stage).
-    pub gravity: Option<Gravity>,
-    /// The water it sets (its surfaces), if it moves it.
-    pub water: Option<crate::water::Water>,
-    /// Zero every point's accumulated displacement when it begins (after a geostatic stage).
-    pub reset_displacements: bool,
-}
-
-/// The static state that ended a stage (`stages.csv`).
-#[derive(Clone, Debug, Default, PartialEq, Serialize)]
-pub struct StageResult {
-    /// The stage.
-    pub name: String,
-    /// Step of its static state.
-    pub step: u64,
-    /// Simulated time (s).
-    pub time: f64,
-    /// K_F (the stopping rule's norm) and K_E at the end.
-    pub force_ratio: f64,
-    /// K_E at the end.
-    pub energy_ratio: f64,
-    /// Kinetic-damping resets so far.
-    pub resets: u64,
 }
 
 /// A kinetic-energy peak at which velocities were reset.
@@ -243,154 +145,6 @@ pub struct Peak {
     pub time: f64,
     /// Kinetic energy at the peak (J).
     pub energy: f64,
-}
-
-/// A prescribed motion of grid nodes: the velocity its nodes are held at and the force
-/// they exert on the body. The system that drives it (`systems::prescribed_motion`) sets
-/// the velocity; `boundary` holds the nodes to it and sums the reaction.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct Drive {
-    /// Name given in the scene.
-    pub name: String,
-    /// The axes the motion drives (bit `a` for axis `a`); its nodes' other held axes are
-    /// fixed by a face condition.
-    pub axes: u8,
-    /// Velocity of the driven components this step (m/s, x y z; zero while holding).
-    pub velocity: [f64; 3],
-    /// Force the driven nodes exert on the body this step, Σ −(f_int + f_ext) over their
-    /// driven components (N; N per metre of thickness in 2D).
-    pub reaction: [f64; 3],
-    /// Distance travelled along the motion so far (m).
-    pub travel: f64,
-    /// Increments finished, each ending at a static state.
-    pub increments: u32,
-}
-
-/// A prescribed motion of grid nodes (`motions: [...]` in a scene), driven by
-/// `systems::prescribed_motion`.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct MotionSpec {
-    /// Name: `curve.csv` rows and `history.csv` columns carry it.
-    pub name: String,
-    /// Lower corner of the box of driven nodes (m).
-    pub min: Vec<f64>,
-    /// Upper corner of the box of driven nodes (m); nodes on its faces are inside.
-    pub max: Vec<f64>,
-    /// Velocity per axis (m/s); `None` leaves that axis free (a smooth footing moves
-    /// only vertically).
-    pub velocity: Vec<Option<f64>>,
-    /// Distance to travel along the velocity (m).
-    pub travel: f64,
-    /// Distance of one increment (m), each ending at a static state: a row of
-    /// `curve.csv`. Default: the whole travel in one.
-    #[serde(default)]
-    pub increment: Option<f64>,
-    /// Loaded area (m²; m per metre of thickness in 2D), for the mean pressure in
-    /// `curve.csv` and `limit_pressure` in summary.json.
-    #[serde(default)]
-    pub area: Option<f64>,
-}
-
-impl MotionSpec {
-    /// The velocity as a vector (m/s, x y z; free axes 0).
-    pub fn vector(&self) -> [f64; 3] {
-        std::array::from_fn(|a| self.velocity.get(a).copied().flatten().unwrap_or(0.0))
-    }
-
-    /// Speed along the motion (m/s).
-    pub fn speed(&self) -> f64 {
-        self.vector().iter().map(|v| v * v).sum::<f64>().sqrt()
-    }
-
-    /// The motion's state at the start of a run: moving.
-    pub fn drive(&self) -> Drive {
-        Drive {
-            name: self.name.clone(),
-            axes: self
-                .velocity
-                .iter()
-                .enumerate()
-                .filter(|(_, v)| v.is_some())
-                .fold(0, |mask, (a, _)| mask | 1 << a),
-            velocity: self.vector(),
-            ..Drive::default()
-        }
-    }
-
-    /// Checks the fields for a scene of `dimension`: or the [`Refusal`] of the field.
-    pub fn check(&self, dimension: usize) -> Result<(), Refusal> {
-        for (field, v) in [("min", &self.min), ("max", &self.max)] {
-            if v.len() != dimension {
-                return Err(Refusal::new(
-                    field,
-                    format!("needs {dimension} entries, one per axis"),
-                ));
-            }
-        }
-        for (field, v) in [("min", &self.min), ("max", &self.max)] {
-            if let Some(k) = v.iter().position(|x| !x.is_finite()) {
-                return Err(Refusal::new(
-                    field,
-                    format!("entry {k} must be a finite coordinate (m), found {}", v[k]),
-                ));
-            }
-        }
-        if self.min.iter().zip(&self.max).any(|(lo, hi)| lo > hi) {
-            return Err(Refusal::new("max", "every entry must be at least min's".into()));
-        }
-        if self.velocity.len() != dimension {
-            return Err(Refusal::new(
-                "velocity",
-                format!("needs {dimension} entries (Some(m/s) or None)"),
-            ));
-        }
-        if self.velocity.iter().flatten().any(|v| !v.is_finite()) {
-            return Err(Refusal::new("velocity", "must be finite".into()));
-        }
-        if self.speed() <= 0.0 {
-            return Err(Refusal::new(
-                "velocity",
-                "must move: at least one entry Some and not zero".into(),
-            ));
-        }
-        if !(self.travel.is_finite() && self.travel > 0.0) {
-            return Err(Refusal::new("travel", "must be above 0 (m)".into()));
-        }
-        if let Some(inc) = self.increment {
-            if !(inc.is_finite() && inc > 0.0 && inc <= self.travel) {
-                return Err(Refusal::new(
-                    "increment",
-                    "must be above 0 and at most travel (m)".into(),
-                ));
-            }
-        }
-        if let Some(a) = self.area {
-            if !(a.is_finite() && a > 0.0) {
-                return Err(Refusal::new("area", "must be above 0".into()));
-            }
-        }
-        Ok(())
-    }
-}
-
-/// One static state of a load–displacement curve (`curve.csv`).
-#[derive(Clone, Debug, Default, PartialEq, Serialize)]
-pub struct CurvePoint {
-    /// Name of the motion or load.
-    pub name: String,
-    /// Step of the static state.
-    pub step: u64,
-    /// Simulated time (s).
-    pub time: f64,
-    /// Displacement along the motion (m).
-    pub displacement: f64,
-    /// Force on the body (N; N/m in 2D, x y z).
-    pub force: [f64; 3],
-    /// Mean pressure against the motion over the loaded area (Pa), when the scene gives
-    /// the area (left out of summary.json otherwise).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub pressure: Option<f64>,
 }
 
 /// Solver-wide quantities updated by the systems every step, in named parts. The parts a
@@ -425,7 +179,7 @@ pub struct SolverState {
     pub points_reordered: bool,
 }
 
-/// Step count and simulated time; Δt is a setting ([`Settings::dt`]).
+/// Step count and simulated time; Δt is a setting ([`Numerics::dt`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Clock {
     /// Number of the current step (1-based while the schedule runs; steps done afterwards).
@@ -437,10 +191,10 @@ pub struct Clock {
 impl Clock {
     /// The limit this step reached, if any: `max_steps`, then `max_time` (to round-off of
     /// n·Δt).
-    pub fn limit(&self, settings: &Settings) -> Option<StopReason> {
-        if settings.max_steps.is_some_and(|m| self.step >= m) {
+    pub fn limit(&self, numerics: &Numerics) -> Option<StopReason> {
+        if numerics.max_steps.is_some_and(|m| self.step >= m) {
             Some(StopReason::MaxSteps)
-        } else if settings.max_time.is_some_and(|t| self.time >= t * (1.0 - 1e-12)) {
+        } else if numerics.max_time.is_some_and(|t| self.time >= t * (1.0 - 1e-12)) {
             Some(StopReason::MaxTime)
         } else {
             None
@@ -571,64 +325,6 @@ pub struct StaticWindow {
     pub snapshot: Vec<[f64; 3]>,
 }
 
-/// What the control systems keep: prescribed motions and their curve, stages, loads
-/// under load control.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct Control {
-    /// Prescribed motions, in scene order (a node's [`NodeFixity::driver`]).
-    ///
-    /// [`NodeFixity::driver`]: crate::components::NodeFixity::driver
-    pub drives: Vec<Drive>,
-    /// Rigid bodies, in scene order.
-    pub bodies: Vec<crate::rigid::BodyState>,
-    /// The nodes in contact with a body this step, in node order (rebuilt each step by
-    /// `rigid_contact` before anything reads it; not checkpointed).
-    pub contacts: crate::rigid::contact::Contacts,
-    /// Each contact's normal impulse at the end of the last step's `rigid_contact` solve,
-    /// by key: the next one's warm start.
-    pub contact_memory: crate::rigid::contact::Memory,
-    /// Static states of the load–displacement curve so far.
-    pub curve: Vec<CurvePoint>,
-    /// The loading stage under way (index in `Settings::stages`).
-    pub stage: usize,
-    /// Stages finished so far.
-    pub stages: Vec<StageResult>,
-    /// Increments each load under load control has finished (`Settings::load_steps`).
-    pub load_increments: Vec<u32>,
-    /// True when a control system consumed a static state in this step (an increment or a
-    /// stage ended): snapshot writers take one.
-    pub milestone: bool,
-}
-
-impl Control {
-    /// True while a prescribed motion or a rigid body under displacement control moves: not
-    /// a static state, however balanced (a body under load control moves until it is
-    /// balanced: [`Control::unbalanced`]).
-    pub fn driving(&self) -> bool {
-        self.drives.iter().any(|d| d.velocity != [0.0; 3])
-            || self
-                .bodies
-                .iter()
-                .any(|b| b.velocity != [0.0; 3] && b.load == [0.0; 3])
-    }
-
-    /// The largest out-of-balance force along its load of a body under load control, over
-    /// the load (0 when no body carries one): a static state needs it within the
-    /// tolerance as K_F is.
-    pub fn unbalanced(&self) -> f64 {
-        self.bodies
-            .iter()
-            .filter(|b| b.load != [0.0; 3])
-            .map(|b| {
-                let f2: f64 = b.load.iter().map(|c| c * c).sum();
-                // The load plus the soil's resistance (−reaction), along the load.
-                let net: f64 = (0..3).map(|a| (b.load[a] - b.reaction[a]) * b.load[a]).sum();
-                net.abs() / f2
-            })
-            .fold(0.0, f64::max)
-    }
-}
-
 /// Counters of a run over MPI ranks (empty or zero on one rank).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct RankCounters {
@@ -641,20 +337,13 @@ pub struct RankCounters {
     pub rebalances: u64,
 }
 
-impl Settings {
-    /// True when the scene asked for mass scaling (`solver.mass_scaling`).
-    pub fn mass_scaling(&self) -> bool {
-        !self.inertia_factors.is_empty()
-    }
-}
-
 impl SolverState {
     /// Goes on after a static state that a control system consumed (an increment, a
     /// stage): the stop is lifted unless the step or time limit is reached, which ends the
     /// run even while increments are left (a load in 10⁹ increments that each balance at
     /// once would otherwise never reach `max_steps`).
-    pub fn go_on(&mut self, settings: &Settings) {
+    pub fn go_on(&mut self, numerics: &Numerics) {
         self.static_window.start = None;
-        self.stop = self.clock.limit(settings);
+        self.stop = self.clock.limit(numerics);
     }
 }

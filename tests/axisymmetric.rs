@@ -4,7 +4,7 @@
 mod common;
 
 use common::{factors, refusal, rel, run};
-use kdmpm::state::CurvePoint;
+use kdmpm::model::CurvePoint;
 
 /// Lamé's thick cylinder (`scenes/cylinder.ron`: a = 1 m, b = 2 m, p = 100 kPa on the bore,
 /// plane strain along the axis): σ_rr = A − B/r², σ_θθ = A + B/r², σ_zz = 2νA with

@@ -89,7 +89,7 @@ fn a_run_whose_time_step_is_far_too_large_stops_with_a_located_error() {
     let AnySimulation::Three(mut sim) = load("bar.ron", &["solver.time_step=Fixed(1.0)"]) else {
         panic!()
     };
-    sim.ctx.settings.dt = 3.0;
+    sim.ctx.numerics.dt = 3.0;
     let err = sim
         .run(|_| {})
         .expect_err("an explicit step three times the critical one blows up");

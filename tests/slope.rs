@@ -69,7 +69,7 @@ fn run_and_continue<D: Dim>(sim: &mut Simulation<D>) -> Rest {
         s.convergence.force_ratio_max,
         s.convergence.energy_ratio
     );
-    let (t_stop, steps, norm) = (s.clock.time, s.clock.step, sim.ctx.settings.force_norm);
+    let (t_stop, steps, norm) = (s.clock.time, s.clock.step, sim.ctx.numerics.force_norm);
     assert!(s.convergence.force_ratio(norm) <= 0.01 && s.convergence.energy_ratio <= 0.01);
     let angle = surface_angle(sim).expect("a surface").degrees;
     let (_, max_ux) = max_displacements(sim).expect("the slope scenes keep displacements");
@@ -83,7 +83,7 @@ fn run_and_continue<D: Dim>(sim: &mut Simulation<D>) -> Rest {
     // Static: ten more seconds move nothing by more than 1 cm.
     let (mut before, mut after) = (Vec::new(), Vec::new());
     positions::<D>(&sim.ctx.world, &mut before);
-    let more = (10.0 / sim.ctx.settings.dt).ceil() as u64;
+    let more = (10.0 / sim.ctx.numerics.dt).ceil() as u64;
     for _ in 0..more {
         sim.step().expect("continuing stays stable");
     }

@@ -57,7 +57,7 @@ fn points_updated_four_at_a_time_get_the_bits_of_points_updated_one_at_a_time() 
     // One step sorts the points by cell, which interleaves the materials of each archetype.
     sim.step().expect("one step");
     let ctx = &mut sim.ctx;
-    let dt = ctx.settings.dt;
+    let dt = ctx.numerics.dt;
     let mut seed = 7;
     let mut expected = Vec::new();
     let mut mixed_groups = 0;

@@ -3,10 +3,10 @@
 use crate::context::Context;
 use crate::dim::Dim;
 use crate::error::StepError;
+use crate::model::Drive;
 use crate::output::dir::RowFile;
 use crate::schedule::System;
 use crate::simulation::{traced_values, TracedPoint};
-use crate::state::Drive;
 use crate::systems::convergence::ratio_cell;
 use std::marker::PhantomData;
 use std::path::Path;

@@ -3,6 +3,7 @@
 //! files (`examples/write_results.rs`).
 
 use crate::dim::Dim;
+use crate::model::{CurvePoint, StageResult};
 use crate::output::dir::OutputDir;
 use crate::output::history::{self, History};
 use crate::output::snapshots::{SnapshotSpec, SnapshotWriter, Snapshots};
@@ -10,7 +11,6 @@ use crate::output::summary::Summary;
 use crate::output::vtk::{write_parallel_points, write_points};
 use crate::output::RowFile;
 use crate::simulation::Simulation;
-use crate::state::{CurvePoint, StageResult};
 use crate::systems::convergence::ratio_cell;
 use std::io::Write;
 use std::path::Path;

@@ -149,7 +149,7 @@ impl<D: Dim> Snapshots<D> {
         let by_time = self
             .spec
             .every_time
-            .is_some_and(|t| (st.clock.time / t).floor() > ((st.clock.time - ctx.settings.dt) / t).floor());
+            .is_some_and(|t| (st.clock.time / t).floor() > ((st.clock.time - ctx.numerics.dt) / t).floor());
         // Every static state a control system consumed (an increment, a stage) too.
         by_steps
             || by_time
@@ -174,12 +174,12 @@ impl<D: Dim> System<D> for Snapshots<D> {
             &ctx.world,
             ctx.state.clock.step,
             ctx.state.clock.time,
-            ctx.settings.water.clone(),
+            ctx.model.water.clone(),
         );
         let spacing = 0.5 * ctx.grid.cell_size;
         let grid = (D::vec_to3(ctx.grid.origin), D::vec_to3(ctx.grid.max_corner()));
         frame.bodies = (0u32..)
-            .zip(ctx.settings.bodies.iter().zip(&ctx.state.control.bodies))
+            .zip(ctx.model.bodies.iter().zip(&ctx.state.control.bodies))
             .flat_map(|(k, (spec, state))| spec.outlines(k, state.offset, spacing, grid))
             .collect();
         let start = Instant::now();

@@ -2,9 +2,10 @@
 
 use crate::dim::Dim;
 use crate::measure::{max_displacements, surface_angle, SurfaceAngle};
+use crate::model::{CurvePoint, StageResult};
 use crate::schedule::Timing;
 use crate::simulation::{Simulation, TracedResult};
-use crate::state::{CurvePoint, ForceNorm, Peak, StageResult, StopReason};
+use crate::state::{ForceNorm, Peak, StopReason};
 use serde::Serialize;
 
 /// The outcome of a run, as written to `summary.json`. Nothing is written as `null`: an
@@ -228,7 +229,7 @@ impl Summary {
         error: Option<String>,
     ) -> Self {
         let s = &sim.ctx.state;
-        let st = &sim.ctx.settings;
+        let (st, model) = (&sim.ctx.numerics, &sim.ctx.model);
         // Over MPI every figure here is the ranks' (each call below is a collective, made
         // by every rank in this order).
         let comm = &sim.ctx.comm;
@@ -261,8 +262,8 @@ impl Summary {
             // Motions' and whole bodies' rows (a part's row has its own name), not a body's
             // under load control: its pressure is the load it was given.
             .filter(|c| {
-                st.motions.iter().any(|m| m.name == c.name)
-                    || st.bodies.iter().any(|b| b.name == c.name && b.load.is_none())
+                model.motions.iter().any(|m| m.name == c.name)
+                    || model.bodies.iter().any(|b| b.name == c.name && b.load.is_none())
             })
             .cloned()
             .collect();

@@ -163,7 +163,7 @@ fn arrays<S: Source>(src: &S) -> Vec<Array<'_>> {
 /// raise the run's peak memory. Snapshots during a run copy the points into a [`Frame`]
 /// instead, for the writer thread.
 pub fn write_points<D: Dim>(sim: &Simulation<D>, path: &Path) -> std::io::Result<()> {
-    let columns = Columns::<D>::of(&sim.ctx.world, sim.ctx.settings.water.clone());
+    let columns = Columns::<D>::of(&sim.ctx.world, sim.ctx.model.water.clone());
     let arrays = arrays(&columns);
     crate::output::dir::write_atomic(path, |out| write_arrays(out, columns.len(), &arrays))
 }
@@ -176,7 +176,7 @@ pub fn write_parallel_points<D: Dim>(
     path: &Path,
     parts: &[String],
 ) -> std::io::Result<()> {
-    let columns = Columns::<D>::of(&sim.ctx.world, sim.ctx.settings.water.clone());
+    let columns = Columns::<D>::of(&sim.ctx.world, sim.ctx.model.water.clone());
     let arrays = arrays(&columns);
     crate::output::dir::write_atomic(path, |out| {
         out.write_all(b"<?xml version=\"1.0\"?>\n<VTKFile type=\"PUnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n<PUnstructuredGrid GhostLevel=\"0\">\n")?;

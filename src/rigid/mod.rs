@@ -455,6 +455,24 @@ impl RigidBodySpec {
         }
     }
 
+    /// Sets the body off at the start of its control (its stage, or the run): moving at its
+    /// motion's velocity, or carrying its load's first increment.
+    pub fn set_off(&self, state: &mut BodyState) {
+        if let Some(m) = &self.motion {
+            state.velocity = m.vector();
+        }
+        if let Some(l) = &self.load {
+            state.load = l.at(0);
+        }
+    }
+
+    /// The kinetic energy it carries as a mass of its own (J; J/m in 2D; J/rad
+    /// axisymmetric): ½ M V² under load control with a `mass`, else 0.
+    pub fn kinetic_energy(&self, state: &BodyState) -> f64 {
+        let mass = self.load.as_ref().and_then(|l| l.mass).unwrap_or(0.0);
+        0.5 * mass * state.velocity.iter().map(|c| c * c).sum::<f64>()
+    }
+
     /// The stage its control waits for (`motion.stage` or `load.stage`), if any.
     pub fn stage(&self) -> Option<&String> {
         match (&self.motion, &self.load) {
@@ -518,20 +536,15 @@ impl RigidBodySpec {
     /// The body's state at the start of a run (`first`: its [`Self::first_stage`]):
     /// moving, unless it holds its place or waits for a later stage.
     pub fn state(&self, first: Option<usize>) -> BodyState {
-        let now = first == Some(0);
-        BodyState {
+        let mut state = BodyState {
             name: self.name.clone(),
-            velocity: match &self.motion {
-                Some(m) if now => m.vector(),
-                _ => [0.0; 3],
-            },
-            load: match &self.load {
-                Some(l) if now => l.at(0),
-                _ => [0.0; 3],
-            },
             parts: vec![[0.0; 3]; self.parts.len()],
             ..BodyState::default()
+        };
+        if first == Some(0) {
+            self.set_off(&mut state);
         }
+        state
     }
 }
 

@@ -18,7 +18,7 @@ use std::sync::Arc;
 /// What a run over several ranks does not do yet, as the reason, or `None` when the scene
 /// can be split.
 pub fn unsupported<D: Dim>(sim: &Simulation<D>) -> Option<&'static str> {
-    let s = &sim.ctx.settings;
+    let (s, n) = (&sim.ctx.model, &sim.ctx.numerics);
     if !s.bodies.is_empty() {
         Some("rigid bodies (their contact forces are not yet summed over the ranks)")
     } else if !s.motions.is_empty() {
@@ -29,7 +29,7 @@ pub fn unsupported<D: Dim>(sim: &Simulation<D>) -> Option<&'static str> {
         Some("surface pressures (a loaded point's neighbours along its surface may be on another rank)")
     } else if !s.load_steps.is_empty() {
         Some("tractions applied in increments")
-    } else if s.anti_locking != crate::state::AntiLocking::Off {
+    } else if n.anti_locking != crate::state::AntiLocking::Off {
         Some("solver.anti_locking (its nodal or cell means are not yet summed over the ranks)")
     } else if s.inertia_factors.iter().any(|&f| f != 1.0) {
         Some("mass scaling")

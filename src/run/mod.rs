@@ -306,7 +306,7 @@ impl Watch<'_> {
                 } else {
                     format!("{}D", D::N)
                 },
-                sim.ctx.settings.dt,
+                sim.ctx.numerics.dt,
                 if sim.ctx.state.clock.step > 0 {
                     format!(", resumed at step {}", sim.ctx.state.clock.step)
                 } else {

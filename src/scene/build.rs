@@ -3,7 +3,7 @@
 
 use super::region::{cell_span, region_bounds, region_contains};
 use super::validate::{self, carried_state, Checked, CheckedGrid, CheckedStage, Derived, FaceHold};
-use super::{pad3, Dimension, LoadedScene, Region, Scene};
+use super::{pad3, Dimension, LoadedScene, Region, Scene, SolverSpec};
 use crate::components::*;
 use crate::context::Context;
 use crate::dim::{Dim, Dim2, Dim3, DimAxi, Vector};
@@ -12,11 +12,12 @@ use crate::grid::Grid;
 use crate::infra::columns::{col, points_with};
 use crate::infra::decomposition::Decomposition;
 use crate::materials::{MaterialModel, MaterialState, StateVisitor};
+use crate::model::{Control, Gravity, LoadStage, Model, MotionSpec};
 use crate::parallel::SlabCache;
 use crate::rigid::RigidBodySpec;
 use crate::shape::{for_each_node, Linear, QuadraticBSpline, ShapeKind, UniformGimp};
 use crate::simulation::{AnySimulation, Simulation, TracedPoint};
-use crate::state::{Control, Gravity, LoadStage, MotionSpec, Settings, SolverState};
+use crate::state::{Numerics, SolverState};
 use crate::systems::spatial_sort::sort_points;
 use crate::systems::{check_names, default_names, schedule_from_names, Needs};
 use hecs::{ColumnBatchBuilder, ColumnBatchType, Entity, World};
@@ -232,6 +233,28 @@ fn loaded_bodies<D: Dim>(s: &Scene, grid: &Grid<D>, table: &[(String, MaterialMo
     bodies
 }
 
+/// The run's numerics from the scene's solver settings: the time step the check chose, and
+/// the node-mass thresholds scaled by the mass of a full interior node (kg).
+fn numerics(solver: &SolverSpec, dt: f64, full_node_mass: f64, initial_energy: f64) -> Numerics {
+    Numerics {
+        dt,
+        scheme: solver.scheme,
+        damping: solver.damping,
+        tolerance: solver.tolerance,
+        force_norm: solver.force_norm,
+        max_steps: solver.max_steps,
+        max_time: solver.max_time,
+        static_check: solver.static_check,
+        anti_locking: solver.anti_locking,
+        sort_every: solver.sort_every,
+        peak_interpolation: solver.peak_interpolation,
+        flip: solver.flip,
+        min_node_mass: solver.node_mass_cutoff * full_node_mass,
+        virtual_mass_floor: solver.virtual_mass_floor * full_node_mass,
+        initial_energy,
+    }
+}
+
 fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulation<D>, Derived), SceneError> {
     let Checked {
         grid: checked_grid,
@@ -271,37 +294,16 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
     sort_points(&world, &grid).expect("set-up spawns only kdmpm components");
     let traced = find_traced::<D>(loaded, &world)?;
 
-    let settings = Settings {
-        dt,
-        scheme: s.solver.scheme,
-        damping: s.solver.damping,
-        tolerance: s.solver.tolerance,
-        force_norm: s.solver.force_norm,
-        max_steps: s.solver.max_steps,
-        max_time: s.solver.max_time,
-        static_check: s.solver.static_check,
-        anti_locking: s.solver.anti_locking,
-        sort_every: s.solver.sort_every,
-        peak_interpolation: s.solver.peak_interpolation,
-        inertia_factors: if s.solver.mass_scaling {
-            table
-                .iter()
-                .map(|(_, m)| ((m.p_wave_modulus() / m.density()) / (c_p * c_p)).max(1.0))
-                .collect()
-        } else {
-            Vec::new()
-        },
-        flip: s.solver.flip,
+    let numerics = numerics(&s.solver, dt, full_node_mass, initial_energy);
+    let model = Model {
         gravity: s.gravity.as_ref().map(|g| Gravity {
             acceleration: pad3(&g.acceleration),
             ramp_time: g.ramp_time,
             start: 0.0,
         }),
-        min_node_mass: s.solver.node_mass_cutoff * full_node_mass,
+        water,
         motions: s.motions.clone(),
         bodies: loaded_bodies::<D>(s, &grid, &table),
-        initial_energy,
-        water,
         friction_faces: checked_grid
             .faces
             .iter()
@@ -310,9 +312,16 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         stages: stages(&grid, loaded, checked_stages, &load_ids, &placed.shares),
         load_steps: placed.steps,
         pressures: placed.pressures,
-        virtual_mass_floor: s.solver.virtual_mass_floor * full_node_mass,
+        inertia_factors: if s.solver.mass_scaling {
+            table
+                .iter()
+                .map(|(_, m)| ((m.p_wave_modulus() / m.density()) / (c_p * c_p)).max(1.0))
+                .collect()
+        } else {
+            Vec::new()
+        },
     };
-    let schedule = schedule_of::<D>(loaded, &settings)?;
+    let schedule = schedule_of::<D>(loaded, &numerics, &model)?;
     let derived = Derived {
         p_wave_speed: c_p,
         critical_time_step: dt_crit,
@@ -326,7 +335,7 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         unused_materials,
         estimate,
         bodies: describe_bodies(s, &body_samples),
-        water: settings.water.as_ref().map(|w| describe_water(s, w)),
+        water: model.water.as_ref().map(|w| describe_water(s, w)),
     };
     let state = initial_state(s);
     let materials = table.into_iter().map(|(_, m)| m).collect();
@@ -335,7 +344,8 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         world,
         grid,
         materials,
-        settings,
+        numerics,
+        model,
         state,
         slabs: SlabCache::default(),
         comm: Default::default(),
@@ -375,7 +385,8 @@ fn every_water<'a>(
 /// default one for its settings.
 fn schedule_of<D: Dim>(
     loaded: &LoadedScene,
-    settings: &Settings,
+    numerics: &Numerics,
+    model: &Model,
 ) -> Result<crate::schedule::Schedule<D>, SceneError> {
     let s = &loaded.scene;
     let needs = Needs {
@@ -383,15 +394,16 @@ fn schedule_of<D: Dim>(
     };
     let names: Vec<String> = match &s.solver.schedule {
         Some(names) => {
-            check_names(names, settings, needs).map_err(|rule| loaded.invalid("solver.schedule", rule))?;
+            check_names(names, numerics, model, needs)
+                .map_err(|rule| loaded.invalid("solver.schedule", rule))?;
             names.clone()
         }
-        None => default_names(settings, needs)
+        None => default_names(numerics, model, needs)
             .into_iter()
             .map(String::from)
             .collect(),
     };
-    Ok(schedule_from_names::<D>(&names, settings, s.shape))
+    Ok(schedule_from_names::<D>(&names, numerics, model, s.shape))
 }
 
 /// The solver's state before the first step: each motion's drive and each rigid body at

@@ -15,8 +15,9 @@ pub use validate::{check, Checked, CheckedGrid, CheckedStage, Derived, Estimate,
 
 use crate::error::{Refusal, SceneError};
 use crate::grid::Face;
+use crate::model::MotionSpec;
 use crate::shape::ShapeKind;
-use crate::state::{AntiLocking, Damping, ForceNorm, MotionSpec, Scheme, StaticCheck};
+use crate::state::{AntiLocking, Damping, ForceNorm, Scheme, StaticCheck};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};

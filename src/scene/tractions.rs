@@ -4,7 +4,7 @@ use super::LoadedScene;
 use crate::components::*;
 use crate::dim::Dim;
 use crate::error::SceneError;
-use crate::state::LoadSteps;
+use crate::model::LoadSteps;
 use crate::surface_pressure::{SurfacePoint, SurfacePressures, NONE};
 use hecs::{Entity, World};
 use std::collections::BTreeMap;

@@ -6,10 +6,11 @@ use crate::context::Context;
 use crate::dim::{Dim, Vector};
 use crate::error::StepError;
 use crate::infra::columns::{col, col_mut, nodes};
+use crate::model::Drive;
 use crate::parallel::{grid_pass, Disjoint};
 use crate::schedule::System;
-use crate::state::Drive;
 use crate::systems::exchange::{exchange, EXTERNAL, FORCE, MASS, MOMENTUM};
+use crate::systems::shared::{hold, Hold};
 
 /// Holds the constrained components of every node: momentum m·v̄ (v̄ = 0 on a fixed face,
 /// the motion's velocity on a driven node) and no force, so that the node moves at v̄.
@@ -44,9 +45,9 @@ impl<D: Dim> System<D> for Boundary {
             Disjoint::new(&mut ne),
         );
         let grid = &ctx.grid;
-        let st = &ctx.settings;
+        let st = &ctx.numerics;
         let friction = Friction {
-            faces: &st.friction_faces,
+            faces: &ctx.model.friction_faces,
             drives,
             dt: st.dt,
             min_mass: st.min_node_mass,
@@ -140,43 +141,6 @@ impl Friction<'_> {
             let scale = if size > mu * push { mu * push / size } else { 1.0 };
             for (a, s) in stop.iter().enumerate().take(D::N) {
                 f.set(a, f.get(a) + s * scale);
-            }
-        }
-    }
-}
-
-/// How a node holds one axis.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Hold {
-    /// Not at all.
-    Free,
-    /// At zero (a face condition).
-    Fixed,
-    /// At the velocity of this prescribed motion.
-    Driven(usize),
-}
-
-/// How `fixity` holds axis `axis`, given the scene's motions.
-#[inline(always)]
-pub fn hold(fixity: NodeFixity, axis: usize, drives: &[Drive]) -> Hold {
-    if !fixity.is_fixed(axis) {
-        return Hold::Free;
-    }
-    match fixity.driver() {
-        Some(d) if drives[d].axes & (1 << axis) != 0 => Hold::Driven(d),
-        _ => Hold::Fixed,
-    }
-}
-
-/// Sets the held components of a nodal velocity: zero, or the driving motion's velocity.
-#[inline(always)]
-pub fn constrain<V: Vector>(v: &mut V, fixity: NodeFixity, dims: usize, drives: &[Drive]) {
-    if fixity.0 != 0 {
-        for a in 0..dims {
-            match hold(fixity, a, drives) {
-                Hold::Free => {}
-                Hold::Fixed => v.set(a, 0.0),
-                Hold::Driven(d) => v.set(a, drives[d].velocity[a]),
             }
         }
     }

@@ -10,7 +10,7 @@ use crate::measure::{max_movement, positions};
 use crate::parallel::grid_pass;
 use crate::schedule::System;
 use crate::state::{StaticCheck, StopReason};
-use crate::systems::boundary::{hold, Hold};
+use crate::systems::shared::{hold, Hold};
 
 /// K_E above which a run is declared unstable (a sound run stays at or below 1).
 pub const UNSTABLE_ENERGY_RATIO: f64 = 10.0;
@@ -83,7 +83,7 @@ impl ForceNorms {
 
 /// Computes the force norms from the node columns.
 pub fn force_norms<D: Dim>(ctx: &Context<D>) -> ForceNorms {
-    let min_mass = ctx.settings.min_node_mass;
+    let min_mass = ctx.numerics.min_node_mass;
     let n = nodes(&ctx.world);
     let nm = col::<NodeMass>(n);
     let nf = col::<NodeForce<D::Vec>>(n);
@@ -199,9 +199,9 @@ impl<D: Dim> System<D> for Convergence {
         // yet balance.
         let time = ctx.state.clock.time;
         let loading = ctx
-            .settings
+            .model
             .gravity
-            .is_some_and(|g| g.step_factor(time, ctx.settings.dt) < 1.0)
+            .is_some_and(|g| g.step_factor(time, ctx.numerics.dt) < 1.0)
             || ctx.state.control.driving();
         // Nothing acts and nothing moves once the loading is done (soil that nothing has
         // touched, a body that moved away from it): K_F and K_E are 0, not 0/0.
@@ -251,7 +251,7 @@ impl<D: Dim> System<D> for Convergence {
         // Energy balance: W_ext + E_0 = E_k + stored + dissipated (E_0 the strain energy of
         // an initial stress), so E_k ≤ W_ext + E_0 in a sound run. Well above that the
         // scheme is creating energy; stop before it turns into NaN.
-        let available = s.convergence.external_work + ctx.settings.initial_energy;
+        let available = s.convergence.external_work + ctx.numerics.initial_energy;
         if s.convergence.external_work > 0.0 && s.energy.current() > UNSTABLE_ENERGY_RATIO * available {
             return Err(StepError::Unstable {
                 step: s.clock.step,
@@ -260,20 +260,20 @@ impl<D: Dim> System<D> for Convergence {
                 ratio: s.convergence.energy_ratio,
             });
         }
-        let tol = ctx.settings.tolerance;
+        let tol = ctx.numerics.tolerance;
         // An undefined ratio (NaN) compares false: it never meets the tolerance.
         let met = !loading
-            && s.convergence.force_ratio(ctx.settings.force_norm) <= tol
+            && s.convergence.force_ratio(ctx.numerics.force_norm) <= tol
             && s.control.unbalanced() <= tol
             && s.convergence.energy_ratio <= tol;
-        let converged = match ctx.settings.static_check {
+        let converged = match ctx.numerics.static_check {
             None => met,
             Some(check) => self.confirm_static(ctx, met, check),
         };
         let s = &mut ctx.state;
         if converged {
             s.stop = Some(StopReason::Converged);
-        } else if let Some(limit) = s.clock.limit(&ctx.settings) {
+        } else if let Some(limit) = s.clock.limit(&ctx.numerics) {
             s.stop = Some(limit);
         }
         Ok(())

@@ -41,13 +41,13 @@ impl<D: Dim, S: Shape> System<D> for G2p<D, S> {
         "g2p"
     }
     fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
-        let (grid, dt) = (&ctx.grid, ctx.settings.dt);
+        let (grid, dt) = (&ctx.grid, ctx.numerics.dt);
         let n = nodes(&ctx.world);
         let nag = col::<NodeAcceleration<D::Vec>>(n);
         let na: &[NodeAcceleration<D::Vec>] = &nag;
         let nvg = col::<NodeVelocity<D::Vec>>(n);
         let nv: &[NodeVelocity<D::Vec>] = &nvg;
-        let flip = ctx.settings.flip;
+        let flip = ctx.numerics.flip;
         // Pure FLIP (the default) never reads the interpolated nodal velocity.
         let pic = flip < 1.0;
         let mut twice_ek = 0.0;

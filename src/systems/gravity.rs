@@ -18,10 +18,10 @@ impl<D: Dim> System<D> for Gravity {
         "gravity"
     }
     fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
-        let Some(spec) = ctx.settings.gravity else {
+        let Some(spec) = ctx.model.gravity else {
             return Ok(());
         };
-        let g = spec.step_factor(ctx.state.clock.time, ctx.settings.dt);
+        let g = spec.step_factor(ctx.state.clock.time, ctx.numerics.dt);
         let a = spec.acceleration;
         let gv = D::vec_from([a[0] * g, a[1] * g, a[2] * g]);
         let n = nodes(&ctx.world);

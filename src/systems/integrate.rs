@@ -8,13 +8,13 @@ use crate::infra::columns::{col, col_mut, nodes};
 use crate::parallel::{for_each_box_node, Disjoint};
 use crate::schedule::System;
 use crate::state::Damping;
-use crate::systems::boundary::constrain;
+use crate::systems::shared::constrain;
 
 /// a_i = (f_i + f_damp)/max(m_i, m_floor) and v_i ← p_i/m_i + a_i Δt (explicit Euler on the
 /// grid). Viscous damping f_damp = −2β m_i v_i and local damping f_damp,a = −α |f_a| sign(v_a)
 /// enter here; massless nodes get no motion.
 ///
-/// m_floor ([`crate::state::Settings::virtual_mass_floor`]) is a virtual mass for nodes that
+/// m_floor ([`crate::state::Numerics::virtual_mass_floor`]) is a virtual mass for nodes that
 /// only the far tail of a point's support reaches: such a node has almost no mass but takes
 /// that point's full stress-gradient force, so its acceleration (and the point's, through
 /// it) would be that of the point pushed by its own stress.
@@ -26,17 +26,17 @@ impl<D: Dim> System<D> for Integrate {
         "integrate"
     }
     fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
-        let dt = ctx.settings.dt;
-        let beta2 = match ctx.settings.damping {
+        let dt = ctx.numerics.dt;
+        let beta2 = match ctx.numerics.damping {
             Damping::Viscous { beta } => 2.0 * beta,
             _ => 0.0,
         };
-        let alpha = match ctx.settings.damping {
+        let alpha = match ctx.numerics.damping {
             Damping::Local { alpha } => alpha,
             _ => 0.0,
         };
-        let min_mass = ctx.settings.min_node_mass;
-        let floor = ctx.settings.virtual_mass_floor;
+        let min_mass = ctx.numerics.min_node_mass;
+        let floor = ctx.numerics.virtual_mass_floor;
         let n = nodes(&ctx.world);
         let nm = col::<NodeMass>(n);
         let np = col::<NodeMomentum<D::Vec>>(n);

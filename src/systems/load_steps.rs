@@ -6,9 +6,10 @@ use crate::context::Context;
 use crate::dim::Dim;
 use crate::error::StepError;
 use crate::infra::columns::{col, points_with};
+use crate::model::{CurvePoint, LoadSteps};
 use crate::schedule::System;
-use crate::state::{CurvePoint, LoadSteps, StopReason};
-use crate::systems::point_loads::set_point_loads;
+use crate::state::StopReason;
+use crate::systems::shared::set_point_loads;
 
 /// Sets each incremental load to its present fraction before the first step and, at each
 /// static state, records the curve and raises the loads that have increments left.
@@ -50,10 +51,10 @@ impl<D: Dim> System<D> for LoadControl {
     }
 
     fn prepare(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
-        let n = ctx.settings.load_steps.len();
+        let n = ctx.model.load_steps.len();
         ctx.state.control.load_increments.resize(n, 0);
         for (load, &done) in ctx
-            .settings
+            .model
             .load_steps
             .iter()
             .zip(&ctx.state.control.load_increments)
@@ -69,7 +70,7 @@ impl<D: Dim> System<D> for LoadControl {
             return Ok(());
         }
         let mut more = false;
-        for (k, load) in ctx.settings.load_steps.iter().enumerate() {
+        for (k, load) in ctx.model.load_steps.iter().enumerate() {
             let done = ctx.state.control.load_increments[k];
             if done >= load.increments {
                 continue;
@@ -97,7 +98,7 @@ impl<D: Dim> System<D> for LoadControl {
             }
         }
         if more {
-            ctx.state.go_on(&ctx.settings);
+            ctx.state.go_on(&ctx.numerics);
         }
         Ok(())
     }

@@ -44,7 +44,7 @@ impl<D: Dim, S: Shape> System<D> for MassScaling<D, S> {
     }
     fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
         let grid = &ctx.grid;
-        let factors = &ctx.settings.inertia_factors;
+        let factors = &ctx.model.inertia_factors;
         let sums = &mut self.inertia;
         // Material points only: a point load's carrier has no material and no mass.
         for arch in points_with::<MaterialId>(&ctx.world) {
@@ -69,9 +69,9 @@ impl<D: Dim, S: Shape> System<D> for MassScaling<D, S> {
             );
         }
         let (dt, min_mass, floor) = (
-            ctx.settings.dt,
-            ctx.settings.min_node_mass,
-            ctx.settings.virtual_mass_floor,
+            ctx.numerics.dt,
+            ctx.numerics.min_node_mass,
+            ctx.numerics.virtual_mass_floor,
         );
         let n = nodes(&ctx.world);
         let nm = col::<NodeMass>(n);

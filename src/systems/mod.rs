@@ -37,6 +37,7 @@ pub mod prescribed_motion;
 pub mod remap;
 pub mod rigid_contact;
 pub mod rigid_control;
+pub mod shared;
 pub mod spatial_sort;
 pub mod stages;
 pub mod stress_update;
@@ -68,9 +69,10 @@ pub use volume_update::VolumeUpdate;
 pub use volumetric_smoothing::VolumetricSmoothing;
 
 use crate::dim::{Dim, Dim2};
+use crate::model::Model;
 use crate::schedule::{Schedule, System};
 use crate::shape::{Linear, QuadraticBSpline, Shape, ShapeKind, UniformGimp};
-use crate::state::{AntiLocking, Damping, Scheme, Settings};
+use crate::state::{AntiLocking, Damping, Numerics, Scheme};
 
 /// What a scene contains that decides which optional systems it needs.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -181,7 +183,7 @@ pub enum When {
     Schemes(&'static [Scheme]),
     /// Exactly when the scene needs it: required then, refused otherwise. The text says
     /// when ("the scene has gravity").
-    Needed(fn(&Settings, Needs) -> bool, &'static str),
+    Needed(fn(&Numerics, &Model, Needs) -> bool, &'static str),
 }
 
 /// One system: everything the schedule, its checks and the docs know about it.
@@ -196,8 +198,8 @@ pub struct Entry<D: Dim> {
     pub after: &'static [(&'static str, &'static str)],
     /// What it does, one line (the docs' list and `kdmpm check`).
     pub does: &'static str,
-    /// Builds it for a scene's settings.
-    pub build: fn(&Settings) -> Box<dyn System<D>>,
+    /// Builds it for a run's numerics and model.
+    pub build: fn(&Numerics, &Model) -> Box<dyn System<D>>,
 }
 
 const MUSL_USL: &[Scheme] = &[Scheme::Musl, Scheme::Usl];
@@ -230,7 +232,7 @@ fn e<D: Dim>(
     when: When,
     after: &'static [(&'static str, &'static str)],
     does: &'static str,
-    build: fn(&Settings) -> Box<dyn System<D>>,
+    build: fn(&Numerics, &Model) -> Box<dyn System<D>>,
 ) -> Entry<D> {
     Entry {
         name,
@@ -253,15 +255,15 @@ fn mapping<D: Dim, S: Shape>() -> Vec<Entry<D>> {
             Always,
             &[],
             "empty, undeformed grid",
-            |_| Box::new(GridReset),
+            |_, _| Box::new(GridReset),
         ),
         e(
             "spatial_sort",
             St::Sort,
-            Needed(|s, _| s.sort_every > 0, "solver.sort_every is above 0"),
+            Needed(|n, _, _| n.sort_every > 0, "solver.sort_every is above 0"),
             &[],
             "points back in cell order (every N steps)",
-            |s| Box::new(SpatialSort::new(s.sort_every)),
+            |n, _| Box::new(SpatialSort::new(n.sort_every)),
         ),
         e(
             "p2g",
@@ -269,7 +271,7 @@ fn mapping<D: Dim, S: Shape>() -> Vec<Entry<D>> {
             Schemes(MUSL_USL),
             &[SORTED],
             "mass, momentum, internal force (and each point's other forces, `point_forces.rs`) to the nodes",
-            |_| Box::new(P2g::<D, S>::new(P2gPart::All)),
+            |_, _| Box::new(P2g::<D, S>::new(P2gPart::All)),
         ),
         e(
             "p2g_momentum",
@@ -277,7 +279,7 @@ fn mapping<D: Dim, S: Shape>() -> Vec<Entry<D>> {
             Schemes(USF),
             &[SORTED],
             "USF: mass and momentum to the nodes",
-            |_| Box::new(P2g::<D, S>::new(P2gPart::MassMomentum)),
+            |_, _| Box::new(P2g::<D, S>::new(P2gPart::MassMomentum)),
         ),
         e(
             "nodal_velocity",
@@ -285,7 +287,7 @@ fn mapping<D: Dim, S: Shape>() -> Vec<Entry<D>> {
             Schemes(USF),
             &[("p2g_momentum", "the nodal velocity needs the mapped momentum")],
             "USF: nodal velocity from momentum",
-            |_| Box::new(NodalVelocity),
+            |_, _| Box::new(NodalVelocity),
         ),
     ]
 }
@@ -308,7 +310,7 @@ fn straining<D: Dim, S: Shape>() -> Vec<Entry<D>> {
                 ),
             ],
             "velocity gradient, position update",
-            |_| Box::new(Kinematics::<D, S>::both()),
+            |_, _| Box::new(Kinematics::<D, S>::both()),
         ),
         e(
             "velocity_gradient",
@@ -316,29 +318,29 @@ fn straining<D: Dim, S: Shape>() -> Vec<Entry<D>> {
             Schemes(USF),
             &[("nodal_velocity", "the velocity gradient needs the nodal velocity")],
             "USF: velocity gradient",
-            |_| Box::new(Kinematics::<D, S>::gradient_only()),
+            |_, _| Box::new(Kinematics::<D, S>::gradient_only()),
         ),
         e(
             "volumetric_smoothing",
             St::Smooth,
             Needed(
-                |s, _| s.anti_locking == AntiLocking::StrainSmoothing,
+                |n, _, _| n.anti_locking == AntiLocking::StrainSmoothing,
                 "solver.anti_locking is StrainSmoothing",
             ),
             &[("kinematics", SMOOTHED), ("velocity_gradient", SMOOTHED)],
             "volumetric strain rate smoothed through the nodes",
-            |_| Box::new(VolumetricSmoothing::<D, S>::default()),
+            |_, _| Box::new(VolumetricSmoothing::<D, S>::default()),
         ),
         e(
             "cell_mean_strain",
             St::Smooth,
             Needed(
-                |s, _| s.anti_locking == AntiLocking::CellMean,
+                |n, _, _| n.anti_locking == AntiLocking::CellMean,
                 "solver.anti_locking is CellMean",
             ),
             &[("kinematics", SMOOTHED), ("velocity_gradient", SMOOTHED)],
             "cell mean of the volumetric strain rate",
-            |_| Box::new(CellMean::<D, S>::new(CellMeanPart::Strain)),
+            |_, _| Box::new(CellMean::<D, S>::new(CellMeanPart::Strain)),
         ),
         e(
             "stress_update",
@@ -351,18 +353,18 @@ fn straining<D: Dim, S: Shape>() -> Vec<Entry<D>> {
                 ("cell_mean_strain", "the stress must see the cell's strain"),
             ],
             "Jaumann rotation + material law",
-            |_| Box::new(StressUpdate),
+            |_, _| Box::new(StressUpdate),
         ),
         e(
             "cell_mean_stress",
             St::Project,
             Needed(
-                |s, _| s.anti_locking == AntiLocking::CellMean,
+                |n, _, _| n.anti_locking == AntiLocking::CellMean,
                 "solver.anti_locking is CellMean",
             ),
             &[("stress_update", "it projects the updated stress")],
             "cell mean of the mean stress",
-            |_| Box::new(CellMean::<D, S>::new(CellMeanPart::Stress)),
+            |_, _| Box::new(CellMean::<D, S>::new(CellMeanPart::Stress)),
         ),
         e(
             "volume_update",
@@ -370,7 +372,7 @@ fn straining<D: Dim, S: Shape>() -> Vec<Entry<D>> {
             Always,
             &[("stress_update", "the volume update follows the stress update")],
             "V ← V det(I + LΔt)",
-            |_| Box::new(VolumeUpdate),
+            |_, _| Box::new(VolumeUpdate),
         ),
         e(
             "p2g_force",
@@ -381,7 +383,7 @@ fn straining<D: Dim, S: Shape>() -> Vec<Entry<D>> {
                 ("cell_mean_stress", "p2g_force maps the projected stress"),
             ],
             "USF: internal force of the updated stress (and each point's other forces)",
-            |_| Box::new(P2g::<D, S>::new(P2gPart::InternalForce)),
+            |_, _| Box::new(P2g::<D, S>::new(P2gPart::InternalForce)),
         ),
     ]
 }
@@ -394,7 +396,7 @@ fn loading<D: Dim, S: Shape>() -> Vec<Entry<D>> {
         e(
             "gravity",
             St::Forces,
-            Needed(|s, _| s.gravity.is_some(), "the scene has gravity"),
+            Needed(|_, m, _| m.gravity.is_some(), "the scene has gravity"),
             &[
                 ("p2g", "gravity acts on the nodal mass that p2g maps"),
                 (
@@ -403,23 +405,23 @@ fn loading<D: Dim, S: Shape>() -> Vec<Entry<D>> {
                 ),
             ],
             "body force m_i g",
-            |_| Box::new(Gravity),
+            |_, _| Box::new(Gravity),
         ),
         e(
             "point_loads",
             St::Forces,
-            Needed(|_, n| n.point_loads, "the scene has point loads"),
+            Needed(|_, _, n| n.point_loads, "the scene has point loads"),
             &[
                 ("p2g", "point loads go to nodes that carry mapped mass"),
                 ("p2g_momentum", "point loads go to nodes that carry mapped mass"),
             ],
             "concentrated loads",
-            |_| Box::new(PointLoads::<D, S>::default()),
+            |_, _| Box::new(PointLoads::<D, S>::default()),
         ),
         e(
             "rigid_contact",
             St::Constrain,
-            Needed(|s, _| !s.bodies.is_empty(), "the scene has rigid bodies"),
+            Needed(|_, m, _| !m.bodies.is_empty(), "the scene has rigid bodies"),
             &[
                 ("p2g", "contact acts on mapped momentum and force"),
                 ("p2g_force", COMPLETE),
@@ -427,7 +429,7 @@ fn loading<D: Dim, S: Shape>() -> Vec<Entry<D>> {
                 ("point_loads", COMPLETE),
             ],
             "soil–body contact: no entry, friction; the bodies' forces",
-            |_| Box::new(RigidContact::<D, S>::default()),
+            |_, _| Box::new(RigidContact::<D, S>::default()),
         ),
         e(
             "boundary",
@@ -444,7 +446,7 @@ fn loading<D: Dim, S: Shape>() -> Vec<Entry<D>> {
                 ),
             ],
             "held components: fixed at zero, or at a motion's velocity",
-            |_| Box::new(Boundary),
+            |_, _| Box::new(Boundary),
         ),
         e(
             "integrate",
@@ -452,15 +454,15 @@ fn loading<D: Dim, S: Shape>() -> Vec<Entry<D>> {
             Always,
             &[("boundary", "integration needs constrained momentum and force")],
             "nodal acceleration and velocity (+ viscous or local damping)",
-            |_| Box::new(Integrate),
+            |_, _| Box::new(Integrate),
         ),
         e(
             "mass_scaling",
             St::Scale,
-            Needed(|s, _| s.mass_scaling(), "solver.mass_scaling is true"),
+            Needed(|_, m, _| m.mass_scaling(), "solver.mass_scaling is true"),
             &[("integrate", "mass scaling rescales the integrated accelerations")],
             "fictitious inertia",
-            |_| Box::new(MassScaling::<D, S>::default()),
+            |_, _| Box::new(MassScaling::<D, S>::default()),
         ),
         e(
             "g2p",
@@ -471,7 +473,7 @@ fn loading<D: Dim, S: Shape>() -> Vec<Entry<D>> {
                 ("mass_scaling", "g2p interpolates the rescaled accelerations"),
             ],
             "point velocities, kinetic energy",
-            |_| Box::new(G2p::<D, S>::default()),
+            |_, _| Box::new(G2p::<D, S>::default()),
         ),
     ]
 }
@@ -484,10 +486,13 @@ fn relaxing<D: Dim, S: Shape>() -> Vec<Entry<D>> {
         e(
             "peak_watch",
             St::Damp,
-            Needed(|s, _| s.damping == Damping::Kinetic, "solver.damping is Kinetic"),
+            Needed(
+                |n, _, _| n.damping == Damping::Kinetic,
+                "solver.damping is Kinetic",
+            ),
             &[("g2p", "the peak watch reads the kinetic energy g2p computes")],
             "kinetic damping reset",
-            |_| Box::new(PeakWatch),
+            |_, _| Box::new(PeakWatch),
         ),
         e(
             "remap",
@@ -501,7 +506,7 @@ fn relaxing<D: Dim, S: Shape>() -> Vec<Entry<D>> {
                 ),
             ],
             "MUSL: point velocities back to the grid",
-            |_| Box::new(Remap::<D, S>::default()),
+            |_, _| Box::new(Remap::<D, S>::default()),
         ),
         e(
             "move_points",
@@ -509,7 +514,7 @@ fn relaxing<D: Dim, S: Shape>() -> Vec<Entry<D>> {
             Schemes(USF),
             &[("integrate", INTEGRATED), ("peak_watch", NOT_IN_RESET)],
             "USF: position update",
-            |_| Box::new(Kinematics::<D, S>::motion_only()),
+            |_, _| Box::new(Kinematics::<D, S>::motion_only()),
         ),
         e(
             "convergence",
@@ -517,32 +522,32 @@ fn relaxing<D: Dim, S: Shape>() -> Vec<Entry<D>> {
             Always,
             &[],
             "K_F, W_ext, K_E, stopping rule",
-            |_| Box::new(Convergence),
+            |_, _| Box::new(Convergence),
         ),
         e(
             "prescribed_motion",
             St::Control,
-            Needed(|s, _| !s.motions.is_empty(), "the scene has motions"),
+            Needed(|_, m, _| !m.motions.is_empty(), "the scene has motions"),
             &[("convergence", "it acts on the step's static state")],
             "displacement control: travel, hold, curve of static states",
-            |s| Box::new(PrescribedMotion::new(s.motions.clone())),
+            |_, m| Box::new(PrescribedMotion::new(m.motions.clone())),
         ),
         e(
             "rigid_control",
             St::Control,
-            Needed(|s, _| !s.bodies.is_empty(), "the scene has rigid bodies"),
+            Needed(|_, m, _| !m.bodies.is_empty(), "the scene has rigid bodies"),
             &[
                 ("convergence", "it acts on the step's static state"),
                 ("prescribed_motion", "the bodies' rows follow the motions'"),
             ],
             "rigid bodies: travel or carry a load, hold, curve of static states",
-            |s| Box::new(RigidControl::new(s.bodies.clone(), &s.stages)),
+            |_, m| Box::new(RigidControl::new(m.bodies.clone(), &m.stages)),
         ),
         e(
             "load_steps",
             St::Control,
             Needed(
-                |s, _| !s.load_steps.is_empty(),
+                |_, m, _| !m.load_steps.is_empty(),
                 "the scene has loads in increments",
             ),
             &[
@@ -551,12 +556,12 @@ fn relaxing<D: Dim, S: Shape>() -> Vec<Entry<D>> {
                 ("rigid_control", "a load increment follows the bodies' last"),
             ],
             "load control: the next load increment at each static state",
-            |_| Box::new(LoadControl),
+            |_, _| Box::new(LoadControl),
         ),
         e(
             "stages",
             St::Control,
-            Needed(|s, _| !s.stages.is_empty(), "the scene has stages"),
+            Needed(|_, m, _| !m.stages.is_empty(), "the scene has stages"),
             &[
                 ("convergence", "it acts on the step's static state"),
                 ("prescribed_motion", "a stage ends once the motions are done"),
@@ -564,7 +569,7 @@ fn relaxing<D: Dim, S: Shape>() -> Vec<Entry<D>> {
                 ("load_steps", "a stage ends once its load increments are done"),
             ],
             "loading stages: the next stage at each static state",
-            |_| Box::new(Stages),
+            |_, _| Box::new(Stages),
         ),
     ]
 }
@@ -579,17 +584,17 @@ pub fn system_names() -> Vec<&'static str> {
     entries().iter().map(|e| e.name).collect()
 }
 
-/// The default list of system names for a scene's settings: each scheme's stages in
+/// The default list of system names for a scene's numerics and model: each scheme's stages in
 /// order, and in each the systems its scheme or the scene needs.
-pub fn default_names(settings: &Settings, needs: Needs) -> Vec<&'static str> {
+pub fn default_names(numerics: &Numerics, model: &Model, needs: Needs) -> Vec<&'static str> {
     let entries = entries();
     let mut names = Vec::new();
-    for &stage in scheme_stages(settings.scheme) {
+    for &stage in scheme_stages(numerics.scheme) {
         for e in entries.iter().filter(|e| e.stage == stage) {
             let wanted = match e.when {
                 When::Always => true,
-                When::Schemes(s) => s.contains(&settings.scheme),
-                When::Needed(needed, _) => needed(settings, needs),
+                When::Schemes(s) => s.contains(&numerics.scheme),
+                When::Needed(needed, _) => needed(numerics, model, needs),
             };
             if wanted {
                 names.push(e.name);
@@ -602,7 +607,7 @@ pub fn default_names(settings: &Settings, needs: Needs) -> Vec<&'static str> {
 /// Checks a list of system names: all known, none twice, every required stage present,
 /// the optional ones present exactly when the scene needs them, and every order rule kept.
 /// The error says what is wrong and why.
-pub fn check_names(names: &[String], settings: &Settings, needs: Needs) -> Result<(), String> {
+pub fn check_names(names: &[String], numerics: &Numerics, model: &Model, needs: Needs) -> Result<(), String> {
     let entries = entries();
     for n in names {
         if !entries.iter().any(|e| e.name == n) {
@@ -646,7 +651,7 @@ pub fn check_names(names: &[String], settings: &Settings, needs: Needs) -> Resul
     }
     // Without the remap a MUSL step is a USL step, which is unstable at the Courant
     // numbers MUSL is allowed (the USL limit is checked against the scheme's name).
-    if settings.scheme == Scheme::Musl && !has("remap") {
+    if numerics.scheme == Scheme::Musl && !has("remap") {
         return Err(
             "scheme Musl needs `remap` (without it the step is USL, which is unstable above \
              Courant 0.7): add `remap`, or set solver.scheme: Usl and keep its Courant limit"
@@ -673,7 +678,7 @@ pub fn check_names(names: &[String], settings: &Settings, needs: Needs) -> Resul
                 ))
             }
             When::Needed(needed, why) => {
-                let needed = needed(settings, needs);
+                let needed = needed(numerics, model, needs);
                 if needed && !has(e.name) {
                     return Err(format!("`{}` is required because {why}", e.name));
                 }
@@ -717,16 +722,26 @@ pub fn systems_table() -> String {
 
 /// The default schedule for a scene: its scheme, its shape functions, and only the optional
 /// systems (gravity, point loads, peak watch) it uses.
-pub fn default_schedule<D: Dim>(settings: &Settings, shape: ShapeKind, needs: Needs) -> Schedule<D> {
-    let names: Vec<String> = default_names(settings, needs)
+pub fn default_schedule<D: Dim>(
+    numerics: &Numerics,
+    model: &Model,
+    shape: ShapeKind,
+    needs: Needs,
+) -> Schedule<D> {
+    let names: Vec<String> = default_names(numerics, model, needs)
         .into_iter()
         .map(String::from)
         .collect();
-    schedule_from_names(&names, settings, shape)
+    schedule_from_names(&names, numerics, model, shape)
 }
 
 /// Builds the systems named in `names` (checked by [`check_names`]) in that order.
-pub fn schedule_from_names<D: Dim>(names: &[String], settings: &Settings, shape: ShapeKind) -> Schedule<D> {
+pub fn schedule_from_names<D: Dim>(
+    names: &[String],
+    numerics: &Numerics,
+    model: &Model,
+    shape: ShapeKind,
+) -> Schedule<D> {
     let entries = match shape {
         ShapeKind::Linear => registry::<D, Linear>(),
         ShapeKind::QuadraticBSpline => registry::<D, QuadraticBSpline>(),
@@ -738,7 +753,7 @@ pub fn schedule_from_names<D: Dim>(names: &[String], settings: &Settings, shape:
             .iter()
             .find(|e| e.name == n)
             .unwrap_or_else(|| unreachable!("checked by check_names: {n}"));
-        s.push_boxed((e.build)(settings));
+        s.push_boxed((e.build)(numerics, model));
     }
     s
 }
@@ -746,10 +761,11 @@ pub fn schedule_from_names<D: Dim>(names: &[String], settings: &Settings, shape:
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::state::{ForceNorm, Gravity as G};
+    use crate::model::Gravity as G;
+    use crate::state::ForceNorm;
 
-    fn settings(scheme: Scheme, damping: Damping, gravity: bool) -> Settings {
-        Settings {
+    fn settings(scheme: Scheme, damping: Damping, gravity: bool) -> (Numerics, Model) {
+        let numerics = Numerics {
             dt: 1e-3,
             scheme,
             damping,
@@ -758,27 +774,23 @@ mod tests {
             max_steps: Some(1),
             max_time: None,
             static_check: None,
+            anti_locking: AntiLocking::Off,
+            sort_every: 100,
+            peak_interpolation: false,
+            flip: 1.0,
+            min_node_mass: 0.0,
+            initial_energy: 0.0,
+            virtual_mass_floor: 0.0,
+        };
+        let model = Model {
             gravity: gravity.then_some(G {
                 acceleration: [0.0, -9.81, 0.0],
                 ramp_time: 0.0,
                 start: 0.0,
             }),
-            anti_locking: AntiLocking::Off,
-            sort_every: 100,
-            peak_interpolation: false,
-            inertia_factors: Vec::new(),
-            flip: 1.0,
-            min_node_mass: 0.0,
-            motions: Vec::new(),
-            bodies: Vec::new(),
-            initial_energy: 0.0,
-            water: None,
-            friction_faces: Vec::new(),
-            stages: Vec::new(),
-            load_steps: Vec::new(),
-            pressures: Default::default(),
-            virtual_mass_floor: 0.0,
-        }
+            ..Model::default()
+        };
+        (numerics, model)
     }
 
     fn names(v: &[&str]) -> Vec<String> {
@@ -793,8 +805,8 @@ mod tests {
                     for loads in [false, true] {
                         let st = settings(scheme, damping, gravity);
                         let needs = Needs { point_loads: loads };
-                        let n = names(&default_names(&st, needs));
-                        assert_eq!(check_names(&n, &st, needs), Ok(()), "{n:?}");
+                        let n = names(&default_names(&st.0, &st.1, needs));
+                        assert_eq!(check_names(&n, &st.0, &st.1, needs), Ok(()), "{n:?}");
                     }
                 }
             }
@@ -804,10 +816,10 @@ mod tests {
     #[test]
     fn default_schedules_run_the_stages_of_each_scheme_in_order() {
         let mut st = settings(Scheme::Musl, Damping::Kinetic, true);
-        st.anti_locking = AntiLocking::StrainSmoothing;
+        st.0.anti_locking = AntiLocking::StrainSmoothing;
         let needs = Needs { point_loads: true };
         assert_eq!(
-            default_names(&st, needs),
+            default_names(&st.0, &st.1, needs),
             [
                 "grid_reset",
                 "spatial_sort",
@@ -826,9 +838,9 @@ mod tests {
                 "convergence"
             ]
         );
-        st.scheme = Scheme::Usf;
+        st.0.scheme = Scheme::Usf;
         assert_eq!(
-            default_names(&st, needs),
+            default_names(&st.0, &st.1, needs),
             [
                 "grid_reset",
                 "spatial_sort",
@@ -851,7 +863,7 @@ mod tests {
         );
         let plain = settings(Scheme::Usl, Damping::None, false);
         assert_eq!(
-            default_names(&plain, Needs::default()),
+            default_names(&plain.0, &plain.1, Needs::default()),
             [
                 "grid_reset",
                 "spatial_sort",
@@ -880,9 +892,9 @@ mod tests {
     #[test]
     fn unknown_system_names_are_rejected_with_the_valid_names() {
         let st = settings(Scheme::Musl, Damping::Kinetic, false);
-        let mut n = names(&default_names(&st, Needs::default()));
+        let mut n = names(&default_names(&st.0, &st.1, Needs::default()));
         n[1] = "p2g_fast".into();
-        let e = check_names(&n, &st, Needs::default()).unwrap_err();
+        let e = check_names(&n, &st.0, &st.1, Needs::default()).unwrap_err();
         assert!(
             e.contains("unknown system `p2g_fast`") && e.contains("grid_reset, spatial_sort, p2g,"),
             "{e}"
@@ -892,27 +904,27 @@ mod tests {
     #[test]
     fn a_schedule_that_breaks_the_order_or_lacks_a_stage_is_rejected() {
         let st = settings(Scheme::Musl, Damping::Kinetic, true);
-        let base = names(&default_names(&st, Needs::default()));
+        let base = names(&default_names(&st.0, &st.1, Needs::default()));
         // Stress update before the velocity gradient exists.
         let mut n = base.clone();
         let k = n.iter().position(|s| s == "kinematics").unwrap();
         let su = n.remove(n.iter().position(|s| s == "stress_update").unwrap());
         n.insert(k, su);
-        let e = check_names(&n, &st, Needs::default()).unwrap_err();
+        let e = check_names(&n, &st.0, &st.1, Needs::default()).unwrap_err();
         assert!(e.contains("`kinematics` must run before `stress_update`"), "{e}");
         // No boundary conditions.
         let n: Vec<String> = base.iter().filter(|s| *s != "boundary").cloned().collect();
-        assert!(check_names(&n, &st, Needs::default())
+        assert!(check_names(&n, &st.0, &st.1, Needs::default())
             .unwrap_err()
             .contains("lacks `boundary`"));
         // Gravity in the scene but not in the schedule.
         let n: Vec<String> = base.iter().filter(|s| *s != "gravity").cloned().collect();
-        assert!(check_names(&n, &st, Needs::default())
+        assert!(check_names(&n, &st.0, &st.1, Needs::default())
             .unwrap_err()
             .contains("`gravity` is required"));
         // A peak watch without kinetic damping.
         let viscous = settings(Scheme::Musl, Damping::Viscous { beta: 0.1 }, true);
-        assert!(check_names(&base, &viscous, Needs::default())
+        assert!(check_names(&base, &viscous.0, &viscous.1, Needs::default())
             .unwrap_err()
             .contains("`peak_watch` is scheduled"));
     }

@@ -1,6 +1,6 @@
 //! Nodal velocity from mapped momentum, v_i = p_i/m_i, with the boundary conditions.
 
-use super::boundary::constrain;
+use super::shared::constrain;
 use crate::components::*;
 use crate::context::Context;
 use crate::dim::{Dim, Vector};
@@ -12,7 +12,7 @@ use crate::schedule::System;
 /// Sets `NodeVelocity` from `NodeMomentum` and `NodeMass` (zero on massless nodes and on
 /// fixed components). Used by the MUSL remap and by USF before its stress update.
 pub fn velocity_from_momentum<D: Dim>(ctx: &Context<D>) {
-    let min_mass = ctx.settings.min_node_mass;
+    let min_mass = ctx.numerics.min_node_mass;
     let n = nodes(&ctx.world);
     let nm = col::<NodeMass>(n);
     let np = col::<NodeMomentum<D::Vec>>(n);

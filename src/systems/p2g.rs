@@ -92,7 +92,7 @@ impl<D: Dim, S: Shape> P2g<D, S> {
         let mut np = col_mut::<NodeMomentum<D::Vec>>(n);
         let mut nf = col_mut::<NodeForce<D::Vec>>(n);
         let mut ne = col_mut::<NodeExternalForce<D::Vec>>(n);
-        let sources = PointForces::of(&ctx.settings, ctx.state.clock.time);
+        let sources = PointForces::of(&ctx.model, ctx.numerics.dt, ctx.state.clock.time);
         let by_material = sources.need_materials();
         let (mass_momentum, force) = self.part.maps();
         for arch in points_with::<Position<D::Vec>>(&ctx.world) {

@@ -10,9 +10,9 @@ use crate::schedule::System;
 use crate::state::Peak;
 
 /// When E_k(n) < E_k(n−1) the energy peaked in the previous step: every point velocity is
-/// set to zero (E_k counts the bodies under load control, ½ M V², and `rigid_control`
-/// zeroes their velocity in the same step), the points do not move in this step, and the stored energy becomes 0 so
-/// that the next step cannot count as a peak.
+/// set to zero (E_k counts the model's own masses, [`crate::model::Model::kinetic_energy`],
+/// whose control zeroes their velocity in the same step), the points do not move in this
+/// step, and the stored energy becomes 0 so that the next step cannot count as a peak.
 ///
 /// With `peak_interpolation` the peak is placed between steps: a parabola through
 /// E(n−2), E(n−1), E(n) at offsets −1, 0, 1 peaks at
@@ -28,15 +28,12 @@ impl<D: Dim> System<D> for PeakWatch {
         "peak_watch"
     }
     fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
-        let (interpolate, dt) = (ctx.settings.peak_interpolation, ctx.settings.dt);
+        let (interpolate, dt) = (ctx.numerics.peak_interpolation, ctx.numerics.dt);
         let s = &mut ctx.state;
-        // Bodies under load control move as masses of their own: ½ M V² each.
-        let bodies: f64 = (ctx.settings.bodies.iter().zip(&s.control.bodies))
-            .filter_map(|(spec, b)| Some((spec.load.as_ref()?.mass?, b.velocity)))
-            .map(|(m, v)| 0.5 * m * v.iter().map(|c| c * c).sum::<f64>())
-            .sum();
-        if bodies > 0.0 {
-            s.energy.set(s.energy.current() + bodies);
+        // The model's own masses (a body under load control) move beside the points.
+        let own = ctx.model.kinetic_energy(&s.control);
+        if own > 0.0 {
+            s.energy.set(s.energy.current() + own);
         }
         if let Some([e2, e1, e0]) = s.energy.peak() {
             let curvature = e2 - 2.0 * e1 + e0;

@@ -17,7 +17,7 @@
 
 use crate::components::MaterialId;
 use crate::dim::{Dim, Vector};
-use crate::state::Settings;
+use crate::model::Model;
 use crate::tensor::StoredSym;
 use crate::water::Water;
 
@@ -28,13 +28,14 @@ pub struct PointForces<'a> {
 }
 
 impl<'a> PointForces<'a> {
-    /// The sources of a simulation of `settings` in the step that ends at `time` (s).
-    pub fn of(settings: &'a Settings, time: f64) -> Self {
+    /// The sources of a `model` solved in steps of `dt` (s), in the step that ends at
+    /// `time` (s).
+    pub fn of(model: &'a Model, dt: f64, time: f64) -> Self {
         PointForces {
-            water: settings.water.as_ref().map(|water| PoreWater {
+            water: model.water.as_ref().map(|water| PoreWater {
                 water,
                 // The pore water's load rises with gravity's ramp, as the weight it buoys does.
-                ramp: settings.gravity.map_or(1.0, |g| g.step_factor(time, settings.dt)),
+                ramp: model.gravity.map_or(1.0, |g| g.step_factor(time, dt)),
             }),
         }
     }

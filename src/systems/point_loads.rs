@@ -40,12 +40,12 @@ impl<D: Dim, S: Shape> System<D> for PointLoads<D, S> {
     }
     fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
         let grid = &ctx.grid;
-        let min_mass = ctx.settings.min_node_mass;
+        let min_mass = ctx.numerics.min_node_mass;
         let n = nodes(&ctx.world);
         let nm = col::<NodeMass>(n);
         let mut nf = col_mut::<NodeForce<D::Vec>>(n);
         let mut ne = col_mut::<NodeExternalForce<D::Vec>>(n);
-        let pressures = &ctx.settings.pressures;
+        let pressures = &ctx.model.pressures;
         if !pressures.is_empty() {
             self.places.resize(pressures.ids.len(), [0.0; 3]);
             for arch in points_with::<PointLoad<D::Vec>>(&ctx.world) {
@@ -95,19 +95,5 @@ impl<D: Dim, S: Shape> System<D> for PointLoads<D, S> {
             }
         }
         Ok(())
-    }
-}
-
-/// Sets the point load of every point named in `loads` (point id, force: N; N/m in 2D,
-/// x y z; sorted by id) to `scale` times its force. Loading stages and load control use it.
-pub fn set_point_loads<D: Dim>(ctx: &Context<D>, loads: &[(u32, [f64; 3])], scale: f64) {
-    for arch in points_with::<PointLoad<D::Vec>>(&ctx.world) {
-        let ids = col::<PointId>(arch);
-        let mut f = col_mut::<PointLoad<D::Vec>>(arch);
-        for (id, f) in ids.iter().zip(f.iter_mut()) {
-            if let Ok(k) = loads.binary_search_by_key(&id.0, |l| l.0) {
-                f.0 = D::vec_from(loads[k].1.map(|c| c * scale));
-            }
-        }
     }
 }

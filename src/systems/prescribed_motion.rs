@@ -17,8 +17,9 @@ use crate::context::Context;
 use crate::dim::Dim;
 use crate::error::StepError;
 use crate::infra::columns::{col_mut, nodes};
+use crate::model::{CurvePoint, MotionSpec};
 use crate::schedule::System;
-use crate::state::{CurvePoint, MotionSpec, StopReason};
+use crate::state::StopReason;
 use crate::systems::increments::Increments;
 
 /// Drives the scene's motions: marks their nodes before the first step, and after each
@@ -30,7 +31,7 @@ pub struct PrescribedMotion {
 }
 
 impl PrescribedMotion {
-    /// The system for these motions (in scene order: [`crate::state::Control::drives`]).
+    /// The system for these motions (in scene order: [`crate::model::Control::drives`]).
     pub fn new(motions: Vec<MotionSpec>) -> Self {
         PrescribedMotion { motions }
     }
@@ -59,7 +60,7 @@ impl<D: Dim> System<D> for PrescribedMotion {
 
     fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
         let s = &mut ctx.state;
-        let dt = s.resets.motion_dt(ctx.settings.dt).unwrap_or(0.0);
+        let dt = s.resets.motion_dt(ctx.numerics.dt).unwrap_or(0.0);
         for (m, d) in self.motions.iter().zip(&mut s.control.drives) {
             if d.velocity == [0.0; 3] {
                 continue;
@@ -69,7 +70,7 @@ impl<D: Dim> System<D> for PrescribedMotion {
                 &mut d.travel,
                 d.increments,
                 dt,
-                ctx.settings.dt,
+                ctx.numerics.dt,
             );
         }
         if s.stop != Some(StopReason::Converged) {
@@ -96,7 +97,7 @@ impl<D: Dim> System<D> for PrescribedMotion {
             }
         }
         if more {
-            s.go_on(&ctx.settings);
+            s.go_on(&ctx.numerics);
         }
         Ok(())
     }

@@ -38,7 +38,7 @@ use crate::rigid::contact::{key, remember, solve, Contact, Contacts, Memory, Slo
 use crate::rigid::Sample;
 use crate::schedule::System;
 use crate::shape::{for_each_node, Shape};
-use crate::systems::boundary::{constrain, hold, Hold};
+use crate::systems::shared::{constrain, hold, Hold};
 use std::collections::HashMap;
 use std::marker::PhantomData;
 
@@ -78,7 +78,7 @@ fn place<D: Dim, S: Shape>(
         col::<NodeForce<D::Vec>>(n),
         col::<NodeFixity>(n),
     );
-    let (grid, st) = (&ctx.grid, &ctx.settings);
+    let (grid, st) = (&ctx.grid, &ctx.numerics);
     let drives = &ctx.state.control.drives;
     let mut set = Contacts::default();
     let mut slot_of: HashMap<usize, usize> = HashMap::new();
@@ -100,7 +100,7 @@ fn place<D: Dim, S: Shape>(
     };
     for (b, body) in samples.iter().enumerate() {
         let state = &ctx.state.control.bodies[b];
-        let spec = &st.bodies[b];
+        let spec = &ctx.model.bodies[b];
         let interfaces = &interfaces[b];
         // The nodes inside the body hold their normal velocity too: the soil's field
         // there is the body's, and a light node that only a point's tail reaches would
@@ -192,13 +192,13 @@ impl<D: Dim, S: Shape> System<D> for RigidContact<D, S> {
     fn prepare(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
         let grid = (D::vec_to3(ctx.grid.origin), D::vec_to3(ctx.grid.max_corner()));
         self.samples = ctx
-            .settings
+            .model
             .bodies
             .iter()
             .map(|b| b.samples(D::N, ctx.grid.cell_size, grid))
             .collect();
         self.interfaces = ctx
-            .settings
+            .model
             .bodies
             .iter()
             .map(|b| (0..b.parts.len()).map(|k| b.interface_of(k).friction()).collect())
@@ -208,11 +208,11 @@ impl<D: Dim, S: Shape> System<D> for RigidContact<D, S> {
 
     fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
         let mut set = place::<D, S>(ctx, &self.samples, &self.interfaces);
-        let bodies = &ctx.settings.bodies;
+        let bodies = &ctx.model.bodies;
         let velocities: Vec<[f64; 3]> = ctx.state.control.bodies.iter().map(|b| b.velocity).collect();
         solve(&mut set, &velocities, &ctx.state.control.contact_memory);
         ctx.state.control.contact_memory = remember(&set.contacts);
-        let dt = ctx.settings.dt;
+        let dt = ctx.numerics.dt;
         let n = nodes(&ctx.world);
         let mut nf = col_mut::<NodeForce<D::Vec>>(n);
         let mut ne = col_mut::<NodeExternalForce<D::Vec>>(n);
@@ -267,7 +267,7 @@ pub fn project<D: Dim>(ctx: &mut Context<D>) {
     let n = nodes(&ctx.world);
     let nm = col::<NodeMass>(n);
     let mut nv = col_mut::<NodeVelocity<D::Vec>>(n);
-    let (grid, floor) = (&ctx.grid, ctx.settings.virtual_mass_floor);
+    let (grid, floor) = (&ctx.grid, ctx.numerics.virtual_mass_floor);
     let control = &mut ctx.state.control;
     for s in &mut control.contacts.slots {
         s.v = D::vec_to3(nv[s.node].0);

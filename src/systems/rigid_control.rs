@@ -38,10 +38,12 @@ use crate::dim::Dim;
 use crate::error::StepError;
 use crate::grid::Grid;
 use crate::infra::columns::{col_mut, points_with};
+use crate::model::CurvePoint;
+use crate::model::LoadStage;
 use crate::rigid::{BodyLoad, BodyState, RigidBodySpec};
 use crate::schedule::System;
-use crate::state::{CurvePoint, StopReason};
-use crate::state::{LoadStage, Settings, SolverState};
+use crate::state::StopReason;
+use crate::state::{Numerics, SolverState};
 use crate::systems::increments::Increments;
 
 /// Moves the bodies, holds them at the end of an increment and, at the static state that
@@ -160,7 +162,7 @@ fn stuck(
     bodies: &[RigidBodySpec],
     first: &[Option<usize>],
     s: &SolverState,
-    settings: &Settings,
+    numerics: &Numerics,
 ) -> Result<(), StepError> {
     for ((spec, b), &f) in bodies.iter().zip(&s.control.bodies).zip(first) {
         if driven(f, s.control.stage) && b.increments < spec.increments() {
@@ -169,7 +171,7 @@ fn stuck(
                 time: s.clock.time,
                 body: spec.name.clone(),
                 increment: b.increments + 1,
-                force_ratio: s.convergence.force_ratio(settings.force_norm),
+                force_ratio: s.convergence.force_ratio(numerics.force_norm),
                 unbalanced: spec.load.as_ref().map(|_| s.control.unbalanced()),
             });
         }
@@ -184,10 +186,10 @@ impl<D: Dim> System<D> for RigidControl {
 
     fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
         let s = &mut ctx.state;
-        let dt = s.resets.motion_dt(ctx.settings.dt).unwrap_or(0.0);
+        let dt = s.resets.motion_dt(ctx.numerics.dt).unwrap_or(0.0);
         for (spec, b) in self.bodies.iter().zip(&mut s.control.bodies) {
             if let (Some(l), true) = (&spec.load, b.load != [0.0; 3]) {
-                carry(l, b, dt, ctx.settings.dt, s.resets.this_step);
+                carry(l, b, dt, ctx.numerics.dt, s.resets.this_step);
                 check_in_grid(spec, b, &ctx.grid, s.clock.step)?;
                 continue;
             }
@@ -200,7 +202,7 @@ impl<D: Dim> System<D> for RigidControl {
                 &mut b.travel,
                 b.increments,
                 dt,
-                ctx.settings.dt,
+                ctx.numerics.dt,
             );
             for a in 0..3 {
                 b.offset[a] += moved[a];
@@ -213,7 +215,7 @@ impl<D: Dim> System<D> for RigidControl {
         }
         let s = &mut ctx.state;
         if s.stop == Some(StopReason::MaxTime) {
-            stuck(&self.bodies, &self.first, s, &ctx.settings)?;
+            stuck(&self.bodies, &self.first, s, &ctx.numerics)?;
         }
         // A static state: the run's stop, or one `prescribed_motion` took this step.
         if s.stop != Some(StopReason::Converged) && !s.control.milestone {
@@ -270,7 +272,7 @@ impl<D: Dim> System<D> for RigidControl {
             }
         }
         if more {
-            s.go_on(&ctx.settings);
+            s.go_on(&ctx.numerics);
         }
         Ok(())
     }

@@ -9,9 +9,10 @@ use crate::context::Context;
 use crate::dim::{Dim, Vector};
 use crate::error::StepError;
 use crate::infra::columns::{col, col_mut, nodes, points_with};
+use crate::model::{Gravity, LoadStage, StageResult};
 use crate::schedule::System;
-use crate::state::{Gravity, LoadStage, StageResult, StopReason};
-use crate::systems::point_loads::set_point_loads;
+use crate::state::StopReason;
+use crate::systems::shared::set_point_loads;
 
 /// Moves to the next stage at each static state until the last: records the finished
 /// stage (`stages.csv`), applies the next one's changes and lets the run go on from the
@@ -25,7 +26,7 @@ pub struct Stages;
 /// it once).
 fn apply<D: Dim>(ctx: &mut Context<D>, stage: &LoadStage, start: f64) {
     if let Some(g) = stage.gravity {
-        ctx.settings.gravity = Some(Gravity { start, ..g });
+        ctx.model.gravity = Some(Gravity { start, ..g });
     }
     if let Some(masks) = &stage.fixity {
         let drives = &ctx.state.control.drives;
@@ -42,10 +43,10 @@ fn apply<D: Dim>(ctx: &mut Context<D>, stage: &LoadStage, start: f64) {
         ctx.materials[*id as usize] = model.clone();
     }
     if let Some(w) = &stage.water {
-        ctx.settings.water = Some(w.clone());
+        ctx.model.water = Some(w.clone());
     }
     // γ_w = ρ_w |g| follows the gravity in force (a centrifuge stage doubles both).
-    if let (Some(w), Some(g)) = (ctx.settings.water.as_mut(), ctx.settings.gravity) {
+    if let (Some(w), Some(g)) = (ctx.model.water.as_mut(), ctx.model.gravity) {
         w.follow_gravity(g.acceleration);
     }
     set_point_loads(ctx, &stage.loads, 1.0);
@@ -55,7 +56,7 @@ fn apply<D: Dim>(ctx: &mut Context<D>, stage: &LoadStage, start: f64) {
 /// surface, ρ_dry above it ([`crate::water::Water::density_ratio`], judged at each point's
 /// current place). Called once as the stage begins, before [`apply`] sets the new water.
 fn rewet<D: Dim>(ctx: &mut Context<D>, stage: &LoadStage) {
-    let (Some(old), Some(new)) = (&ctx.settings.water, &stage.water) else {
+    let (Some(old), Some(new)) = (&ctx.model.water, &stage.water) else {
         return;
     };
     for arch in points_with::<MaterialId>(&ctx.world) {
@@ -85,7 +86,7 @@ fn reweigh<D: Dim>(ctx: &mut Context<D>, stage: &LoadStage) {
     if changes.is_empty() {
         return;
     }
-    let water = ctx.settings.water.as_ref();
+    let water = ctx.model.water.as_ref();
     for arch in points_with::<MaterialId>(&ctx.world) {
         let ids = col::<MaterialId>(arch);
         let xs = col::<Position<D::Vec>>(arch);
@@ -109,7 +110,7 @@ impl<D: Dim> System<D> for Stages {
 
     fn prepare(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
         // The stages so far, in order (a resumed run starts inside one).
-        let stages = ctx.settings.stages.clone();
+        let stages = ctx.model.stages.clone();
         for (k, stage) in stages[..=ctx.state.control.stage.min(stages.len() - 1)]
             .iter()
             .enumerate()
@@ -134,12 +135,12 @@ impl<D: Dim> System<D> for Stages {
             return Ok(());
         }
         let s = &mut ctx.state;
-        let stages = &ctx.settings.stages;
+        let stages = &ctx.model.stages;
         s.control.stages.push(StageResult {
             name: stages[s.control.stage].name.clone(),
             step: s.clock.step,
             time: s.clock.time,
-            force_ratio: s.convergence.force_ratio(ctx.settings.force_norm),
+            force_ratio: s.convergence.force_ratio(ctx.numerics.force_norm),
             energy_ratio: s.convergence.energy_ratio,
             resets: s.resets.count,
         });
@@ -148,19 +149,9 @@ impl<D: Dim> System<D> for Stages {
             return Ok(());
         }
         s.control.stage += 1;
-        s.go_on(&ctx.settings);
-        // The rigid bodies that set off with this stage.
-        for (spec, b) in ctx.settings.bodies.iter().zip(&mut s.control.bodies) {
-            if spec.stage() != Some(&stages[s.control.stage].name) {
-                continue;
-            }
-            if let Some(m) = &spec.motion {
-                b.velocity = m.vector();
-            }
-            if let Some(l) = &spec.load {
-                b.load = l.at(0);
-            }
-        }
+        s.go_on(&ctx.numerics);
+        ctx.model
+            .start_stage(&stages[s.control.stage].name, &mut s.control);
         s.energy.reset();
         let stage = stages[s.control.stage].clone();
         let start = ctx.state.clock.time;
