@@ -10,17 +10,14 @@
 
 use std::ops::{Add, Div, Mul, Sub};
 
-/// `a·b + c`: rounded once where the build targets a CPU with fused multiply-add (the
-/// host CPU, `.cargo/config.toml`; fewer instructions a particle-step, see
-/// docs/performance.md); rounded twice, as written, where it does not (a software fused
-/// multiply-add would cost more than it saves). Either way the same for every thread count.
+/// `a·b + c` rounded once (IEEE 754 fusedMultiplyAdd), on every machine: one instruction
+/// where the build targets a CPU with fused multiply-add (x86-64 with FMA, which
+/// `.cargo/config.toml`'s `target-cpu=native` turns on where the CPU has it; every
+/// aarch64), the C library's `fma` elsewhere (slower, the same bits). So a run gives the
+/// same bits whichever machine built it, and for every thread count.
 #[inline(always)]
 pub fn madd(a: f64, b: f64, c: f64) -> f64 {
-    if cfg!(target_feature = "fma") {
-        a.mul_add(b, c)
-    } else {
-        a * b + c
-    }
+    a.mul_add(b, c)
 }
 
 /// Four f64 lanes (one 256-bit AVX register where the build targets AVX).
@@ -37,8 +34,7 @@ pub trait Lanes:
 {
     /// `v` in every lane.
     fn splat(v: f64) -> Self;
-    /// `a·b + c` lane by lane, rounded once where the build has fused multiply-add and
-    /// twice (as written) where it does not: the same choice as [`madd`].
+    /// `a·b + c` lane by lane, rounded once, as [`madd`].
     fn madd(a: Self, b: Self, c: Self) -> Self;
     /// Square root, correctly rounded.
     fn sqrt(self) -> Self;
@@ -78,10 +74,14 @@ impl Lanes for F64x4 {
     }
     #[inline(always)]
     fn madd(a: F64x4, b: F64x4, c: F64x4) -> F64x4 {
-        if cfg!(target_feature = "fma") {
+        if cfg!(all(target_feature = "avx", target_feature = "fma")) {
+            // One fused instruction for the four lanes.
             a.mul_add(b, c)
         } else {
-            a * b + c
+            // `wide` rounds twice here (a·b, then + c); lane by lane through `madd` keeps
+            // the one rounding.
+            let (a, b, c) = (a.to_array(), b.to_array(), c.to_array());
+            F64x4::new(std::array::from_fn(|i| madd(a[i], b[i], c[i])))
         }
     }
     #[inline(always)]
@@ -111,13 +111,14 @@ mod tests {
     #[test]
     fn a_lane_multiply_add_rounds_like_the_scalar_one() {
         // 1 + 2⁻⁵² squared: the exact product 1 + 2⁻⁵¹ + 2⁻¹⁰⁴ loses its last term when
-        // rounded before the add, so fused and unfused differ in the last bit; the lanes must
-        // take the same choice as `madd`.
+        // rounded before the add, so fused and unfused differ in the last bit; the lanes,
+        // like `madd`, round once on every build.
         let a = 1.0 + f64::EPSILON;
         let c = -(1.0 + 2.0 * f64::EPSILON);
         let lane = <F64x4 as Lanes>::madd(F64x4::splat(a), F64x4::splat(a), F64x4::splat(c));
         for v in lane.to_array() {
             assert_eq!(v.to_bits(), madd(a, a, c).to_bits());
+            assert_eq!(v, 2f64.powi(-104));
         }
     }
 }
