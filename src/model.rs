@@ -18,7 +18,7 @@ pub struct Model {
     /// Prescribed motions (displacement control), in scene order.
     pub motions: Vec<MotionSpec>,
     /// Rigid bodies, in scene order.
-    pub bodies: Vec<crate::rigid::RigidBodySpec>,
+    pub bodies: Vec<crate::rigid::RigidBody>,
     /// The scene's `Friction` faces: (normal axis, upper face, tan δ).
     pub friction_faces: Vec<(usize, bool, f64)>,
     /// Loading stages, in order; the first is the scene as built.
@@ -42,16 +42,16 @@ impl Model {
     /// J/rad axisymmetric): what a kinetic-damping peak watch counts with the soil's.
     pub fn kinetic_energy(&self, control: &Control) -> f64 {
         (self.bodies.iter().zip(&control.bodies))
-            .map(|(spec, b)| spec.kinetic_energy(b))
+            .map(|(body, b)| body.spec.kinetic_energy(b))
             .sum()
     }
 
     /// Sets off what waits for the stage named `stage` to begin (the rigid bodies whose
     /// motion or load starts with it).
     pub fn start_stage(&self, stage: &str, control: &mut Control) {
-        for (spec, b) in self.bodies.iter().zip(&mut control.bodies) {
-            if spec.stage().is_some_and(|s| s == stage) {
-                spec.set_off(b);
+        for (body, b) in self.bodies.iter().zip(&mut control.bodies) {
+            if body.spec.stage().is_some_and(|s| s == stage) {
+                body.spec.set_off(b);
             }
         }
     }

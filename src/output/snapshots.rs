@@ -180,7 +180,7 @@ impl<D: Dim> System<D> for Snapshots<D> {
         let grid = (D::vec_to3(ctx.grid.origin), D::vec_to3(ctx.grid.max_corner()));
         frame.bodies = (0u32..)
             .zip(ctx.model.bodies.iter().zip(&ctx.state.control.bodies))
-            .flat_map(|(k, (spec, state))| spec.outlines(k, state.offset, spacing, grid))
+            .flat_map(|(k, (body, state))| body.spec.outlines(k, state.offset, spacing, grid))
             .collect();
         let start = Instant::now();
         if tx.send(frame).is_err() {

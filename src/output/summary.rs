@@ -263,7 +263,10 @@ impl Summary {
             // under load control: its pressure is the load it was given.
             .filter(|c| {
                 model.motions.iter().any(|m| m.name == c.name)
-                    || model.bodies.iter().any(|b| b.name == c.name && b.load.is_none())
+                    || model
+                        .bodies
+                        .iter()
+                        .any(|b| b.spec.name == c.name && b.spec.load.is_none())
             })
             .cloned()
             .collect();

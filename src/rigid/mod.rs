@@ -53,6 +53,38 @@ pub struct RigidBodySpec {
     pub area: Option<f64>,
 }
 
+/// A body's surface samples in its starting frame, each with the index of its part.
+pub type Samples = Vec<(Sample, usize)>;
+
+/// A rigid body as a run holds it: the scene's body, checked and with its meshes read; the
+/// samples of its surface at which contact is held, cut once at set-up; and each part's
+/// interface law.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RigidBody {
+    /// The body as the scene gives it (a body under load control without a mass of its own
+    /// has the soil's it displaces, filled in by set-up).
+    pub spec: RigidBodySpec,
+    /// Its surface samples in its starting frame, each with its part's index
+    /// ([`RigidBodySpec::samples`]).
+    pub samples: Samples,
+    /// Per part: (tan δ, adhesion a in Pa) of its interface ([`Interface::friction`]).
+    pub interfaces: Vec<(f64, f64)>,
+}
+
+impl RigidBody {
+    /// The body of `spec` with the surface `samples` cut for the run's grid.
+    pub fn new(spec: RigidBodySpec, samples: Samples) -> Self {
+        let interfaces = (0..spec.parts.len())
+            .map(|k| spec.interface_of(k).friction())
+            .collect();
+        RigidBody {
+            spec,
+            samples,
+            interfaces,
+        }
+    }
+}
+
 /// A named part of a rigid body.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -410,7 +442,7 @@ impl RigidBodySpec {
     /// functions' support, two cells, around it), each with its part, less those on a face
     /// two parts share (a cone's tip against its shaft: inside the body, not on its
     /// surface).
-    pub fn samples(&self, n: usize, cell: f64, (lo, hi): ([f64; 3], [f64; 3])) -> Vec<(Sample, usize)> {
+    pub fn samples(&self, n: usize, cell: f64, (lo, hi): ([f64; 3], [f64; 3])) -> Samples {
         let reach = self.reach(n, lo, hi, 2.0 * cell);
         let spacing = 0.5 * cell;
         let inner = 1e-9 * cell;

@@ -14,7 +14,7 @@ use crate::infra::decomposition::Decomposition;
 use crate::materials::{MaterialModel, MaterialState, StateVisitor};
 use crate::model::{Control, Gravity, LoadStage, Model, MotionSpec};
 use crate::parallel::SlabCache;
-use crate::rigid::RigidBodySpec;
+use crate::rigid::{RigidBody, Samples};
 use crate::shape::{for_each_node, Linear, QuadraticBSpline, ShapeKind, UniformGimp};
 use crate::simulation::{AnySimulation, Simulation, TracedPoint};
 use crate::state::{Numerics, SolverState};
@@ -212,10 +212,15 @@ fn stages<D: Dim>(
     out
 }
 
-/// The scene's rigid bodies as the run takes them: a body under load control without a
-/// mass of its own gets the mass of the soil it displaces (its volume in the grid times
-/// the densest material's density, at least one cell's worth).
-fn loaded_bodies<D: Dim>(s: &Scene, grid: &Grid<D>, table: &[(String, MaterialModel)]) -> Vec<RigidBodySpec> {
+/// The scene's rigid bodies as the run takes them, with their contact `samples`: a body
+/// under load control without a mass of its own gets the mass of the soil it displaces
+/// (its volume in the grid times the densest material's density, at least one cell's worth).
+fn loaded_bodies<D: Dim>(
+    s: &Scene,
+    grid: &Grid<D>,
+    table: &[(String, MaterialModel)],
+    samples: Vec<Samples>,
+) -> Vec<RigidBody> {
     let density = table.iter().map(|(_, m)| m.density()).fold(0.0, f64::max);
     let h = grid.cell_size;
     let origin = D::vec_to3(grid.origin);
@@ -231,6 +236,10 @@ fn loaded_bodies<D: Dim>(s: &Scene, grid: &Grid<D>, table: &[(String, MaterialMo
         }
     }
     bodies
+        .into_iter()
+        .zip(samples)
+        .map(|(b, s)| RigidBody::new(b, s))
+        .collect()
 }
 
 /// The run's numerics from the scene's solver settings: the time step the check chose, and
@@ -303,7 +312,7 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         }),
         water,
         motions: s.motions.clone(),
-        bodies: loaded_bodies::<D>(s, &grid, &table),
+        bodies: loaded_bodies::<D>(s, &grid, &table, body_samples),
         friction_faces: checked_grid
             .faces
             .iter()
@@ -334,7 +343,7 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         systems: schedule.names(),
         unused_materials,
         estimate,
-        bodies: describe_bodies(s, &body_samples),
+        bodies: describe_bodies(&model.bodies),
         water: model.water.as_ref().map(|w| describe_water(s, w)),
     };
     let state = initial_state(s);
@@ -424,13 +433,13 @@ fn initial_state(s: &Scene) -> SolverState {
     }
 }
 
-/// Each rigid body as `kdmpm check` prints it: name, parts, its contact samples (`samples`,
-/// counted by the check), control and travel.
-fn describe_bodies(s: &Scene, samples: &[u64]) -> Vec<String> {
-    s.rigid_bodies
+/// Each rigid body as `kdmpm check` prints it: name, parts, its contact samples, control
+/// and travel.
+fn describe_bodies(bodies: &[RigidBody]) -> Vec<String> {
+    bodies
         .iter()
-        .zip(samples)
-        .map(|(b, samples)| {
+        .map(|RigidBody { spec: b, samples, .. }| {
+            let samples = samples.len();
             let control = match (&b.motion, &b.load) {
                 (Some(m), _) => format!(
                     "moves {} m at {:?} m/s in {} increment(s)",

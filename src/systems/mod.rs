@@ -541,7 +541,12 @@ fn relaxing<D: Dim, S: Shape>() -> Vec<Entry<D>> {
                 ("prescribed_motion", "the bodies' rows follow the motions'"),
             ],
             "rigid bodies: travel or carry a load, hold, curve of static states",
-            |_, m| Box::new(RigidControl::new(m.bodies.clone(), &m.stages)),
+            |_, m| {
+                Box::new(RigidControl::new(
+                    m.bodies.iter().map(|b| b.spec.clone()).collect(),
+                    &m.stages,
+                ))
+            },
         ),
         e(
             "load_steps",

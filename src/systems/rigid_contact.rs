@@ -35,42 +35,29 @@ use crate::dim::Dim;
 use crate::error::StepError;
 use crate::infra::columns::{col, col_mut, nodes};
 use crate::rigid::contact::{key, remember, solve, Contact, Contacts, Memory, Slot};
-use crate::rigid::Sample;
 use crate::schedule::System;
 use crate::shape::{for_each_node, Shape};
 use crate::systems::shared::{constrain, hold, Hold};
 use std::collections::HashMap;
 use std::marker::PhantomData;
 
-/// Samples the bodies' surfaces once, then at every step holds the contacts at them
-/// (before `boundary`).
+/// Holds the contacts at the bodies' surface samples ([`crate::rigid::RigidBody::samples`],
+/// cut at set-up) at every step (before `boundary`).
 #[derive(Debug)]
 pub struct RigidContact<D: Dim, S> {
-    /// Per body: its samples in its starting frame and the part each belongs to.
-    samples: Vec<Vec<(Sample, usize)>>,
-    /// Per body, per part: (tan δ, adhesion a in Pa) of the part's interface.
-    interfaces: Vec<Vec<(f64, f64)>>,
     _marker: PhantomData<fn() -> (D, S)>,
 }
 
 impl<D: Dim, S> Default for RigidContact<D, S> {
     fn default() -> Self {
-        RigidContact {
-            samples: Vec::new(),
-            interfaces: Vec::new(),
-            _marker: PhantomData,
-        }
+        RigidContact { _marker: PhantomData }
     }
 }
 
 /// Places every sample that meets soil at its body's current place: its nodes that carry
 /// soil and their weights, each node's trial velocity p/m + f Δt/m̃. A sample meets soil
 /// when nodes carrying mass hold at least half its support.
-fn place<D: Dim, S: Shape>(
-    ctx: &Context<D>,
-    samples: &[Vec<(Sample, usize)>],
-    interfaces: &[Vec<(f64, f64)>],
-) -> Contacts {
+fn place<D: Dim, S: Shape>(ctx: &Context<D>) -> Contacts {
     let n = nodes(&ctx.world);
     let (nm, np, nf, fix) = (
         col::<NodeMass>(n),
@@ -98,10 +85,9 @@ fn place<D: Dim, S: Shape>(
             slots.len() - 1
         })
     };
-    for (b, body) in samples.iter().enumerate() {
+    for (b, body) in ctx.model.bodies.iter().enumerate() {
         let state = &ctx.state.control.bodies[b];
-        let spec = &ctx.model.bodies[b];
-        let interfaces = &interfaces[b];
+        let (spec, interfaces) = (&body.spec, &body.interfaces);
         // The nodes inside the body hold their normal velocity too: the soil's field
         // there is the body's, and a light node that only a point's tail reaches would
         // otherwise be free to run into it (under a confining stress it does).
@@ -140,7 +126,7 @@ fn place<D: Dim, S: Shape>(
                 impulse: [0.0; 3],
             });
         }
-        for (index, (s, part)) in body.iter().enumerate() {
+        for (index, (s, part)) in body.samples.iter().enumerate() {
             let x3: [f64; 3] = std::array::from_fn(|a| s.x[a] + state.offset[a]);
             let x = D::vec_from(x3);
             if !grid.contains(x) {
@@ -189,25 +175,8 @@ impl<D: Dim, S: Shape> System<D> for RigidContact<D, S> {
         "rigid_contact"
     }
 
-    fn prepare(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
-        let grid = (D::vec_to3(ctx.grid.origin), D::vec_to3(ctx.grid.max_corner()));
-        self.samples = ctx
-            .model
-            .bodies
-            .iter()
-            .map(|b| b.samples(D::N, ctx.grid.cell_size, grid))
-            .collect();
-        self.interfaces = ctx
-            .model
-            .bodies
-            .iter()
-            .map(|b| (0..b.parts.len()).map(|k| b.interface_of(k).friction()).collect())
-            .collect();
-        Ok(())
-    }
-
     fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
-        let mut set = place::<D, S>(ctx, &self.samples, &self.interfaces);
+        let mut set = place::<D, S>(ctx);
         let bodies = &ctx.model.bodies;
         let velocities: Vec<[f64; 3]> = ctx.state.control.bodies.iter().map(|b| b.velocity).collect();
         solve(&mut set, &velocities, &ctx.state.control.contact_memory);
@@ -224,7 +193,7 @@ impl<D: Dim, S: Shape> System<D> for RigidContact<D, S> {
         let control = &mut ctx.state.control;
         for (b, state) in control.bodies.iter_mut().enumerate() {
             state.reaction = [0.0; 3];
-            state.parts = vec![[0.0; 3]; bodies[b].parts.len()];
+            state.parts = vec![[0.0; 3]; bodies[b].spec.parts.len()];
         }
         for p in &set.contacts {
             let state = &mut control.bodies[p.body];
@@ -235,12 +204,12 @@ impl<D: Dim, S: Shape> System<D> for RigidContact<D, S> {
         }
         // The soil that moves with each body under load control: every node its contacts
         // reach, once (a body under displacement control does not need it).
-        let loaded = bodies.iter().any(|b| b.load.is_some());
+        let loaded = bodies.iter().any(|b| b.spec.load.is_some());
         let mut seen = vec![u32::MAX; if loaded { set.slots.len() } else { 0 }];
         for state in &mut control.bodies {
             state.contact_mass = 0.0;
         }
-        for p in set.contacts.iter().filter(|p| bodies[p.body].load.is_some()) {
+        for p in set.contacts.iter().filter(|p| bodies[p.body].spec.load.is_some()) {
             for &(k, _) in &p.nodes {
                 if seen[k] != p.body as u32 {
                     seen[k] = p.body as u32;

@@ -4,6 +4,7 @@
 use super::*;
 use crate::error::SceneError;
 use crate::materials::MaterialModel;
+use crate::rigid::Samples;
 use crate::scene::LoadedScene;
 use serde::Serialize;
 
@@ -164,7 +165,7 @@ pub fn memory_limit() -> Option<(u64, &'static str)> {
 pub(super) fn estimate(
     loaded: &LoadedScene,
     table: &[(String, MaterialModel)],
-) -> Result<(Estimate, Vec<u64>), SceneError> {
+) -> Result<(Estimate, Vec<Samples>), SceneError> {
     let s = &loaded.scene;
     let n = s.dimension.axes();
     let too_many =
@@ -213,12 +214,12 @@ pub(super) fn estimate(
             }
         }),
     );
-    let per_body: Vec<u64> = s
+    let per_body: Vec<Samples> = s
         .rigid_bodies
         .iter()
-        .map(|b| b.samples(n, s.grid.cell_size, (lo, hi)).len() as u64)
+        .map(|b| b.samples(n, s.grid.cell_size, (lo, hi)))
         .collect();
-    let samples: u64 = per_body.iter().sum();
+    let samples: u64 = per_body.iter().map(|b| b.len() as u64).sum();
     let bytes = samples
         .checked_mul(SAMPLE_BYTES)
         .and_then(|b| bytes.checked_add(b))
@@ -239,7 +240,7 @@ pub(super) fn estimate(
 pub(super) fn check_memory(
     r: &Rules,
     table: &[(String, MaterialModel)],
-) -> Result<(Estimate, Vec<u64>), SceneError> {
+) -> Result<(Estimate, Vec<Samples>), SceneError> {
     let loaded = r.loaded;
     let (estimate, samples) = estimate(loaded, table)?;
     if let Some((total, what)) = memory_limit() {

@@ -130,8 +130,9 @@ pub struct Checked {
     pub unused_materials: Vec<String>,
     /// What the run will hold in memory, at most.
     pub estimate: Estimate,
-    /// Each rigid body's contact samples, in scene order.
-    pub body_samples: Vec<u64>,
+    /// Each rigid body's contact samples (in its starting frame, with its part), in scene
+    /// order: cut once here, for the memory bound, and handed to set-up.
+    pub body_samples: Vec<crate::rigid::Samples>,
     /// The water, if any.
     pub water: Option<crate::water::Water>,
 }
