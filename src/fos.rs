@@ -100,7 +100,7 @@ pub enum FosError {
     /// The bracket does not hold the factor of safety: the trials are in their folders.
     #[error("{0}")]
     NotBracketed(String),
-    /// Stopped by a signal ([`crate::interrupt`]) during the trial at this factor.
+    /// Stopped by a signal ([`crate::catch_signals`]) during the trial at this factor.
     #[error("interrupted during the trial at F = {0}: the trials so far are in their folders")]
     Interrupted(f64),
     /// The output directory cannot be used (exit 2).

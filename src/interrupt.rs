@@ -28,8 +28,8 @@ pub fn requested() -> bool {
 }
 
 /// Installs the handler of Ctrl-C, SIGTERM and SIGHUP, once per process: the first signal
-/// sets the flag ([`request`]); a second one while the first is being honoured ends the
-/// process at once with [`INTERRUPTED_EXIT`] (every file is written whole or not at all, so
+/// sets the process's stop flag; a second one while the first is being honoured ends the
+/// process at once with exit code 130 (every file is written whole or not at all, so
 /// nothing torn is left). A process that cannot install it (another handler is installed)
 /// keeps that handler.
 pub fn catch_signals() {
@@ -49,7 +49,7 @@ pub fn catch_signals() {
 pub struct StopSignal(Option<Arc<AtomicBool>>);
 
 impl StopSignal {
-    /// The process's flag alone (signals and [`request`]).
+    /// The process's flag alone (what [`catch_signals`] sets).
     pub fn process() -> StopSignal {
         StopSignal(None)
     }

@@ -32,16 +32,16 @@
 #[macro_use]
 pub mod components;
 #[macro_use]
-pub mod simulation;
+mod simulation;
 
 pub mod checkpoint;
-pub mod context;
-pub mod dim;
-pub mod error;
+mod context;
+mod dim;
+mod error;
 pub mod fos;
-pub mod grid;
+mod grid;
 pub mod infra;
-pub mod interrupt;
+mod interrupt;
 pub mod materials;
 pub mod measure;
 pub mod model;
@@ -52,11 +52,11 @@ pub mod refine;
 pub mod rigid;
 pub mod run;
 pub mod scene;
-pub mod schedule;
+mod schedule;
 pub mod shape;
 pub mod state;
 pub mod study;
-pub mod surface_pressure;
+mod surface_pressure;
 pub mod systems;
 pub mod tensor;
 #[cfg(test)]
@@ -65,15 +65,17 @@ pub(crate) mod unique_map;
 pub mod water;
 
 pub use context::Context;
-pub use dim::{Dim, Dim2, Dim3, DimAxi};
-pub use error::{SceneError, StepError};
-pub use interrupt::StopSignal;
+pub use dim::{Dim, Dim2, Dim3, DimAxi, Vector};
+pub use error::{Ending, Refusal, SceneError, StepError};
+pub use grid::{Axis, Face, Grid, NodeBox};
+pub use interrupt::{catch_signals, StopSignal};
 pub use output::{Outcome, Summary};
 /// The scatters' grouping of points, kept in the [`Context`]: a system that moves or
 /// reorders points calls `ctx.slabs.invalidate()`.
 pub use parallel::SlabCache;
 pub use run::{Run, RunError, RunReport};
 pub use scene::LoadedScene;
-pub use schedule::{FnSystem, Schedule, System};
-pub use simulation::{AnySimulation, Simulation};
+pub use schedule::{FnSystem, Schedule, System, Timing};
+pub use simulation::{AnySimulation, Simulation, TracedResult};
 pub use state::SolverState;
+pub use surface_pressure::{SurfacePoint, SurfacePressures};

@@ -276,9 +276,9 @@ pub enum AnySimulation {
 macro_rules! with_simulation {
     ($any:expr, $sim:ident => $body:expr) => {
         match $any {
-            $crate::simulation::AnySimulation::Two($sim) => $body,
-            $crate::simulation::AnySimulation::Three($sim) => $body,
-            $crate::simulation::AnySimulation::Axi($sim) => $body,
+            $crate::AnySimulation::Two($sim) => $body,
+            $crate::AnySimulation::Three($sim) => $body,
+            $crate::AnySimulation::Axi($sim) => $body,
         }
     };
 }

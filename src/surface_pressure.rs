@@ -41,7 +41,7 @@ pub struct SurfacePoint {
     /// The axes across the surface's normal (the second unused in 2D).
     pub across: [usize; 2],
     /// The neighbours' ids before and after the point along each axis of `across`
-    /// ([`NONE`] at the surface's edge).
+    /// (`u32::MAX` at the surface's edge).
     pub links: [[u32; 2]; 2],
     /// The spacing of the lattice along each axis of `across` at set-up (m): the tangent of
     /// a point that has no neighbour along an axis.

@@ -25,7 +25,7 @@ fn column_u(y: f64, h: f64, rho: f64, g: f64, e: f64, nu: f64) -> f64 {
     ((-a * (h - y)).exp() - (-a * h).exp()) / a - y
 }
 
-fn traced<'a>(s: &'a kdmpm::output::Summary, name: &str) -> &'a kdmpm::simulation::TracedResult {
+fn traced<'a>(s: &'a kdmpm::output::Summary, name: &str) -> &'a kdmpm::TracedResult {
     s.traced.iter().find(|t| t.name == name).expect("traced point")
 }
 

@@ -9,9 +9,9 @@
 
 mod common;
 
-use kdmpm::error::SceneError;
 use kdmpm::scene::{build, check, LoadedScene};
 use kdmpm::with_simulation;
+use kdmpm::SceneError;
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
 use std::cell::Cell;

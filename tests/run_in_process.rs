@@ -5,10 +5,10 @@
 mod common;
 
 use common::{scene, scratch};
-use kdmpm::interrupt::StopSignal;
 use kdmpm::output::Outcome;
 use kdmpm::run::Run;
 use kdmpm::scene::LoadedScene;
+use kdmpm::StopSignal;
 
 /// The footing loaded in traction increments to its limit (7146 steps, 72 resets): a stop
 /// halfway falls inside an increment.

@@ -318,7 +318,7 @@ pub struct TractionSpec {
     pub traction: Vec<f64>,
     /// A pressure (Pa, compression positive) that follows the surface: normal to it and in
     /// proportion to its size as it deforms (a surcharge on ground that heaves, a fluid;
-    /// [`crate::surface_pressure`]). Instead of `traction`.
+    /// [`crate::SurfacePressures`]). Instead of `traction`.
     #[serde(default)]
     pub pressure: Option<f64>,
     /// Apply it in this many equal increments, each to its static stop and a row of

@@ -285,7 +285,7 @@ pub use report::{front_table, orders_table};
 /// Runs a whole study into `dir`: the reference first (refused when it did not converge),
 /// then every planned run (skipping those an earlier invocation completed), and writes the
 /// study's table and picture. Progress goes to stderr unless `quiet`. A signal
-/// ([`crate::interrupt`]) stops the run under way and the study.
+/// ([`crate::catch_signals`]) stops the run under way and the study.
 pub fn conduct(study: &Study, dir: &OutputDir, launch: &Launch, quiet: bool) -> Result<Results, StudyError> {
     let total = study.runs.len() + usize::from(study.reference.is_some());
     let progress = progress::StudyProgress::new(total as u64, quiet);

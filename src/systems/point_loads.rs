@@ -16,7 +16,7 @@ use std::marker::PhantomData;
 /// support reaches the empty node beyond, where a share of F would be lost (massless nodes
 /// have no degrees of freedom). Renormalising keeps the whole load on the body.
 ///
-/// A point under a pressure ([`crate::surface_pressure`]) carries −p times its share's area
+/// A point under a pressure ([`crate::SurfacePressures`]) carries −p times its share's area
 /// vector now, from its neighbours' places, instead of its set-up load.
 #[derive(Debug)]
 pub struct PointLoads<D, S> {

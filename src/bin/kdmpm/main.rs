@@ -7,11 +7,11 @@
 
 use clap::Parser;
 use cli::{Cli, Command, Stepping, Workers};
-use kdmpm::error::Ending;
 use kdmpm::infra::comm::Comm;
 use kdmpm::output::{Outcome, OutputDir};
 use kdmpm::run::{Run, RunError, RunReport};
 use kdmpm::scene::{build, LoadedScene};
+use kdmpm::Ending;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::Arc;
@@ -76,7 +76,7 @@ fn command(command: Command, comm: &Arc<Comm>) -> Result<ExitCode, Fault> {
     // Over several ranks a signal is mpirun's to pass on (a checkpoint would be rank 0's
     // alone).
     if comm.size() == 1 {
-        kdmpm::interrupt::catch_signals();
+        kdmpm::catch_signals();
     }
     let (threads, trace) = match &command {
         Command::Run { stepping, trace, .. } => (stepping.workers.threads, trace.clone()),
