@@ -181,25 +181,35 @@ impl<D: Dim, S: Shape> CellMean<D, S> {
                     }
                 }
             }
+            // Every point in them, archetype by archetype in point order, and their
+            // means afresh, each cell's summed in point order as in the first round.
+            let dirty: &[bool] = dirty;
             let active: Vec<Vec<u32>> = points_with::<Volume>(&ctx.world)
                 .map(|arch| {
-                    let x = col::<Position<D::Vec>>(arch);
-                    (0..x.len() as u32)
-                        .filter(|&p| dirty[grid.cell_key(x[p as usize].0)])
+                    let xg = col::<Position<D::Vec>>(arch);
+                    xg.par_chunks(CHUNK)
+                        .enumerate()
+                        .flat_map_iter(|(c, x)| {
+                            (0..x.len())
+                                .filter(|&k| dirty[grid.cell_key(x[k].0)])
+                                .map(move |k| (c * CHUNK + k) as u32)
+                        })
                         .collect()
                 })
                 .collect();
-            // Their means afresh, summed in that order.
-            for (arch, points) in points_with::<Volume>(&ctx.world).zip(&active) {
-                let (x, vol) = (col::<Position<D::Vec>>(arch), col::<Volume>(arch));
-                let s = col::<Stress<D::Stress>>(arch);
-                for &p in points {
-                    let p = p as usize;
-                    let pair = sums.at_mut(grid.cell_key(x[p].0));
-                    pair[0] += vol[p].0 * mean_stress::<D>(&s[p].0);
-                    pair[1] += vol[p].0;
-                }
+            for arch in points_with::<Volume>(&ctx.world) {
+                let (xg, vg, sg) = (
+                    col::<Position<D::Vec>>(arch),
+                    col::<Volume>(arch),
+                    col::<Stress<D::Stress>>(arch),
+                );
+                let (x, vol): (&[Position<D::Vec>], &[Volume]) = (&xg, &vg);
+                let s: &[Stress<D::Stress>] = &sg;
+                sums.scatter_cells_where::<D, S>(&mut ctx.slabs, grid, x, |p| {
+                    dirty[grid.cell_key(x[p].0)].then(|| [vol[p].0 * mean_stress::<D>(&s[p].0), vol[p].0])
+                });
             }
+            let dirty = &mut self.dirty;
             for key in cells {
                 let pair = sums.at_mut(key);
                 pair[0] /= pair[1];
@@ -302,7 +312,6 @@ impl<D: Dim> Project<'_, D> {
             sp.0 = D::Stress::from_sym3(&t);
             returned
         };
-        let mut spare = S::default();
         // The points of one chunk of CHUNK rows, c its number.
         let chunk = |c: usize, s: &mut [Stress<D::Stress>], st: &mut [S]| -> Vec<u32> {
             (0..s.len())
@@ -311,15 +320,38 @@ impl<D: Dim> Project<'_, D> {
                 .collect()
         };
         match (self.only, states) {
-            // A later round: the few points of the cells that moved, one by one.
-            (Some(only), mut states) => only
-                .iter()
-                .copied()
-                .filter(|&p| {
-                    let state = states.as_mut().map_or(&mut spare, |st| &mut st[p as usize]);
-                    point(p as usize, &mut sg[p as usize], state)
-                })
-                .collect(),
+            // A later round: the points of the cells that moved, chunk by chunk, each
+            // chunk's listed points (`only` is in point order) in order.
+            (Some(only), states) => {
+                let listed = |c: usize, len: usize| {
+                    let first = only.partition_point(|&p| (p as usize) < c * CHUNK);
+                    let end = only.partition_point(|&p| (p as usize) < c * CHUNK + len);
+                    &only[first..end]
+                };
+                let some = |c: usize, s: &mut [Stress<D::Stress>], st: &mut [S]| -> Vec<u32> {
+                    listed(c, s.len())
+                        .iter()
+                        .copied()
+                        .filter(|&p| {
+                            let k = p as usize - c * CHUNK;
+                            point(p as usize, &mut s[k], &mut st[k])
+                        })
+                        .collect()
+                };
+                match states {
+                    Some(mut states) => sg
+                        .par_chunks_mut(CHUNK)
+                        .zip(states.par_chunks_mut(CHUNK))
+                        .enumerate()
+                        .flat_map_iter(|(c, (s, st))| some(c, s, st))
+                        .collect(),
+                    None => sg
+                        .par_chunks_mut(CHUNK)
+                        .enumerate()
+                        .flat_map_iter(|(c, s)| some(c, s, &mut vec![S::default(); s.len()]))
+                        .collect(),
+                }
+            }
             (None, Some(mut states)) => sg
                 .par_chunks_mut(CHUNK)
                 .zip(states.par_chunks_mut(CHUNK))

@@ -42,7 +42,8 @@ impl NodePairs {
 
     /// Adds the points at `x` (a column of one archetype) cell by cell: `value(p)` goes into
     /// the pair of the lowest node of the cell that holds point p, whole. Deterministic as
-    /// [`NodePairs::scatter`]: the slabs fix each cell's order of contributions, and a cell's
+    /// [`NodePairs::scatter`]: the slabs fix each cell's order of contributions (a slab lists
+    /// its points in point order, so a cell's are added in point order), and a cell's
     /// lowest node lies in the node range of its point's slab whatever the shape.
     pub(crate) fn scatter_cells<D: Dim, S: Shape>(
         &mut self,
@@ -51,11 +52,24 @@ impl NodePairs {
         x: &[Position<D::Vec>],
         value: impl Fn(usize) -> [f64; 2] + Sync,
     ) {
+        self.scatter_cells_where::<D, S>(slabs, grid, x, |p| Some(value(p)));
+    }
+
+    /// [`NodePairs::scatter_cells`] of the points whose `value` is `Some`; the others add
+    /// nothing.
+    pub(crate) fn scatter_cells_where<D: Dim, S: Shape>(
+        &mut self,
+        slabs: &mut SlabCache,
+        grid: &Grid<D>,
+        x: &[Position<D::Vec>],
+        value: impl Fn(usize) -> Option<[f64; 2]> + Sync,
+    ) {
         self.each_point::<D, S>(slabs, grid, x, |p, sums, lo| {
-            let [a, b] = value(p);
-            let pair = &mut sums[grid.cell_key(x[p].0) - lo];
-            pair[0] += a;
-            pair[1] += b;
+            if let Some([a, b]) = value(p) {
+                let pair = &mut sums[grid.cell_key(x[p].0) - lo];
+                pair[0] += a;
+                pair[1] += b;
+            }
         });
     }
 
