@@ -1,9 +1,10 @@
 //! Building a simulation from a valid scene: grid nodes, material points, loads, tracing
 //! and the schedule. Only what the scene uses is created.
 
+use super::loaded::LoadedScene;
 use super::region::{cell_span, region_bounds, region_contains};
+use super::spec::{pad3, Dimension, Region, Scene, SolverSpec};
 use super::validate::{self, carried_state, Checked, CheckedGrid, CheckedStage, Derived, FaceHold};
-use super::{pad3, Dimension, LoadedScene, Region, Scene, SolverSpec};
 use crate::components::*;
 use crate::context::Context;
 use crate::dim::{Dim, Dim2, Dim3, DimAxi, Vector};

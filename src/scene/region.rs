@@ -2,7 +2,7 @@
 //! cells it touches. Shared by the checks (memory bound, masses) and set-up (filling the
 //! region with points), which both sit above it.
 
-use super::{pad3, Region};
+use super::spec::{pad3, Region};
 
 /// Bounding box of a region (m, x y z; z is 0..0 in 2D).
 pub(crate) fn region_bounds(region: &Region, n: usize) -> ([f64; 3], [f64; 3]) {

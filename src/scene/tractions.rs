@@ -1,6 +1,6 @@
 //! Tractions: a distributed load on a body's surface, carried by the outermost points.
 
-use super::LoadedScene;
+use super::loaded::LoadedScene;
 use crate::components::*;
 use crate::dim::Dim;
 use crate::error::SceneError;

@@ -1,9 +1,9 @@
 //! The bodies: each region (box, polygon) inside the grid, its material and its points
 //! per cell.
 
-use super::*;
+use super::rules::*;
 use crate::error::SceneError;
-use crate::scene::Region;
+use crate::scene::spec::Region;
 
 /// The bodies: material, points per cell, region.
 pub(super) fn check_bodies(r: &Rules) -> Result<(), SceneError> {

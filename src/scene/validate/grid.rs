@@ -1,10 +1,10 @@
 //! The grid: origin, cell size and counts, the shape's needs, and the face conditions.
 
-use super::*;
+use super::rules::*;
 use crate::error::Refusal;
 use crate::error::SceneError;
 use crate::rigid::check_friction_angle;
-use crate::scene::{pad3, BoundarySpec, Condition};
+use crate::scene::spec::{pad3, BoundarySpec, Condition};
 use crate::shape::ShapeKind;
 
 /// The grid as set-up builds it, checked.
@@ -151,7 +151,7 @@ pub(super) fn check_grid(r: &Rules) -> Result<CheckedGrid, SceneError> {
     }
     let faces = check_faces(&s.boundaries, "boundaries", n)
         .map_err(|Refusal { field, rule }| r.loaded.invalid(&field, rule))?;
-    if s.dimension == crate::scene::Dimension::Axisymmetric {
+    if s.dimension == crate::scene::spec::Dimension::Axisymmetric {
         if s.grid.origin[0] != 0.0 {
             return r.bad(
                 "grid.origin",

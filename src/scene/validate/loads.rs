@@ -2,7 +2,7 @@
 //! the rule that a scene loads something.
 
 use super::materials::{check_mass_finite, check_smoothing};
-use super::*;
+use super::rules::*;
 use crate::error::SceneError;
 use crate::materials::MaterialModel;
 
@@ -29,7 +29,11 @@ pub(super) fn check_loads(r: &Rules, table: &[(String, MaterialModel)]) -> Resul
 /// ramp of at least 0 s, and along the axis in an axisymmetric scene (a radial gravity
 /// would pull every ring outwards alike). Under water the water checks it too
 /// ([`crate::water::Water::gravity_fault`]).
-pub(super) fn check_gravity(r: &Rules, field: &str, g: &crate::scene::GravitySpec) -> Result<(), SceneError> {
+pub(super) fn check_gravity(
+    r: &Rules,
+    field: &str,
+    g: &crate::scene::spec::GravitySpec,
+) -> Result<(), SceneError> {
     let s = &r.loaded.scene;
     let at = format!("{field}.acceleration");
     r.len(&at, g.acceleration.len())?;
@@ -40,7 +44,7 @@ pub(super) fn check_gravity(r: &Rules, field: &str, g: &crate::scene::GravitySpe
             format!("must be ≥ 0 s, found {}", g.ramp_time),
         );
     }
-    if s.dimension == crate::scene::Dimension::Axisymmetric && g.acceleration[0] != 0.0 {
+    if s.dimension == crate::scene::spec::Dimension::Axisymmetric && g.acceleration[0] != 0.0 {
         return r.bad(
             &at,
             "in an axisymmetric scene gravity acts along the axis (y): its x entry must be 0".into(),

@@ -1,10 +1,11 @@
 //! The materials: each entry's own rules, the mass its density gives, and smoothing only
 //! where the flow rule allows it.
 
-use super::*;
+use super::rules::*;
+use crate::error::Refusal;
 use crate::error::SceneError;
 use crate::materials::MaterialModel;
-use crate::scene::LoadedScene;
+use crate::scene::loaded::LoadedScene;
 
 /// Each body's mass (ρ times its bounding box's volume, an upper bound) and the scene's
 /// weight are finite numbers: a density of 1e308 kg/m³ gives points whose mass sums to

@@ -1,11 +1,11 @@
 //! What a scene will hold in memory, bounded before anything is allocated, against what
 //! the machine, its cgroup and the process limits allow.
 
-use super::*;
+use super::rules::*;
 use crate::error::SceneError;
 use crate::materials::MaterialModel;
 use crate::rigid::Samples;
-use crate::scene::LoadedScene;
+use crate::scene::loaded::LoadedScene;
 use serde::Serialize;
 
 /// An upper bound of what a scene holds in memory, computed before anything is allocated.
@@ -205,7 +205,7 @@ pub(super) fn estimate(
             .ok_or_else(|| too_many(&field, "the points' memory"))?;
     }
     let (lo, hi) = (
-        crate::scene::pad3(&s.grid.origin),
+        crate::scene::spec::pad3(&s.grid.origin),
         std::array::from_fn(|a| {
             if a < n {
                 s.grid.origin[a] + s.grid.cells[a] as f64 * s.grid.cell_size

@@ -12,6 +12,7 @@ mod materials;
 mod memory;
 mod motions;
 mod rigid_bodies;
+mod rules;
 mod solver;
 mod stages;
 mod water;
@@ -22,7 +23,6 @@ pub use memory::Estimate;
 pub(crate) use motions::check_motion_boxes;
 pub use stages::CheckedStage;
 
-use crate::error::Refusal;
 use bodies::check_bodies;
 use grid::check_grid;
 use loads::{check_has_load, check_loads, check_tractions_and_traced};
@@ -30,14 +30,15 @@ use materials::check_materials;
 use memory::check_memory;
 use motions::check_motions_and_analyses;
 use rigid_bodies::check_rigid_bodies;
+use rules::Rules;
 use solver::{check_solver, time_step};
 use stages::check_stages;
 pub(crate) use water::check_saturated;
 use water::check_water;
 
-use super::LoadedScene;
 use crate::error::SceneError;
 use crate::materials::MaterialModel;
+use crate::scene::loaded::LoadedScene;
 use serde::Serialize;
 
 /// Figures derived from a valid scene (printed by `kdmpm check`).
@@ -135,81 +136,6 @@ pub struct Checked {
     pub body_samples: Vec<crate::rigid::Samples>,
     /// The water, if any.
     pub water: Option<crate::water::Water>,
-}
-
-/// Names that label output (columns of `history.csv`, rows of `curve.csv` and
-/// `stages.csv`) are unique within their list: two traced points called "top" would give
-/// two columns of one name.
-fn unique_names(s: &super::Scene) -> Result<(), Refusal> {
-    let lists: [(&str, Vec<&str>); 5] = [
-        ("traced", s.traced.iter().map(|t| t.name.as_str()).collect()),
-        (
-            "point_loads",
-            s.point_loads.iter().map(|t| t.name.as_str()).collect(),
-        ),
-        ("tractions", s.tractions.iter().map(|t| t.name.as_str()).collect()),
-        ("motions", s.motions.iter().map(|t| t.name.as_str()).collect()),
-        ("stages", s.stages.iter().map(|t| t.name.as_str()).collect()),
-    ];
-    for (field, names) in lists {
-        for (i, name) in names.iter().enumerate() {
-            if let Some(j) = names[..i].iter().position(|m| m == name) {
-                return Err(Refusal::new(
-                    format!("{field}[{i}].name"),
-                    format!("\"{name}\" is also the name of {field}[{j}]: each needs its own name"),
-                ));
-            }
-        }
-    }
-    Ok(())
-}
-
-/// True for a finite number > 0 (NaN fails).
-fn positive(x: f64) -> bool {
-    x > 0.0 && x.is_finite()
-}
-
-/// True for a finite number ≥ 0 (NaN fails).
-fn non_negative(x: f64) -> bool {
-    x >= 0.0 && x.is_finite()
-}
-
-/// The scene and its dimension, for the checks of each part: each names a field and the
-/// rule it breaks through [`Rules::bad`].
-struct Rules<'a> {
-    loaded: &'a LoadedScene,
-    /// 2 or 3.
-    n: usize,
-}
-
-impl Rules<'_> {
-    /// The error for `field`, breaking `rule`.
-    fn bad<T>(&self, field: &str, rule: String) -> Result<T, SceneError> {
-        Err(self.loaded.invalid(field, rule))
-    }
-
-    /// A vector of one entry per axis.
-    fn len(&self, field: &str, v: usize) -> Result<(), SceneError> {
-        let n = self.n;
-        if v != n {
-            return Err(self
-                .loaded
-                .invalid(field, format!("needs {n} entries (dimension {n}), found {v}")));
-        }
-        Ok(())
-    }
-
-    /// Every coordinate, force and acceleration is a finite number: a NaN or infinity in
-    /// the input would reach the state and be written out.
-    fn finite(&self, field: &str, v: &[f64], unit: &str) -> Result<(), SceneError> {
-        match v.iter().position(|x| !x.is_finite()) {
-            Some(k) => Err(self.loaded.invalid(
-                field,
-                format!("entry {k} must be a finite number ({unit}), found {}", v[k]),
-            )),
-            None => Ok(()),
-        }
-    }
 }
 
 /// A displacement control's first step of an increment moves at its full velocity: an

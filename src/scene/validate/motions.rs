@@ -2,11 +2,13 @@
 //! are checked against the grid nodes the bodies touch once set-up has placed the points
 //! ([`check_motion_boxes`]).
 
-use super::*;
+use super::rules::*;
 use crate::components::NodeFixity;
 use crate::dim::Dim;
+use crate::error::Refusal;
 use crate::error::SceneError;
 use crate::grid::Grid;
+use crate::scene::loaded::LoadedScene;
 
 /// The finest bisection of `kdmpm fos`, relative to the bracket's high end: about 24
 /// halvings of a bracket [0.5, 2].
@@ -140,6 +142,33 @@ pub(crate) fn check_motion_boxes<D: Dim>(
                      box on the body's surface"
                 ),
             ));
+        }
+    }
+    Ok(())
+}
+
+/// Names that label output (columns of `history.csv`, rows of `curve.csv` and
+/// `stages.csv`) are unique within their list: two traced points called "top" would give
+/// two columns of one name.
+fn unique_names(s: &crate::scene::spec::Scene) -> Result<(), Refusal> {
+    let lists: [(&str, Vec<&str>); 5] = [
+        ("traced", s.traced.iter().map(|t| t.name.as_str()).collect()),
+        (
+            "point_loads",
+            s.point_loads.iter().map(|t| t.name.as_str()).collect(),
+        ),
+        ("tractions", s.tractions.iter().map(|t| t.name.as_str()).collect()),
+        ("motions", s.motions.iter().map(|t| t.name.as_str()).collect()),
+        ("stages", s.stages.iter().map(|t| t.name.as_str()).collect()),
+    ];
+    for (field, names) in lists {
+        for (i, name) in names.iter().enumerate() {
+            if let Some(j) = names[..i].iter().position(|m| m == name) {
+                return Err(Refusal::new(
+                    format!("{field}[{i}].name"),
+                    format!("\"{name}\" is also the name of {field}[{j}]: each needs its own name"),
+                ));
+            }
         }
     }
     Ok(())

@@ -3,7 +3,7 @@
 //! whole travel along the axes they move on (a body under load control finds its own
 //! travel: it is stopped if it leaves the grid), and that no two overlap.
 
-use super::*;
+use super::rules::*;
 use crate::error::Refusal;
 use crate::error::SceneError;
 
@@ -25,7 +25,7 @@ pub(super) fn check_rigid_bodies(r: &Rules) -> Result<(), SceneError> {
     let mut boxes: Vec<(Boxed, Boxed)> = Vec::new();
     for (i, b) in s.rigid_bodies.iter().enumerate() {
         let field = |f: &str| format!("rigid_bodies[{i}].{f}");
-        b.check(n, s.dimension == crate::scene::Dimension::Axisymmetric)
+        b.check(n, s.dimension == crate::scene::spec::Dimension::Axisymmetric)
             .map_err(|Refusal { field: f, rule }| loaded.invalid(&field(&f), rule))?;
         if let Some(j) = s.motions.iter().position(|m| m.name == b.name) {
             return r.bad(

@@ -1,10 +1,10 @@
 //! The solver settings, and the time step they and the materials give (Courant, mass
 //! scaling, the scheme's limits).
 
-use super::*;
+use super::rules::*;
 use crate::error::SceneError;
 use crate::materials::MaterialModel;
-use crate::scene::TimeStep;
+use crate::scene::spec::TimeStep;
 use crate::state::Scheme;
 
 /// The largest Courant number accepted with the USL scheme. Measured on the self-weight
@@ -126,10 +126,10 @@ pub(super) fn check_solver(r: &Rules) -> Result<(), SceneError> {
         }
     }
     match s.solver.checkpoint_every {
-        Some(crate::scene::CheckpointEvery::Steps(0)) => {
+        Some(crate::scene::spec::CheckpointEvery::Steps(0)) => {
             return r.bad("solver.checkpoint_every", "Steps(n) needs n ≥ 1".into());
         }
-        Some(crate::scene::CheckpointEvery::Seconds(t)) if !positive(t) => {
+        Some(crate::scene::spec::CheckpointEvery::Seconds(t)) if !positive(t) => {
             return r.bad(
                 "solver.checkpoint_every",
                 format!("Seconds(t) needs a wall time t > 0 s, found {t}"),

@@ -2,7 +2,9 @@
 //! built once.
 
 use super::grid::{check_axis, check_faces, FaceHold};
-use super::*;
+use super::memory::carried_state;
+use super::rules::*;
+use crate::error::Refusal;
 use crate::error::SceneError;
 use crate::materials::MaterialModel;
 
@@ -165,7 +167,7 @@ fn stage_faces(r: &Rules, k: usize) -> Result<Option<Vec<FaceHold>>, SceneError>
         ),
         None => None,
     };
-    if let (Some(f), crate::scene::Dimension::Axisymmetric) = (&faces, s.dimension) {
+    if let (Some(f), crate::scene::spec::Dimension::Axisymmetric) = (&faces, s.dimension) {
         check_axis(f, &format!("stages[{k}].boundaries"))
             .map_err(|Refusal { field, rule }| loaded.invalid(&field, rule))?;
     }

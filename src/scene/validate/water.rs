@@ -3,10 +3,11 @@
 //! saturated density is checked as the points are placed ([`check_saturated`]).
 
 use super::grid::CheckedGrid;
-use super::*;
+use super::rules::*;
 use crate::error::Refusal;
 use crate::error::SceneError;
 use crate::materials::MaterialModel;
+use crate::scene::loaded::LoadedScene;
 use crate::water::{Frame, Water};
 
 /// The scene's water, checked, or `None` when the scene is dry; with each stage's (`None`
@@ -15,7 +16,7 @@ pub(super) fn check_water(
     r: &Rules,
     grid: &CheckedGrid,
     table: &[(String, MaterialModel)],
-    checked_stages: &[super::CheckedStage],
+    checked_stages: &[super::stages::CheckedStage],
 ) -> Result<(Option<Water>, Vec<Option<Water>>), SceneError> {
     let (loaded, s) = (r.loaded, &r.loaded.scene);
     let n = r.n;
@@ -28,7 +29,7 @@ pub(super) fn check_water(
         lo: &grid.origin[..n],
         hi: &hi,
         materials: &materials,
-        axisymmetric: s.dimension == crate::scene::Dimension::Axisymmetric,
+        axisymmetric: s.dimension == crate::scene::spec::Dimension::Axisymmetric,
     };
     // A refusal of the scene's gravity is the scene's own field, not the water's.
     let at = |prefix: &str, r: Refusal| {
