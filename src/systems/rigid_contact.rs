@@ -38,26 +38,32 @@ use crate::rigid::contact::{key, remember, solve, Contact, Contacts, Memory, Slo
 use crate::schedule::System;
 use crate::shape::{for_each_node, Shape};
 use crate::systems::shared::{constrain, hold, Hold};
-use std::collections::HashMap;
 use std::marker::PhantomData;
 
 /// Holds the contacts at the bodies' surface samples ([`crate::rigid::RigidBody::samples`],
 /// cut at set-up) at every step (before `boundary`).
 #[derive(Debug)]
 pub struct RigidContact<D: Dim, S> {
+    /// Per node, its slot in this step's [`Contacts::slots`] (`u32::MAX`: none); all
+    /// `u32::MAX` between steps.
+    slot_of: Vec<u32>,
     _marker: PhantomData<fn() -> (D, S)>,
 }
 
 impl<D: Dim, S> Default for RigidContact<D, S> {
     fn default() -> Self {
-        RigidContact { _marker: PhantomData }
+        RigidContact {
+            slot_of: Vec::new(),
+            _marker: PhantomData,
+        }
     }
 }
 
 /// Places every sample that meets soil at its body's current place: its nodes that carry
 /// soil and their weights, each node's trial velocity p/m + f Δt/m̃. A sample meets soil
-/// when nodes carrying mass hold at least half its support.
-fn place<D: Dim, S: Shape>(ctx: &Context<D>) -> Contacts {
+/// when nodes carrying mass hold at least half its support. `slot_of` is all `u32::MAX`
+/// (one entry a node) and is left so.
+fn place<D: Dim, S: Shape>(ctx: &Context<D>, slot_of: &mut Vec<u32>) -> Contacts {
     let n = nodes(&ctx.world);
     let (nm, np, nf, fix) = (
         col::<NodeMass>(n),
@@ -68,22 +74,24 @@ fn place<D: Dim, S: Shape>(ctx: &Context<D>) -> Contacts {
     let (grid, st) = (&ctx.grid, &ctx.numerics);
     let drives = &ctx.state.control.drives;
     let mut set = Contacts::default();
-    let mut slot_of: HashMap<usize, usize> = HashMap::new();
+    slot_of.resize(grid.node_count(), u32::MAX);
     // The slot of node `i` (which carries mass), made at its first reach with the node's
     // trial velocity p/m + f Δt/m̃, inertia and free axes.
-    let slot = |slots: &mut Vec<Slot>, slot_of: &mut HashMap<usize, usize>, i: usize| -> usize {
-        *slot_of.entry(i).or_insert_with(|| {
-            let m = nm[i].0;
-            let inertia = grid.inertia(i, m, st.virtual_mass_floor);
-            // The held components as `boundary` will hold them (it runs next, so that a
-            // friction face and a motion feel the contact's force).
-            let mut v = np[i].0 * (1.0 / m) + nf[i].0 * (st.dt / inertia);
-            constrain(&mut v, fix[i], D::N, drives);
-            let v = D::vec_to3(v);
-            let free = std::array::from_fn(|a| a < D::N && hold(fix[i], a, drives) == Hold::Free);
-            slots.push(Slot::new(i, v, inertia, free));
-            slots.len() - 1
-        })
+    let slot = |slots: &mut Vec<Slot>, slot_of: &mut Vec<u32>, i: usize| -> usize {
+        if slot_of[i] != u32::MAX {
+            return slot_of[i] as usize;
+        }
+        let m = nm[i].0;
+        let inertia = grid.inertia(i, m, st.virtual_mass_floor);
+        // The held components as `boundary` will hold them (it runs next, so that a
+        // friction face and a motion feel the contact's force).
+        let mut v = np[i].0 * (1.0 / m) + nf[i].0 * (st.dt / inertia);
+        constrain(&mut v, fix[i], D::N, drives);
+        let v = D::vec_to3(v);
+        let free = std::array::from_fn(|a| a < D::N && hold(fix[i], a, drives) == Hold::Free);
+        slots.push(Slot::new(i, v, inertia, free));
+        slot_of[i] = (slots.len() - 1) as u32;
+        slots.len() - 1
     };
     for (b, body) in ctx.model.bodies.iter().enumerate() {
         let state = &ctx.state.control.bodies[b];
@@ -111,7 +119,7 @@ fn place<D: Dim, S: Shape>(ctx: &Context<D>) -> Contacts {
             if phi > 0.0 {
                 continue;
             }
-            let k = slot(&mut set.slots, &mut slot_of, i);
+            let k = slot(&mut set.slots, slot_of, i);
             set.contacts.push(Contact {
                 key: key(b, false, i),
                 body: b,
@@ -139,7 +147,7 @@ fn place<D: Dim, S: Shape>(ctx: &Context<D>) -> Contacts {
                 if w <= 0.0 || !grid.carries(i, m, st.min_node_mass) {
                     return;
                 }
-                let k = slot(&mut set.slots, &mut slot_of, i);
+                let k = slot(&mut set.slots, slot_of, i);
                 reach.push((k, w));
                 weight += w;
             });
@@ -176,7 +184,10 @@ impl<D: Dim, S: Shape> System<D> for RigidContact<D, S> {
     }
 
     fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
-        let mut set = place::<D, S>(ctx);
+        let mut set = place::<D, S>(ctx, &mut self.slot_of);
+        for s in &set.slots {
+            self.slot_of[s.node] = u32::MAX;
+        }
         let bodies = &ctx.model.bodies;
         let velocities: Vec<[f64; 3]> = ctx.state.control.bodies.iter().map(|b| b.velocity).collect();
         solve(&mut set, &velocities, &ctx.state.control.contact_memory);
