@@ -312,54 +312,36 @@ impl<D: Dim> Project<'_, D> {
             sp.0 = D::Stress::from_sym3(&t);
             returned
         };
-        // The points of one chunk of CHUNK rows, c its number.
+        // The points of one chunk of CHUNK rows, c its number: all of them, or in a later
+        // round those `only` lists (in point order); gives those returned.
+        let only = self.only;
         let chunk = |c: usize, s: &mut [Stress<D::Stress>], st: &mut [S]| -> Vec<u32> {
-            (0..s.len())
-                .filter(|&k| point(c * CHUNK + k, &mut s[k], &mut st[k]))
-                .map(|k| (c * CHUNK + k) as u32)
-                .collect()
-        };
-        match (self.only, states) {
-            // A later round: the points of the cells that moved, chunk by chunk, each
-            // chunk's listed points (`only` is in point order) in order.
-            (Some(only), states) => {
-                let listed = |c: usize, len: usize| {
-                    let first = only.partition_point(|&p| (p as usize) < c * CHUNK);
-                    let end = only.partition_point(|&p| (p as usize) < c * CHUNK + len);
-                    &only[first..end]
-                };
-                let some = |c: usize, s: &mut [Stress<D::Stress>], st: &mut [S]| -> Vec<u32> {
-                    listed(c, s.len())
+            let (first, len) = (c * CHUNK, s.len());
+            let mut visit = |k: usize| point(first + k, &mut s[k], &mut st[k]);
+            let id = |k: usize| (first + k) as u32;
+            match only {
+                None => (0..len).filter(|&k| visit(k)).map(id).collect(),
+                Some(only) => {
+                    let lo = only.partition_point(|&p| (p as usize) < first);
+                    let hi = only.partition_point(|&p| (p as usize) < first + len);
+                    only[lo..hi]
                         .iter()
-                        .copied()
-                        .filter(|&p| {
-                            let k = p as usize - c * CHUNK;
-                            point(p as usize, &mut s[k], &mut st[k])
-                        })
+                        .map(|&p| p as usize - first)
+                        .filter(|&k| visit(k))
+                        .map(id)
                         .collect()
-                };
-                match states {
-                    Some(mut states) => sg
-                        .par_chunks_mut(CHUNK)
-                        .zip(states.par_chunks_mut(CHUNK))
-                        .enumerate()
-                        .flat_map_iter(|(c, (s, st))| some(c, s, st))
-                        .collect(),
-                    None => sg
-                        .par_chunks_mut(CHUNK)
-                        .enumerate()
-                        .flat_map_iter(|(c, s)| some(c, s, &mut vec![S::default(); s.len()]))
-                        .collect(),
                 }
             }
-            (None, Some(mut states)) => sg
+        };
+        match states {
+            Some(mut states) => sg
                 .par_chunks_mut(CHUNK)
                 .zip(states.par_chunks_mut(CHUNK))
                 .enumerate()
                 .flat_map_iter(|(c, (s, st))| chunk(c, s, st))
                 .collect(),
             // A state of no size: the slice costs no memory.
-            (None, None) => sg
+            None => sg
                 .par_chunks_mut(CHUNK)
                 .enumerate()
                 .flat_map_iter(|(c, s)| chunk(c, s, &mut vec![S::default(); s.len()]))

@@ -61,8 +61,8 @@ impl<D: Dim, S> Default for RigidContact<D, S> {
 
 /// Places every sample that meets soil at its body's current place: its nodes that carry
 /// soil and their weights, each node's trial velocity p/m + f Δt/m̃. A sample meets soil
-/// when nodes carrying mass hold at least half its support. `slot_of` is all `u32::MAX`
-/// (one entry a node) and is left so.
+/// when nodes carrying mass hold at least half its support. `slot_of` (one entry a node)
+/// is all `u32::MAX` on entry and is left so.
 fn place<D: Dim, S: Shape>(ctx: &Context<D>, slot_of: &mut Vec<u32>) -> Contacts {
     let n = nodes(&ctx.world);
     let (nm, np, nf, fix) = (
@@ -175,6 +175,9 @@ fn place<D: Dim, S: Shape>(ctx: &Context<D>, slot_of: &mut Vec<u32>) -> Contacts
             });
         }
     }
+    for s in &set.slots {
+        slot_of[s.node] = u32::MAX;
+    }
     set
 }
 
@@ -185,9 +188,6 @@ impl<D: Dim, S: Shape> System<D> for RigidContact<D, S> {
 
     fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
         let mut set = place::<D, S>(ctx, &mut self.slot_of);
-        for s in &set.slots {
-            self.slot_of[s.node] = u32::MAX;
-        }
         let bodies = &ctx.model.bodies;
         let velocities: Vec<[f64; 3]> = ctx.state.control.bodies.iter().map(|b| b.velocity).collect();
         solve(&mut set, &velocities, &ctx.state.control.contact_memory);
