@@ -56,4 +56,16 @@ impl<D: Dim> Context<D> {
         let layer = self.grid.layer();
         Some(layers.start * layer..layers.end * layer)
     }
+
+    /// The node ids whose values this rank holds whole when the run has several ranks
+    /// (its own and the bands it shares, once summed: [`Decomposition::held_nodes`]);
+    /// `None` with one rank.
+    pub fn held_node_ids(&self) -> Option<Range<usize>> {
+        if self.comm.size() == 1 {
+            return None;
+        }
+        let layers = self.decomposition.held_nodes();
+        let layer = self.grid.layer();
+        Some(layers.start * layer..layers.end * layer)
+    }
 }

@@ -299,3 +299,102 @@ fn an_axisymmetric_column_on_2_and_4_ranks_agrees_with_one_rank_to_1e_10() {
         agrees(&one, &many, 1e-10, &format!("axisymmetric on {ranks} ranks"));
     }
 }
+
+/// The curve of a summary: each static state's step and the force on its body or motion.
+fn curve(s: &Value) -> Vec<(u64, [f64; 3])> {
+    s["curve"]
+        .as_array()
+        .expect("a curve")
+        .iter()
+        .map(|c| {
+            let f = &c["force"];
+            (
+                c["step"].as_u64().expect("a step"),
+                std::array::from_fn(|a| f[a].as_f64().expect("a force")),
+            )
+        })
+        .collect()
+}
+
+/// The curves of two summaries agree: the same static states at the same steps, every
+/// force within `tolerance` of the larger component of its row.
+fn curves_agree(one: &Value, many: &Value, tolerance: f64, what: &str) {
+    let (a, b) = (curve(one), curve(many));
+    assert_eq!(a.len(), b.len(), "{what}: rows");
+    assert!(!a.is_empty(), "{what}: no static state");
+    for ((sa, fa), (sb, fb)) in a.iter().zip(&b) {
+        assert_eq!(sa, sb, "{what}: step of a static state");
+        let size = fa.iter().chain(fb).fold(0.0f64, |m, f| m.max(f.abs()));
+        for c in 0..3 {
+            assert!(
+                (fa[c] - fb[c]).abs() <= tolerance * size,
+                "{what}: force {fb:?} against {fa:?} at step {sa}"
+            );
+        }
+    }
+}
+
+/// The penetration problems on 2 and 4 ranks follow one rank step for step: a footing of
+/// driven nodes and a rigid one (their reactions summed over the nodes each rank owns), a
+/// c–φ footing with the cell means against locking, the T-bar under a confining pressure,
+/// the cone's first half diameter with its surcharge as a pressure, and a rigid footing
+/// and a surface load under load control. Every rank solves the contacts whole, from the
+/// nodal values their owners gather, so the curves differ from one rank's only by the
+/// order of additions in the shared node layers.
+#[test]
+fn rigid_bodies_motions_and_loads_on_2_and_4_ranks_agree_with_one_rank_to_1e_10() {
+    let cases: [(&str, &str, &[&str]); 7] = [
+        ("footing.ron", "footing", &[]),
+        ("footing_rigid.ron", "rigid", &[]),
+        ("footing_cphi.ron", "cphi", &["motions[0].travel=0.06"]),
+        (
+            "tbar.ron",
+            "tbar",
+            &["rigid_bodies[0].motion=(velocity: [0.0, -0.01], travel: 0.1, increment: 0.05)"],
+        ),
+        (
+            "cpt.ron",
+            "cpt",
+            &["rigid_bodies[0].motion=(velocity: [0.0, -0.05], travel: 0.25, increment: 0.25)"],
+        ),
+        ("footing_rigid_load.ron", "rigid-load", &[]),
+        ("footing_load.ron", "load", &[]),
+    ];
+    for (scene, name, overrides) in cases {
+        let (_, one) = run_on(scene, 1, name, overrides);
+        for ranks in [2, 4] {
+            let (_, many) = run_on(scene, ranks, name, overrides);
+            let what = format!("{name} on {ranks} ranks");
+            agrees(&one, &many, 1e-10, &what);
+            curves_agree(&one, &many, 1e-10, &what);
+            let bodies = |s: &Value| s["rigid_bodies"].as_array().cloned().unwrap_or_default();
+            for (a, b) in bodies(&one).iter().zip(&bodies(&many)) {
+                assert_eq!(a["entries"], b["entries"], "{what}: points put back out");
+                assert!(rel(&a["travel"], &b["travel"]) <= 1e-10, "{what}: travel");
+            }
+        }
+    }
+}
+
+/// The staged slope on 2 and 4 ranks: its geostatic stage ends where one rank's does, to
+/// 1e-10; the second stage turns the soil to Mohr–Coulomb and lets the slope fail, a flow
+/// that grows the round-off of another order of additions, and ends at one rank's step.
+#[test]
+fn the_staged_slope_on_2_and_4_ranks_passes_its_stages_where_one_rank_does() {
+    let (_, one) = run_on("slope_staged.ron", 1, "staged", &[]);
+    let stages = |s: &Value| s["stages"].as_array().expect("stages").clone();
+    for ranks in [2, 4] {
+        let (_, many) = run_on("slope_staged.ron", ranks, "staged", &[]);
+        let what = format!("staged on {ranks} ranks");
+        assert_eq!(one["steps"], many["steps"], "{what}: steps");
+        let (a, b) = (stages(&one), stages(&many));
+        assert_eq!(a.len(), 2, "{what}: stages");
+        assert_eq!(a.len(), b.len(), "{what}: stages");
+        for (x, y) in a.iter().zip(&b) {
+            assert_eq!(x["step"], y["step"], "{what}: a stage's last step");
+        }
+        for k in ["force_ratio", "energy_ratio"] {
+            assert!(rel(&a[0][k], &b[0][k]) <= 1e-10, "{what}: geostatic {k}");
+        }
+    }
+}

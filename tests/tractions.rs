@@ -194,23 +194,3 @@ fn a_pressure_is_given_alone_on_points_of_its_own() {
         "{e}"
     );
 }
-
-/// A run over several MPI ranks refuses a pressure, with the reason (a point's neighbours
-/// along its surface may be on another rank), and splits the same scene with a traction.
-#[test]
-fn a_run_over_ranks_refuses_a_pressure_and_says_why() {
-    use kdmpm::scene::{build, LoadedScene};
-    let split = |text: &str| {
-        let loaded = LoadedScene::from_text(std::path::Path::new("column.ron"), text, &[]).unwrap();
-        let kdmpm::AnySimulation::Two(sim) = build(&loaded).unwrap().0 else {
-            unreachable!("a 2D scene")
-        };
-        kdmpm::run::distribute::unsupported(&sim)
-    };
-    assert_eq!(split(COLUMN_2D), None);
-    let why = split(&COLUMN_2D.replace("traction: [0.0, -10.0e3]", "pressure: 10.0e3")).unwrap();
-    assert!(
-        why.contains("surface pressures") && why.contains("another rank"),
-        "{why}"
-    );
-}

@@ -146,6 +146,20 @@ impl Decomposition {
         ]
     }
 
+    /// The node layers whose whole sums this rank holds once the shared bands are summed:
+    /// the layers it owns and the bands it shares with its neighbours (empty when it holds
+    /// no cells).
+    pub fn held_nodes(&self) -> Range<usize> {
+        let owned = self.owned_nodes();
+        if owned.is_empty() {
+            return owned;
+        }
+        self.bands()
+            .into_iter()
+            .flatten()
+            .fold(owned, |r, (_, b)| r.start.min(b.start)..r.end.max(b.end))
+    }
+
     /// Largest point count of a rank over the mean (1 is perfect balance).
     pub fn imbalance(points_per_rank: &[u64]) -> f64 {
         let total: u64 = points_per_rank.iter().sum();

@@ -253,6 +253,11 @@ impl Summary {
                 bytes_per_step: migrations[1] / s.clock.step.max(1) as f64,
             }
         });
+        // The points each rank put back out of the bodies: summed, the deepest of all.
+        let mut entries: Vec<f64> = s.control.bodies.iter().map(|b| b.entries as f64).collect();
+        let mut deepest: Vec<f64> = s.control.bodies.iter().map(|b| b.deepest_entry).collect();
+        comm.sum(&mut entries);
+        comm.max(&mut deepest);
         // Under load control a static state may follow a collapse (the body rests again on
         // what it heaved): the largest pressure is a limit only under displacement control.
         let displacement_control: Vec<CurvePoint> = s
@@ -326,12 +331,13 @@ impl Summary {
                 .control
                 .bodies
                 .iter()
-                .map(|b| BodyResult {
+                .zip(entries.iter().zip(&deepest))
+                .map(|(b, (&entries, &deepest_entry))| BodyResult {
                     name: b.name.clone(),
                     offset: b.offset,
                     travel: b.travel,
-                    entries: b.entries,
-                    deepest_entry: b.deepest_entry,
+                    entries: entries as u64,
+                    deepest_entry,
                 })
                 .collect(),
             stages: s.control.stages.clone(),

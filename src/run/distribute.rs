@@ -15,41 +15,9 @@ use crate::systems::migrate::{layer_counts, Migrate};
 use hecs::Entity;
 use std::sync::Arc;
 
-/// What a run over several ranks does not do yet, as the reason, or `None` when the scene
-/// can be split.
-pub fn unsupported<D: Dim>(sim: &Simulation<D>) -> Option<&'static str> {
-    let (s, n) = (&sim.ctx.model, &sim.ctx.numerics);
-    if !s.bodies.is_empty() {
-        Some("rigid bodies (their contact forces are not yet summed over the ranks)")
-    } else if !s.motions.is_empty() {
-        Some("prescribed motions (their reaction is not yet summed over the ranks)")
-    } else if !s.stages.is_empty() {
-        Some("stages")
-    } else if !s.pressures.is_empty() {
-        Some("surface pressures (a loaded point's neighbours along its surface may be on another rank)")
-    } else if !s.load_steps.is_empty() {
-        Some("tractions applied in increments")
-    } else if n.anti_locking != crate::state::AntiLocking::Off {
-        Some("solver.anti_locking (its nodal or cell means are not yet summed over the ranks)")
-    } else if s.inertia_factors.iter().any(|&f| f != 1.0) {
-        Some("mass scaling")
-    } else {
-        None
-    }
-}
-
 /// Gives `sim` its part of the run: the decomposition of its points over `comm`'s ranks,
 /// and only the points of this rank's cell layers. With one rank nothing changes.
-pub fn decompose<D: Dim>(sim: &mut Simulation<D>, comm: Arc<Comm>) -> Result<(), String> {
-    if comm.size() > 1 {
-        if let Some(what) = unsupported(sim) {
-            return Err(format!(
-                "this scene uses {what}, which a run over {} ranks does not do yet: run it \
-                 on one rank",
-                comm.size()
-            ));
-        }
-    }
+pub fn decompose<D: Dim>(sim: &mut Simulation<D>, comm: Arc<Comm>) {
     let ctx = &mut sim.ctx;
     let axis = ctx.grid.slab_axis;
     // Every rank holds the whole scene here: its counts are everyone's.
@@ -79,5 +47,4 @@ pub fn decompose<D: Dim>(sim: &mut Simulation<D>, comm: Arc<Comm>) -> Result<(),
             t.entity = e;
         }
     }
-    Ok(())
 }

@@ -26,7 +26,7 @@ pub(super) fn go<D: Dim>(
             comm.size()
         )));
     }
-    super::distribute::decompose(sim, comm.clone()).map_err(refuse)?;
+    super::distribute::decompose(sim, comm.clone());
     // Every rank gathers the traced points for rank 0's history, before it is written.
     let gather = TracedGather::new(&sim.traced);
     sim.schedule.push(gather);

@@ -53,6 +53,9 @@ impl<D: Dim> System<D> for Boundary {
             min_mass: st.min_node_mass,
             floor: st.virtual_mass_floor,
         };
+        // Over several ranks a shared node is held on both; its reaction counts on its owner.
+        let owned = ctx.owned_node_ids();
+        let owned = owned.as_ref();
         let parts = grid_pass(grid, ctx.state.active_nodes, &target, |b, (np, nf, ne), first| {
             let mut reactions = vec![[0.0; 3]; velocities.len()];
             for i in b.rows(grid).flatten() {
@@ -69,7 +72,9 @@ impl<D: Dim> System<D> for Boundary {
                         Hold::Free => continue,
                         Hold::Driven(d) => {
                             let r = -nf[k].0.get(a);
-                            reactions[d][a] += r;
+                            if owned.is_none_or(|o| o.contains(&i)) {
+                                reactions[d][a] += r;
+                            }
                             ne[k].0.set(a, ne[k].0.get(a) + r);
                             np[k].0.set(a, nm[i].0 * velocities[d][a]);
                         }
@@ -80,10 +85,17 @@ impl<D: Dim> System<D> for Boundary {
             }
             reactions
         });
-        for (d, drive) in ctx.state.control.drives.iter_mut().enumerate() {
-            drive.reaction = parts
-                .iter()
-                .fold([0.0; 3], |s, p| std::array::from_fn(|a| s[a] + p[d][a]));
+        let mut reactions: Vec<f64> = (0..velocities.len())
+            .flat_map(|d| {
+                parts
+                    .iter()
+                    .fold([0.0; 3], |s, p| std::array::from_fn(|a| s[a] + p[d][a]))
+            })
+            .collect();
+        // Each rank's owned nodes' part, added in rank order.
+        ctx.comm.sum(&mut reactions);
+        for (drive, r) in ctx.state.control.drives.iter_mut().zip(reactions.chunks(3)) {
+            drive.reaction = [r[0], r[1], r[2]];
         }
         Ok(())
     }

@@ -143,6 +143,7 @@ impl<D: Dim, S: Shape> CellMean<D, S> {
             self.sums
                 .scatter_cells::<D, S>(&mut ctx.slabs, grid, &xg, |p| [vol[p].0 * q(&qs[p]), vol[p].0]);
         }
+        self.sums.sum_over_ranks(grid, &ctx.comm, &ctx.decomposition);
         // Every cell a point is in has Σ V > 0; the others are never read.
         self.sums
             .map(grid, |s| [if s[1] > 0.0 { s[0] / s[1] } else { 0.0 }, s[1]]);
@@ -162,7 +163,7 @@ impl<D: Dim, S: Shape> CellMean<D, S> {
         self.means::<Stress<D::Stress>>(ctx, |s| mean_stress::<D>(&s.0));
         let mut returned = self.project(ctx, None, RETURNS == 0);
         for round in 1..=RETURNS {
-            if returned.iter().all(Vec::is_empty) {
+            if !ctx.comm.any(returned.iter().any(|r| !r.is_empty())) {
                 break;
             }
             // The cells a returned point is in (emptied), and every point in them,
@@ -179,6 +180,14 @@ impl<D: Dim, S: Shape> CellMean<D, S> {
                         *sums.at_mut(key) = [0.0; 2];
                         cells.push(key);
                     }
+                }
+            }
+            // Over several ranks the cells of the shared layers may hold points of both:
+            // every rank takes them all afresh, whichever rank returned a point in them.
+            for key in shared_cells(ctx) {
+                if !std::mem::replace(&mut dirty[key], true) {
+                    *sums.at_mut(key) = [0.0; 2];
+                    cells.push(key);
                 }
             }
             // Every point in them, archetype by archetype in point order, and their
@@ -209,10 +218,14 @@ impl<D: Dim, S: Shape> CellMean<D, S> {
                     dirty[grid.cell_key(x[p].0)].then(|| [vol[p].0 * mean_stress::<D>(&s[p].0), vol[p].0])
                 });
             }
+            sums.sum_over_ranks(grid, &ctx.comm, &ctx.decomposition);
             let dirty = &mut self.dirty;
             for key in cells {
                 let pair = sums.at_mut(key);
-                pair[0] /= pair[1];
+                // A shared cell may hold no point.
+                if pair[1] > 0.0 {
+                    pair[0] /= pair[1];
+                }
                 dirty[key] = false;
             }
             returned = self.project(ctx, Some(&active), round == RETURNS);
@@ -242,6 +255,21 @@ impl<D: Dim, S: Shape> CellMean<D, S> {
             })
             .collect()
     }
+}
+
+/// The cells (by their lowest node) of the node layers this rank shares with its
+/// neighbours; none with one rank.
+fn shared_cells<D: Dim>(ctx: &Context<D>) -> impl Iterator<Item = usize> {
+    let layer = ctx.grid.layer();
+    let bands = if ctx.comm.size() > 1 {
+        ctx.decomposition.bands()
+    } else {
+        [None, None]
+    };
+    bands
+        .into_iter()
+        .flatten()
+        .flat_map(move |(_, l)| l.start * layer..l.end * layer)
 }
 
 /// How many times a step returns the points that the shift of their mean took outside

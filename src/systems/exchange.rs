@@ -11,8 +11,10 @@
 use crate::components::*;
 use crate::context::Context;
 use crate::dim::Dim;
-use crate::grid::NodeBox;
+use crate::grid::{Grid, NodeBox};
 use crate::infra::columns::{col, col_mut, nodes};
+use crate::infra::comm::Comm;
+use crate::infra::decomposition::Decomposition;
 use std::ops::Range;
 
 /// Node mass.
@@ -39,49 +41,63 @@ pub fn exchange_again<D: Dim>(ctx: &mut Context<D>, what: u8) {
     if ctx.comm.size() == 1 {
         return;
     }
-    let layer = ctx.grid.layer();
-    let [below, above] = ctx.decomposition.bands();
-    let ids = |b: &Option<(usize, Range<usize>)>| b.as_ref().map(|(_, l)| l.start * layer..l.end * layer);
-    let (ids_below, ids_above) = (ids(&below), ids(&above));
-    let mine_below = ids_below
-        .clone()
-        .map(|r| pack::<D>(ctx, what, r))
-        .unwrap_or_default();
-    let mine_above = ids_above
-        .clone()
-        .map(|r| pack::<D>(ctx, what, r))
-        .unwrap_or_default();
-    let (rank_below, rank_above) = (below.as_ref().map(|b| b.0), above.as_ref().map(|a| a.0));
-    let from_below = ctx.comm.exchange(rank_above, &mine_above, rank_below);
-    let from_above = ctx.comm.exchange(rank_below, &mine_below, rank_above);
-    if let Some(r) = ids_below {
-        // The lower rank's part first.
-        let sum: Vec<f64> = from_below.iter().zip(&mine_below).map(|(l, u)| l + u).collect();
-        unpack::<D>(ctx, what, r, &sum);
-    }
-    if let Some(r) = ids_above {
-        let sum: Vec<f64> = mine_above.iter().zip(&from_above).map(|(l, u)| l + u).collect();
-        unpack::<D>(ctx, what, r, &sum);
-    }
+    let bands = share_bands(
+        &ctx.grid,
+        &ctx.comm,
+        &ctx.decomposition,
+        |ids| pack::<D>(ctx, what, ids),
+        |ids, lower, upper| {
+            let sum: Vec<f64> = lower.iter().zip(upper).map(|(l, u)| l + u).collect();
+            unpack::<D>(ctx, what, ids, &sum)
+        },
+    );
     // The shared bands are part of this rank's grid from now on in the step: reset, updated
     // and read like the nodes its own points reach.
-    let cross = |a: usize| {
-        if a == ctx.grid.slab_axis {
-            None
-        } else {
-            Some(ctx.grid.nodes[a])
-        }
-    };
-    for r in [below, above].into_iter().flatten().map(|(_, l)| l) {
-        let mut b = NodeBox::default();
-        for a in 0..3 {
-            (b.lo[a], b.hi[a]) = match cross(a) {
-                Some(n) => (0, n),
-                None => (r.start, r.end),
-            };
-        }
+    for b in bands.into_iter().flatten() {
         ctx.state.active_nodes = ctx.state.active_nodes.union(b);
     }
+}
+
+/// The partial values of the node layers this rank shares with its neighbours, made whole:
+/// `pack(ids)` gives this rank's values at the node ids of a band (any number a node, the
+/// same layout on both sides), `unpack(ids, lower, upper)` gets the lower rank's part and
+/// the upper rank's and combines them (added in that order, the same bits on both ranks).
+/// Returns the bands' boxes.
+pub(crate) fn share_bands<D: Dim>(
+    grid: &Grid<D>,
+    comm: &Comm,
+    decomposition: &Decomposition,
+    pack: impl Fn(Range<usize>) -> Vec<f64>,
+    mut unpack: impl FnMut(Range<usize>, &[f64], &[f64]),
+) -> [Option<NodeBox>; 2] {
+    let layer = grid.layer();
+    let [below, above] = decomposition.bands();
+    let ids = |b: &Option<(usize, Range<usize>)>| b.as_ref().map(|(_, l)| l.start * layer..l.end * layer);
+    let (ids_below, ids_above) = (ids(&below), ids(&above));
+    let mine_below = ids_below.clone().map(&pack).unwrap_or_default();
+    let mine_above = ids_above.clone().map(&pack).unwrap_or_default();
+    let (rank_below, rank_above) = (below.as_ref().map(|b| b.0), above.as_ref().map(|a| a.0));
+    let from_below = comm.exchange(rank_above, &mine_above, rank_below);
+    let from_above = comm.exchange(rank_below, &mine_below, rank_above);
+    if let Some(r) = ids_below {
+        unpack(r, &from_below, &mine_below);
+    }
+    if let Some(r) = ids_above {
+        unpack(r, &mine_above, &from_above);
+    }
+    [below, above].map(|b| {
+        b.map(|(_, r)| {
+            let mut b = NodeBox::default();
+            for a in 0..3 {
+                (b.lo[a], b.hi[a]) = if a == grid.slab_axis {
+                    (r.start, r.end)
+                } else {
+                    (0, grid.nodes[a])
+                };
+            }
+            b
+        })
+    })
 }
 
 /// The values of the columns of `what` at node ids `ids`, in node order, column after

@@ -42,7 +42,10 @@ fn settlement<D: Dim>(ctx: &Context<D>, load: &LoadSteps) -> f64 {
             }
         }
     }
-    sum / count.max(1) as f64
+    // Over several ranks, every rank's loaded points (rank order).
+    let mut both = [sum, count as f64];
+    ctx.comm.sum(&mut both);
+    both[0] / both[1].max(1.0)
 }
 
 impl<D: Dim> System<D> for LoadControl {

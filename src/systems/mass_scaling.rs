@@ -68,6 +68,10 @@ impl<D: Dim, S: Shape> System<D> for MassScaling<D, S> {
                 },
             );
         }
+        // Over MPI: the shared nodes' scaled mass summed, their largest factor kept.
+        sums.combine_over_ranks(grid, &ctx.comm, &ctx.decomposition, |l, u| {
+            [l[0] + u[0], l[1].max(u[1])]
+        });
         let (dt, min_mass, floor) = (
             ctx.numerics.dt,
             ctx.numerics.min_node_mass,

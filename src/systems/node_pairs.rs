@@ -7,9 +7,12 @@ use crate::components::{Position, VelocityGradient, Volume};
 use crate::dim::Dim;
 use crate::grid::{Grid, NodeBox};
 use crate::infra::columns::{col, col_mut, points_with};
+use crate::infra::comm::Comm;
+use crate::infra::decomposition::Decomposition;
 use crate::parallel::CHUNK;
 use crate::parallel::{fill_box, for_each_box_node, scatter, Disjoint, SlabCache};
 use crate::shape::{for_each_node, Shape};
+use crate::systems::exchange::share_bands;
 use hecs::World;
 use rayon::prelude::*;
 
@@ -119,6 +122,55 @@ impl NodePairs {
     /// The pairs, by node index.
     pub(crate) fn pairs(&self) -> &[[f64; 2]] {
         &self.sums
+    }
+
+    /// Over MPI ranks: the pairs of the node layers this rank shares with its neighbours
+    /// made whole (both hold the lower rank's part plus the upper's, as
+    /// [`crate::systems::exchange`] sums the node columns), those layers then counted as
+    /// reached. Cell sums, kept at a cell's lowest node, are made whole alike: a point that
+    /// crossed into the next rank's cell layers this step has not moved rank yet. With one
+    /// rank nothing happens.
+    pub(crate) fn sum_over_ranks<D: Dim>(
+        &mut self,
+        grid: &Grid<D>,
+        comm: &Comm,
+        decomposition: &Decomposition,
+    ) {
+        self.combine_over_ranks(grid, comm, decomposition, |l, u| [l[0] + u[0], l[1] + u[1]]);
+    }
+
+    /// As [`NodePairs::sum_over_ranks`], each shared pair `combine(lower rank's, upper
+    /// rank's)` (a sum and a largest value, for mass scaling).
+    pub(crate) fn combine_over_ranks<D: Dim>(
+        &mut self,
+        grid: &Grid<D>,
+        comm: &Comm,
+        decomposition: &Decomposition,
+        combine: impl Fn([f64; 2], [f64; 2]) -> [f64; 2],
+    ) {
+        if comm.size() == 1 {
+            return;
+        }
+        self.sums.resize(grid.node_count(), [0.0; 2]);
+        let sums = std::cell::RefCell::new(&mut self.sums);
+        let bands = share_bands(
+            grid,
+            comm,
+            decomposition,
+            |ids| sums.borrow()[ids].as_flattened().to_vec(),
+            |ids, lower, upper| {
+                for ((pair, l), u) in sums.borrow_mut()[ids]
+                    .iter_mut()
+                    .zip(lower.chunks_exact(2))
+                    .zip(upper.chunks_exact(2))
+                {
+                    *pair = combine([l[0], l[1]], [u[0], u[1]]);
+                }
+            },
+        );
+        for b in bands.into_iter().flatten() {
+            self.active = self.active.union(b);
+        }
     }
 
     /// Zeroes the nodes the points reached, for the next step.

@@ -7,6 +7,7 @@ use crate::error::StepError;
 use crate::infra::columns::{col, col_mut, nodes, points_with};
 use crate::schedule::System;
 use crate::shape::{for_each_node, Shape};
+use crate::systems::exchange::{exchange, MASS};
 use std::marker::PhantomData;
 
 /// Spreads each point load F over the nodes of its support that carry mass, with the shape
@@ -39,6 +40,8 @@ impl<D: Dim, S: Shape> System<D> for PointLoads<D, S> {
         "point_loads"
     }
     fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
+        // Over MPI: which nodes carry soil is a question of the whole mass.
+        exchange(ctx, MASS);
         let grid = &ctx.grid;
         let min_mass = ctx.numerics.min_node_mass;
         let n = nodes(&ctx.world);
@@ -48,6 +51,9 @@ impl<D: Dim, S: Shape> System<D> for PointLoads<D, S> {
         let pressures = &ctx.model.pressures;
         if !pressures.is_empty() {
             self.places.resize(pressures.ids.len(), [0.0; 3]);
+            if ctx.comm.size() > 1 {
+                self.places.fill([0.0; 3]);
+            }
             for arch in points_with::<PointLoad<D::Vec>>(&ctx.world) {
                 let (x, id) = (col::<Position<D::Vec>>(arch), col::<PointId>(arch));
                 for (x, id) in x.iter().zip(id.iter()) {
@@ -56,6 +62,9 @@ impl<D: Dim, S: Shape> System<D> for PointLoads<D, S> {
                     }
                 }
             }
+            // Over several ranks a point's neighbours along its surface may be another
+            // rank's: each rank holds its own points' places and zeros, the sums all.
+            ctx.comm.sum(self.places.as_flattened_mut());
         }
         let places = &self.places;
         let place = |id: u32| {

@@ -31,12 +31,14 @@
 
 use crate::components::*;
 use crate::context::Context;
-use crate::dim::Dim;
+use crate::dim::{Dim, Vector};
 use crate::error::StepError;
+use crate::grid::NodeBox;
 use crate::infra::columns::{col, col_mut, nodes};
 use crate::rigid::contact::{key, remember, solve, Contact, Contacts, Memory, Slot};
 use crate::schedule::System;
 use crate::shape::{for_each_node, Shape};
+use crate::systems::exchange::{exchange, EXTERNAL, FORCE, MASS, MOMENTUM};
 use crate::systems::shared::{constrain, hold, Hold};
 use std::marker::PhantomData;
 
@@ -59,18 +61,128 @@ impl<D: Dim, S> Default for RigidContact<D, S> {
     }
 }
 
+/// The soil's mass, momentum and force at the nodes the contacts may reach: this rank's
+/// columns with one rank; over several, every node's whole values gathered from the rank
+/// that owns it, so that every rank places and solves the same contacts in the same order
+/// (the answer one rank finds, to the order of the sums that made the nodal values).
+enum Soil<'a, D: Dim> {
+    /// One rank: its node columns.
+    Columns {
+        nm: &'a [NodeMass],
+        np: &'a [NodeMomentum<D::Vec>],
+        nf: &'a [NodeForce<D::Vec>],
+    },
+    /// Several ranks: the node ids, ascending, and 1 + 2N values each (m, p, f).
+    Gathered { ids: Vec<usize>, values: Vec<f64> },
+}
+
+impl<D: Dim> Soil<'_, D> {
+    /// Mass (kg), momentum (kg m/s) and force (N) at node `i`; nothing for a node no
+    /// contact reaches.
+    fn at(&self, i: usize) -> (f64, D::Vec, D::Vec) {
+        match self {
+            Soil::Columns { nm, np, nf } => (nm[i].0, np[i].0, nf[i].0),
+            Soil::Gathered { ids, values } => {
+                let w = 1 + 2 * D::N;
+                let Ok(k) = ids.binary_search(&i) else {
+                    return (0.0, D::Vec::ZERO, D::Vec::ZERO);
+                };
+                let v = &values[k * w..(k + 1) * w];
+                let vec =
+                    |o: usize| D::vec_from(std::array::from_fn(|a| if a < D::N { v[o + a] } else { 0.0 }));
+                (v[0], vec(1), vec(1 + D::N))
+            }
+        }
+    }
+}
+
+/// The nodes a body's inside-node constraints visit: those within its bounds at its current
+/// place, among `region`.
+fn inside_box<D: Dim>(
+    ctx: &Context<D>,
+    body: &crate::rigid::RigidBody,
+    offset: [f64; 3],
+    region: NodeBox,
+) -> NodeBox {
+    let grid = &ctx.grid;
+    let (lo, hi) = body.spec.bounds(D::N);
+    let o = D::vec_to3(grid.origin);
+    let mut inside = region;
+    for a in 0..D::N {
+        let first = ((lo[a] + offset[a] - o[a]) * grid.inv_h).ceil().max(0.0) as usize;
+        let last = ((hi[a] + offset[a] - o[a]) * grid.inv_h).floor().max(-1.0) + 1.0;
+        inside.lo[a] = inside.lo[a].max(first);
+        inside.hi[a] = inside.hi[a].min(last as usize).max(inside.lo[a]);
+    }
+    inside
+}
+
+/// The region of nodes the inside-node constraints look in: this rank's active nodes with
+/// one rank, the whole grid over several (each rank sees every body whole).
+fn region<D: Dim>(ctx: &Context<D>) -> NodeBox {
+    if ctx.comm.size() == 1 {
+        return ctx.state.active_nodes;
+    }
+    let mut whole = NodeBox::default();
+    for a in 0..3 {
+        whole.hi[a] = if a < D::N { ctx.grid.nodes[a] } else { 1 };
+    }
+    whole
+}
+
+/// The soil's values at the nodes the contacts may reach (see [`Soil`]): over several
+/// ranks, each rank gives the nodes it owns and the sums make them whole on every rank.
+fn soil<'a, D: Dim, S: Shape>(
+    ctx: &Context<D>,
+    nm: &'a [NodeMass],
+    np: &'a [NodeMomentum<D::Vec>],
+    nf: &'a [NodeForce<D::Vec>],
+) -> Soil<'a, D> {
+    let Some(owned) = ctx.owned_node_ids() else {
+        return Soil::Columns { nm, np, nf };
+    };
+    let grid = &ctx.grid;
+    let whole = region(ctx);
+    let mut ids = Vec::new();
+    for (b, body) in ctx.model.bodies.iter().enumerate() {
+        let offset = ctx.state.control.bodies[b].offset;
+        ids.extend(inside_box(ctx, body, offset, whole).rows(grid).flatten());
+        for (s, _) in &body.samples {
+            let x = D::vec_from(std::array::from_fn(|a| s.x[a] + offset[a]));
+            if grid.contains(x) {
+                for_each_node::<D, S>(grid, x, |i, w, _| {
+                    if w > 0.0 {
+                        ids.push(i);
+                    }
+                });
+            }
+        }
+    }
+    ids.sort_unstable();
+    ids.dedup();
+    let w = 1 + 2 * D::N;
+    let mut values = vec![0.0; ids.len() * w];
+    for (k, &i) in ids.iter().enumerate() {
+        if owned.contains(&i) {
+            let v = &mut values[k * w..(k + 1) * w];
+            v[0] = nm[i].0;
+            for a in 0..D::N {
+                v[1 + a] = np[i].0.get(a);
+                v[1 + D::N + a] = nf[i].0.get(a);
+            }
+        }
+    }
+    // One rank owns each node: its value plus zeros, the same bits on every rank.
+    ctx.comm.sum(&mut values);
+    Soil::Gathered { ids, values }
+}
+
 /// Places every sample that meets soil at its body's current place: its nodes that carry
 /// soil and their weights, each node's trial velocity p/m + f Δt/m̃. A sample meets soil
 /// when nodes carrying mass hold at least half its support. `slot_of` (one entry a node)
 /// is all `u32::MAX` on entry and is left so.
-fn place<D: Dim, S: Shape>(ctx: &Context<D>, slot_of: &mut Vec<u32>) -> Contacts {
-    let n = nodes(&ctx.world);
-    let (nm, np, nf, fix) = (
-        col::<NodeMass>(n),
-        col::<NodeMomentum<D::Vec>>(n),
-        col::<NodeForce<D::Vec>>(n),
-        col::<NodeFixity>(n),
-    );
+fn place<D: Dim, S: Shape>(ctx: &Context<D>, soil: &Soil<D>, slot_of: &mut Vec<u32>) -> Contacts {
+    let fix = col::<NodeFixity>(nodes(&ctx.world));
     let (grid, st) = (&ctx.grid, &ctx.numerics);
     let drives = &ctx.state.control.drives;
     let mut set = Contacts::default();
@@ -81,11 +193,11 @@ fn place<D: Dim, S: Shape>(ctx: &Context<D>, slot_of: &mut Vec<u32>) -> Contacts
         if slot_of[i] != u32::MAX {
             return slot_of[i] as usize;
         }
-        let m = nm[i].0;
+        let (m, p, f) = soil.at(i);
         let inertia = grid.inertia(i, m, st.virtual_mass_floor);
         // The held components as `boundary` will hold them (it runs next, so that a
         // friction face and a motion feel the contact's force).
-        let mut v = np[i].0 * (1.0 / m) + nf[i].0 * (st.dt / inertia);
+        let mut v = p * (1.0 / m) + f * (st.dt / inertia);
         constrain(&mut v, fix[i], D::N, drives);
         let v = D::vec_to3(v);
         let free = std::array::from_fn(|a| a < D::N && hold(fix[i], a, drives) == Hold::Free);
@@ -93,24 +205,15 @@ fn place<D: Dim, S: Shape>(ctx: &Context<D>, slot_of: &mut Vec<u32>) -> Contacts
         slot_of[i] = (slots.len() - 1) as u32;
         slots.len() - 1
     };
+    let region = region(ctx);
     for (b, body) in ctx.model.bodies.iter().enumerate() {
         let state = &ctx.state.control.bodies[b];
         let (spec, interfaces) = (&body.spec, &body.interfaces);
         // The nodes inside the body hold their normal velocity too: the soil's field
         // there is the body's, and a light node that only a point's tail reaches would
         // otherwise be free to run into it (under a confining stress it does).
-        let (lo, hi) = spec.bounds(D::N);
-        let o = D::vec_to3(grid.origin);
-        let mut inside = ctx.state.active_nodes;
-        for a in 0..D::N {
-            let first = ((lo[a] + state.offset[a] - o[a]) * grid.inv_h).ceil().max(0.0) as usize;
-            let last = ((hi[a] + state.offset[a] - o[a]) * grid.inv_h).floor().max(-1.0) + 1.0;
-            inside.lo[a] = inside.lo[a].max(first);
-            inside.hi[a] = inside.hi[a].min(last as usize).max(inside.lo[a]);
-        }
-        for i in inside.rows(grid).flatten() {
-            let m = nm[i].0;
-            if !grid.carries(i, m, st.min_node_mass) {
+        for i in inside_box(ctx, body, state.offset, region).rows(grid).flatten() {
+            if !grid.carries(i, soil.at(i).0, st.min_node_mass) {
                 continue;
             }
             let x = D::vec_to3(grid.node_position(grid.node_ijk(i)));
@@ -143,8 +246,7 @@ fn place<D: Dim, S: Shape>(ctx: &Context<D>, slot_of: &mut Vec<u32>) -> Contacts
             let mut reach = Vec::new();
             let mut weight = 0.0;
             for_each_node::<D, S>(grid, x, |i, w, _| {
-                let m = nm[i].0;
-                if w <= 0.0 || !grid.carries(i, m, st.min_node_mass) {
+                if w <= 0.0 || !grid.carries(i, soil.at(i).0, st.min_node_mass) {
                     return;
                 }
                 let k = slot(&mut set.slots, slot_of, i);
@@ -187,7 +289,18 @@ impl<D: Dim, S: Shape> System<D> for RigidContact<D, S> {
     }
 
     fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
-        let mut set = place::<D, S>(ctx, &mut self.slot_of);
+        // Over MPI: every force is mapped by now; the shared nodes get their whole sums.
+        exchange(ctx, MASS | MOMENTUM | FORCE | EXTERNAL);
+        let mut set = {
+            let n = nodes(&ctx.world);
+            let (nm, np, nf) = (
+                col::<NodeMass>(n),
+                col::<NodeMomentum<D::Vec>>(n),
+                col::<NodeForce<D::Vec>>(n),
+            );
+            let soil = soil::<D, S>(ctx, &nm, &np, &nf);
+            place::<D, S>(ctx, &soil, &mut self.slot_of)
+        };
         let bodies = &ctx.model.bodies;
         let velocities: Vec<[f64; 3]> = ctx.state.control.bodies.iter().map(|b| b.velocity).collect();
         solve(&mut set, &velocities, &ctx.state.control.contact_memory);
@@ -196,7 +309,13 @@ impl<D: Dim, S: Shape> System<D> for RigidContact<D, S> {
         let n = nodes(&ctx.world);
         let mut nf = col_mut::<NodeForce<D::Vec>>(n);
         let mut ne = col_mut::<NodeExternalForce<D::Vec>>(n);
-        for s in &set.slots {
+        // Every rank solved the same contacts; each changes the nodes it holds.
+        let held = ctx.held_node_ids();
+        for s in set
+            .slots
+            .iter()
+            .filter(|s| held.as_ref().is_none_or(|h| h.contains(&s.node)))
+        {
             let fc = D::vec_from(std::array::from_fn(|a| s.inertia * (s.v[a] - s.v0[a]) / dt));
             nf[s.node].0 += fc;
             ne[s.node].0 += fc;
@@ -244,15 +363,27 @@ pub fn project<D: Dim>(ctx: &mut Context<D>) {
     if ctx.state.control.contacts.contacts.is_empty() {
         return;
     }
+    // Over several ranks each rank gives the slots' nodes it owns (mass, then velocity),
+    // and the sums make them whole on every rank: all solve the same contacts.
+    let (owned, held) = (ctx.owned_node_ids(), ctx.held_node_ids());
     let n = nodes(&ctx.world);
     let nm = col::<NodeMass>(n);
     let mut nv = col_mut::<NodeVelocity<D::Vec>>(n);
     let (grid, floor) = (&ctx.grid, ctx.numerics.virtual_mass_floor);
     let control = &mut ctx.state.control;
-    for s in &mut control.contacts.slots {
-        s.v = D::vec_to3(nv[s.node].0);
+    let w = 1 + D::N;
+    let mut values = vec![0.0; control.contacts.slots.len() * w];
+    for (s, v) in control.contacts.slots.iter().zip(values.chunks_mut(w)) {
+        if owned.as_ref().is_none_or(|o| o.contains(&s.node)) {
+            v[0] = nm[s.node].0;
+            (0..D::N).for_each(|a| v[1 + a] = nv[s.node].0.get(a));
+        }
+    }
+    ctx.comm.sum(&mut values);
+    for (s, v) in control.contacts.slots.iter_mut().zip(values.chunks(w)) {
+        s.v = std::array::from_fn(|a| if a < D::N { v[1 + a] } else { 0.0 });
         s.v0 = s.v;
-        s.inertia = grid.inertia(s.node, nm[s.node].0, floor);
+        s.inertia = grid.inertia(s.node, v[0], floor);
     }
     let velocities: Vec<[f64; 3]> = control.bodies.iter().map(|b| b.velocity).collect();
     for p in &mut control.contacts.contacts {
@@ -260,6 +391,8 @@ pub fn project<D: Dim>(ctx: &mut Context<D>) {
     }
     solve(&mut control.contacts, &velocities, &Memory::new());
     for s in &control.contacts.slots {
-        nv[s.node].0 = D::vec_from(s.v);
+        if held.as_ref().is_none_or(|h| h.contains(&s.node)) {
+            nv[s.node].0 = D::vec_from(s.v);
+        }
     }
 }
