@@ -15,6 +15,7 @@
 //! the trial at the smallest failing F (`mechanism`).
 
 use crate::error::{Ending, SceneError};
+use crate::infra::comm::Comm;
 use crate::output::dir::write_atomic;
 use crate::output::{Outcome, OutputDir};
 use crate::run::{DisplacementLimit, Run, RunError};
@@ -22,6 +23,7 @@ use crate::scene::{LoadedScene, StrengthReductionSpec};
 use serde::Serialize;
 use std::io::Write;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 use std::time::Instant;
 
 /// One strength-reduction trial.
@@ -164,6 +166,18 @@ fn has_strength(loaded: &LoadedScene) -> bool {
 pub fn strength_reduction(
     loaded: &LoadedScene,
     out: &Path,
+    report: impl FnMut(&Trial),
+) -> Result<FosReport, FosError> {
+    strength_reduction_over(loaded, out, &Arc::new(Comm::single()), report)
+}
+
+/// [`strength_reduction`] with every trial split over the ranks of `comm` (under
+/// `mpirun`): the ranks run each trial together, every rank finds the same outcome (the
+/// trial's figures are the ranks'), so all bisect alike; rank 0 writes the analysis's files.
+pub fn strength_reduction_over(
+    loaded: &LoadedScene,
+    out: &Path,
+    comm: &Arc<Comm>,
     mut report: impl FnMut(&Trial),
 ) -> Result<FosReport, FosError> {
     let spec = loaded.scene.strength_reduction.clone().ok_or_else(|| {
@@ -186,9 +200,13 @@ pub fn strength_reduction(
     let io = |e: std::io::Error| FosError::Output(out.to_path_buf(), e);
     // The analysis's own directory, held for its whole run: one that cannot be made (a
     // file of that name, no permission) or that another run holds is bad input.
-    let _dir = OutputDir::claim(out).map_err(|e| FosError::OutputDir(e.to_string()))?;
+    let _dir = comm
+        .is_root()
+        .then(|| OutputDir::claim(out))
+        .transpose()
+        .map_err(|e| FosError::OutputDir(e.to_string()))?;
     let mut trials: Vec<Trial> = Vec::new();
-    let mut trial = |f: f64| run_trial(loaded, &spec, f, out, &mut report, &mut trials);
+    let mut trial = |f: f64| run_trial(loaded, &spec, f, out, comm, &mut report, &mut trials);
     let [lo, hi] = [spec.bracket[0], spec.bracket[1]];
     if trial(lo)?.failed {
         return Err(FosError::NotBracketed(format!(
@@ -221,7 +239,9 @@ pub fn strength_reduction(
         trials,
         wall_seconds: start.elapsed().as_secs_f64(),
     };
-    write_report(&fos, out).map_err(io)?;
+    if comm.is_root() {
+        write_report(&fos, out).map_err(io)?;
+    }
     Ok(fos)
 }
 
@@ -246,8 +266,9 @@ pub fn narrow(
     let start = Instant::now();
     let _dir = OutputDir::claim(out).map_err(|e| FosError::OutputDir(e.to_string()))?;
     let mut trials = Vec::new();
+    let one = Arc::new(Comm::single());
     let [lo, hi] = bisect(fos.bracket, tolerance, &mut |f| {
-        run_trial(loaded, &spec, f, out, &mut report, &mut trials)
+        run_trial(loaded, &spec, f, out, &one, &mut report, &mut trials)
     })?;
     fos.steps += trials.iter().map(|t| t.steps).sum::<u64>();
     fos.trials.extend(trials);
@@ -295,6 +316,7 @@ fn run_trial(
     spec: &StrengthReductionSpec,
     factor: f64,
     out: &Path,
+    comm: &Arc<Comm>,
     report: &mut impl FnMut(&Trial),
     trials: &mut Vec<Trial>,
 ) -> Result<Trial, FosError> {
@@ -305,6 +327,7 @@ fn run_trial(
         .into_dir(&path)
         .quiet(true)
         .without_checkpoints()
+        .over(comm.clone())
         .displacement_limit(DisplacementLimit {
             every: spec.check_every,
             limit: spec.failure_displacement,

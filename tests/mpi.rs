@@ -398,3 +398,47 @@ fn the_staged_slope_on_2_and_4_ranks_passes_its_stages_where_one_rank_does() {
         }
     }
 }
+
+/// `kdmpm fos` on `ranks` ranks (one thread each): its summary.json.
+fn fos_on(scene: &str, ranks: usize) -> Value {
+    let out = common::scratch("mpi", &format!("fos-{ranks}"));
+    let o = Command::new("mpirun")
+        .args(["--allow-run-as-root", "--oversubscribe", "-n", &ranks.to_string()])
+        .arg(env!("CARGO_BIN_EXE_kdmpm"))
+        .args([
+            "fos",
+            common::scene(scene).to_str().expect("UTF-8"),
+            "--quiet",
+            "--threads",
+            "1",
+            "--out",
+        ])
+        .arg(&out)
+        .output()
+        .expect("mpirun starts");
+    assert!(
+        o.status.success(),
+        "fos on {ranks} ranks: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let summary = std::fs::read_to_string(out.join("summary.json")).expect("summary.json");
+    serde_json::from_str(&summary).expect("JSON")
+}
+
+/// The factor of safety on 2 ranks: the ranks run every trial together and bisect alike,
+/// to one rank's factor, bracket and trials (each trial's outcome and steps).
+#[test]
+fn the_factor_of_safety_on_2_ranks_is_one_ranks() {
+    let (one, two) = (fos_on("slope_fos.ron", 1), fos_on("slope_fos.ron", 2));
+    assert_eq!(one["factor_of_safety"], two["factor_of_safety"]);
+    assert_eq!(one["bracket"], two["bracket"]);
+    let trials = |s: &Value| -> Vec<(Value, Value, Value)> {
+        s["trials"]
+            .as_array()
+            .expect("trials")
+            .iter()
+            .map(|t| (t["factor"].clone(), t["outcome"].clone(), t["steps"].clone()))
+            .collect()
+    };
+    assert_eq!(trials(&one), trials(&two));
+}

@@ -114,8 +114,10 @@ impl<D: Dim> Hook<D> for DisplacementLimit {
     fn after_step(&mut self, sim: &mut Simulation<D>) -> Result<(), StepError> {
         let st = &sim.ctx.state;
         if st.stop.is_none() && st.clock.step.is_multiple_of(self.every) {
-            let (u, _) = max_displacements(sim).unwrap_or_default();
-            if u > self.limit {
+            // Over several ranks, the largest of every rank's (each rank looks alike).
+            let mut u = [max_displacements(sim).unwrap_or_default().0];
+            sim.ctx.comm.max(&mut u);
+            if u[0] > self.limit {
                 sim.ctx.state.stop = Some(StopReason::DisplacementLimit);
             }
         }

@@ -2,6 +2,7 @@
 //! summary.json (the ranks' figures) and points.pvtu, every rank its own
 //! `points_<rank>.vtu`.
 
+use super::hooks::Hook;
 use super::{claim, RunError, RunReport, Watch};
 use crate::checkpoint;
 use crate::dim::Dim;
@@ -51,7 +52,12 @@ pub(super) fn go<D: Dim>(
         return watch.drive(sim, loaded, dir.as_ref(), None, header);
     }
     let start = Instant::now();
-    let result = sim.run(|_| {});
+    // A strength-reduction trial's limit is every rank's decision (a collective).
+    let mut limit = watch.limit;
+    let result = sim.run_with(|s| match &mut limit {
+        Some(l) => Hook::after_step(l, s),
+        None => Ok(()),
+    });
     // A state with a non-finite value comes with the run's error, reported with it.
     let unwritten = watch
         .out

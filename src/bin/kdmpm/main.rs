@@ -66,10 +66,19 @@ impl Fault {
 
 /// Sets up the process for the command (signals, trace, threads) and runs it.
 fn command(command: Command, comm: &Arc<Comm>) -> Result<ExitCode, Fault> {
-    if comm.size() > 1 && !matches!(command, Command::Run { .. }) {
+    if comm.size() > 1
+        && !matches!(
+            command,
+            Command::Run { .. }
+                | Command::Fos {
+                    refining: cli::Refining { refine: None },
+                    ..
+                }
+        )
+    {
         return Err(Fault::bad(format!(
-            "kdmpm was started on {} ranks; only `kdmpm run` is split across ranks: start the \
-             other commands without mpirun",
+            "kdmpm was started on {} ranks; only `kdmpm run` and `kdmpm fos` are split across \
+             ranks: start the other commands (and `--refine`) without mpirun",
             comm.size()
         )));
     }
@@ -119,7 +128,7 @@ fn command(command: Command, comm: &Arc<Comm>) -> Result<ExitCode, Fault> {
             overrides,
             refining,
             workers,
-        } => run_fos(&scene, out, &overrides, refining.refine, workers.quiet)?,
+        } => run_fos(&scene, out, &overrides, refining.refine, workers.quiet, comm)?,
         Command::Resume { dir, stepping } => {
             let run = Run::resume(dir).quiet(stepping.workers.quiet).go();
             return report(run, stepping, comm);
@@ -256,7 +265,10 @@ fn run_fos(
     overrides: &[String],
     refine: Option<u32>,
     quiet: bool,
+    comm: &Arc<Comm>,
 ) -> Result<(), Fault> {
+    // Over several ranks rank 0 speaks for all.
+    let quiet = quiet || !comm.is_root();
     let loaded = LoadedScene::from_file(path, overrides).map_err(Fault::bad)?;
     let out = out.unwrap_or_else(|| default_out(path, "fos-", "scene"));
     if let Some(levels) = refine {
@@ -277,8 +289,8 @@ fn run_fos(
             eprintln!("{}", t.describe());
         }
     };
-    let r =
-        kdmpm::fos::strength_reduction(&loaded, &out, show).map_err(|e| Fault(e.to_string(), e.ending()))?;
+    let r = kdmpm::fos::strength_reduction_over(&loaded, &out, comm, show)
+        .map_err(|e| Fault(e.to_string(), e.ending()))?;
     if !quiet {
         println!("{} → {}", r.describe(), out.display());
     }
