@@ -442,3 +442,50 @@ fn the_factor_of_safety_on_2_ranks_is_one_ranks() {
     };
     assert_eq!(trials(&one), trials(&two));
 }
+
+/// Snapshots on 2 ranks: the collection lists one rank's snapshots, each a `.pvtu` of the
+/// two ranks' pieces, which hold every point once at one rank's displacement (to 1e-10 of
+/// the largest).
+#[test]
+fn snapshots_on_2_ranks_hold_every_point_once_as_one_rank_does() {
+    let snapshots = ["output.snapshots=(every_steps: 1000)"];
+    let (a, one) = run_on("footing_rigid.ron", 1, "snap", &snapshots);
+    let (b, two) = run_on("footing_rigid.ron", 2, "snap", &snapshots);
+    assert_eq!(one["snapshots"], two["snapshots"]);
+    let pvd = std::fs::read_to_string(b.join("points.pvd")).expect("points.pvd");
+    let step = "000005000";
+    assert!(pvd.contains(&format!("snapshots/points_{step}.pvtu")), "{pvd}");
+    let pvtu = std::fs::read_to_string(b.join(format!("snapshots/points_{step}.pvtu"))).expect("pvtu");
+    let pieces: Vec<PathBuf> = (0..2)
+        .map(|r| format!("points_{step}_{r}.vtu"))
+        .inspect(|p| assert!(pvtu.contains(&format!("Source=\"{p}\"")), "{pvtu}"))
+        .map(|p| b.join("snapshots").join(p))
+        .collect();
+    // Displacements by point id.
+    let by_id = |files: &[PathBuf]| -> std::collections::BTreeMap<u64, [f64; 3]> {
+        let mut m = std::collections::BTreeMap::new();
+        for f in files {
+            let v = common::read_vtu(f);
+            let (ids, u) = (&v["id"].1, &v["displacement"].1);
+            for (k, id) in ids.iter().enumerate() {
+                assert!(
+                    m.insert(*id as u64, [u[3 * k], u[3 * k + 1], u[3 * k + 2]])
+                        .is_none(),
+                    "point {id} twice"
+                );
+            }
+        }
+        m
+    };
+    let whole = by_id(&[a.join(format!("snapshots/points_{step}.vtu"))]);
+    let split = by_id(&pieces);
+    assert_eq!(whole.len(), split.len());
+    let largest = whole.values().flatten().fold(0.0f64, |m, c| m.max(c.abs()));
+    for (id, u) in &whole {
+        let v = split[id];
+        assert!(
+            (0..3).all(|c| (u[c] - v[c]).abs() <= 1e-10 * largest),
+            "point {id}: {v:?} against {u:?}"
+        );
+    }
+}

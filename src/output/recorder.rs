@@ -154,7 +154,8 @@ impl Recorder {
         let snapshots = match snapshots {
             Some(spec) => {
                 let resumed = history_bytes.map(|_| sim.ctx.state.clock.time);
-                let (system, writer) = Snapshots::<D>::start(dir.path(), spec, resumed)?;
+                let ranks = (sim.ctx.comm.rank(), sim.ctx.comm.size());
+                let (system, writer) = Snapshots::<D>::start(dir.path(), spec, resumed, ranks)?;
                 sim.schedule.push(system);
                 Some(writer)
             }

@@ -7,7 +7,7 @@ use crate::dim::Dim;
 use crate::error::StepError;
 use crate::output::bodies::write_bodies;
 use crate::output::dir::write_atomic;
-use crate::output::vtk::{write_frame, Frame};
+use crate::output::vtk::{write_frame, write_parallel_frame, Frame};
 use crate::schedule::System;
 use crossbeam::channel::{bounded, Receiver, Sender};
 use serde::{Deserialize, Serialize};
@@ -77,13 +77,20 @@ type Entry = (f64, String);
 impl<D: Dim> Snapshots<D> {
     /// Starts the writer thread for output directory `dir`. `resume_time` (s) keeps the
     /// entries of an earlier run's `points.pvd` up to that time (a resumed run).
+    ///
+    /// Over MPI (`rank` of `ranks`) every rank writes its own points of each snapshot,
+    /// `points_<step>_<rank>.vtu`; rank 0 also writes `points_<step>.pvtu`, which ties them
+    /// together, the bodies and the collection, which lists the `.pvtu`. Rank 0 clears an
+    /// earlier series before the first step; no rank writes a snapshot before every rank
+    /// has begun stepping (a step's sums wait for all).
     pub fn start(
         dir: &Path,
         spec: SnapshotSpec,
         resume_time: Option<f64>,
+        (rank, ranks): (usize, usize),
     ) -> std::io::Result<(Self, SnapshotWriter)> {
         let folder = dir.join(FOLDER);
-        if resume_time.is_none() {
+        if resume_time.is_none() && rank == 0 {
             clear(dir)?;
         }
         std::fs::create_dir_all(&folder)?;
@@ -107,8 +114,22 @@ impl<D: Dim> Snapshots<D> {
                     // Hand the buffers back for the next snapshot; never blocks (a full
                     // return channel drops them).
                     let _ = back.try_send(frame);
-                    let name = format!("{FOLDER}/points_{:09}.vtu", sorted.step);
-                    write_frame(&sorted, &dir.join(&name))?;
+                    let name = if ranks == 1 {
+                        format!("{FOLDER}/points_{:09}.vtu", sorted.step)
+                    } else {
+                        let piece = |r: usize| format!("points_{:09}_{r}.vtu", sorted.step);
+                        write_frame(&sorted, &dir.join(FOLDER).join(piece(rank)))?;
+                        if rank > 0 {
+                            continue;
+                        }
+                        let name = format!("{FOLDER}/points_{:09}.pvtu", sorted.step);
+                        let pieces: Vec<String> = (0..ranks).map(piece).collect();
+                        write_parallel_frame(&sorted, &dir.join(&name), &pieces)?;
+                        name
+                    };
+                    if ranks == 1 {
+                        write_frame(&sorted, &dir.join(&name))?;
+                    }
                     entries.push((sorted.time, name));
                     if !bodies.is_empty() {
                         let name = format!("{FOLDER}/{BODIES}{:09}.vtu", sorted.step);
@@ -284,7 +305,9 @@ pub(crate) fn clear(dir: &Path) -> std::io::Result<()> {
     if let Ok(entries) = std::fs::read_dir(&folder) {
         for e in entries.flatten() {
             let name = e.file_name().to_string_lossy().into_owned();
-            if (name.starts_with("points_") || name.starts_with(BODIES)) && name.ends_with(".vtu") {
+            // Over MPI, each rank's pieces and the `.pvtu` that ties them.
+            let vtk = name.ends_with(".vtu") || name.ends_with(".pvtu");
+            if (name.starts_with("points_") || name.starts_with(BODIES)) && vtk {
                 std::fs::remove_file(e.path())?;
             }
         }

@@ -178,6 +178,18 @@ pub fn write_parallel_points<D: Dim>(
 ) -> std::io::Result<()> {
     let columns = Columns::<D>::of(&sim.ctx.world, sim.ctx.model.water.clone());
     let arrays = arrays(&columns);
+    write_parallel(&arrays, path, parts)
+}
+
+/// The `.pvtu` of a snapshot taken over MPI ranks: `frame` (this rank's part) names the
+/// arrays, `parts` the ranks' files.
+pub fn write_parallel_frame(frame: &Frame, path: &Path, parts: &[String]) -> std::io::Result<()> {
+    let arrays = arrays(frame);
+    write_parallel(&arrays, path, parts)
+}
+
+/// A `.pvtu` of `arrays` over the pieces `parts` (file names relative to it).
+fn write_parallel(arrays: &[Array<'_>], path: &Path, parts: &[String]) -> std::io::Result<()> {
     crate::output::dir::write_atomic(path, |out| {
         out.write_all(b"<?xml version=\"1.0\"?>\n<VTKFile type=\"PUnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n<PUnstructuredGrid GhostLevel=\"0\">\n")?;
         for (section, part) in [("PPoints", Part::Points), ("PPointData", Part::PointData)] {

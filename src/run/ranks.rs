@@ -7,6 +7,7 @@ use super::{claim, RunError, RunReport, Watch};
 use crate::checkpoint;
 use crate::dim::Dim;
 use crate::output::recorder::write_final_points;
+use crate::output::snapshots::{SnapshotWriter, Snapshots};
 use crate::output::{Summary, TracedGather};
 use crate::scene::LoadedScene;
 use crate::simulation::Simulation;
@@ -20,10 +21,10 @@ pub(super) fn go<D: Dim>(
 ) -> Result<RunReport, RunError> {
     let comm = watch.comm.clone();
     let refuse = |what: String| RunError::Ranks(format!("{}: {what}", loaded.path.display()));
-    if loaded.scene.solver.checkpoint_every.is_some() || loaded.scene.output.snapshots.is_some() {
+    if loaded.scene.solver.checkpoint_every.is_some() {
         return Err(refuse(format!(
-            "a run over {} ranks does not yet write checkpoints or snapshots: remove \
-             solver.checkpoint_every and output.snapshots, or run on one rank",
+            "a run over {} ranks does not yet write checkpoints: remove \
+             solver.checkpoint_every, or run on one rank",
             comm.size()
         )));
     }
@@ -51,6 +52,18 @@ pub(super) fn go<D: Dim>(
         };
         return watch.drive(sim, loaded, dir.as_ref(), None, header);
     }
+    // This rank's part of each snapshot (rank 0's recorder writes the rest).
+    let snapshots = match (&watch.out, loaded.scene.output.snapshots) {
+        (Some(out), Some(spec)) => {
+            let ranks = (comm.rank(), comm.size());
+            let (system, writer) = Snapshots::<D>::start(out, spec, None, ranks).map_err(|e| {
+                RunError::Results(format!("rank {}: cannot start its snapshots: {e}", comm.rank()))
+            })?;
+            sim.schedule.push(system);
+            Some(writer)
+        }
+        _ => None,
+    };
     let start = Instant::now();
     // A strength-reduction trial's limit is every rank's decision (a collective).
     let mut limit = watch.limit;
@@ -63,6 +76,10 @@ pub(super) fn go<D: Dim>(
         .out
         .as_deref()
         .and_then(|out| Some((out, write_final_points(sim, out).err()?)));
+    let series = snapshots
+        .map(SnapshotWriter::finish)
+        .transpose()
+        .map_err(|e| RunError::Results(format!("rank {}: cannot write its snapshots: {e}", comm.rank())));
     // The summary's figures are collectives: this rank takes part, rank 0 writes them.
     let error = result.err();
     let summary = Summary::collect(
@@ -71,6 +88,7 @@ pub(super) fn go<D: Dim>(
         start.elapsed().as_secs_f64(),
         error.as_ref().map(|e| e.to_string()),
     );
+    series?;
     if let (None, Some((out, e))) = (&error, unwritten) {
         return Err(RunError::Results(format!(
             "rank {}: cannot write its points into {}: {e}",
