@@ -253,11 +253,7 @@ impl Summary {
                 bytes_per_step: migrations[1] / s.clock.step.max(1) as f64,
             }
         });
-        // The points each rank put back out of the bodies: summed, the deepest of all.
-        let mut entries: Vec<f64> = s.control.bodies.iter().map(|b| b.entries as f64).collect();
-        let mut deepest: Vec<f64> = s.control.bodies.iter().map(|b| b.deepest_entry).collect();
-        comm.sum(&mut entries);
-        comm.max(&mut deepest);
+        let rigid_bodies = body_results(sim);
         // Under load control a static state may follow a collapse (the body rests again on
         // what it heaved): the largest pressure is a limit only under displacement control.
         let displacement_control: Vec<CurvePoint> = s
@@ -327,23 +323,32 @@ impl Summary {
             limit_pressure: limit_pressure(&displacement_control),
             last_increment_rise: last_increment_rise(&displacement_control),
             curve: s.control.curve.clone(),
-            rigid_bodies: s
-                .control
-                .bodies
-                .iter()
-                .zip(entries.iter().zip(&deepest))
-                .map(|(b, (&entries, &deepest_entry))| BodyResult {
-                    name: b.name.clone(),
-                    offset: b.offset,
-                    travel: b.travel,
-                    entries: entries as u64,
-                    deepest_entry,
-                })
-                .collect(),
+            rigid_bodies,
             stages: s.control.stages.clone(),
             ranks,
         }
     }
+}
+
+/// Every rigid body at the end of a run, the points the ranks put back out of it summed
+/// and the deepest entry of all (a collective over MPI).
+fn body_results<D: Dim>(sim: &Simulation<D>) -> Vec<BodyResult> {
+    let (bodies, comm) = (&sim.ctx.state.control.bodies, &sim.ctx.comm);
+    let mut entries: Vec<f64> = bodies.iter().map(|b| b.entries as f64).collect();
+    let mut deepest: Vec<f64> = bodies.iter().map(|b| b.deepest_entry).collect();
+    comm.sum(&mut entries);
+    comm.max(&mut deepest);
+    bodies
+        .iter()
+        .zip(entries.iter().zip(&deepest))
+        .map(|(b, (&entries, &deepest_entry))| BodyResult {
+            name: b.name.clone(),
+            offset: b.offset,
+            travel: b.travel,
+            entries: entries as u64,
+            deepest_entry,
+        })
+        .collect()
 }
 
 /// A rigid body at the end of a run (`rigid_bodies` in summary.json).
