@@ -52,9 +52,7 @@ impl<D: Dim> Context<D> {
         if self.comm.size() == 1 {
             return None;
         }
-        let layers = self.decomposition.owned_nodes();
-        let layer = self.grid.layer();
-        Some(layers.start * layer..layers.end * layer)
+        Some(self.grid.layer_node_ids(self.decomposition.owned_nodes()))
     }
 
     /// The node ids whose values this rank holds whole when the run has several ranks
@@ -64,8 +62,6 @@ impl<D: Dim> Context<D> {
         if self.comm.size() == 1 {
             return None;
         }
-        let layers = self.decomposition.held_nodes();
-        let layer = self.grid.layer();
-        Some(layers.start * layer..layers.end * layer)
+        Some(self.grid.layer_node_ids(self.decomposition.held_nodes()))
     }
 }

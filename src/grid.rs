@@ -162,6 +162,12 @@ impl<D: Dim> Grid<D> {
         self.strides[self.slab_axis]
     }
 
+    /// The node ids of node `layers` along the slab axis (ids run layer by layer).
+    pub fn layer_node_ids(&self, layers: std::ops::Range<usize>) -> std::ops::Range<usize> {
+        let layer = self.layer();
+        layers.start * layer..layers.end * layer
+    }
+
     /// Integer coordinates of a node id.
     #[inline]
     pub fn node_ijk(&self, id: usize) -> [usize; 3] {

@@ -135,11 +135,8 @@ impl Slabs {
     /// layers `s − 1 .. s + support` (a stencil starts at the point's cell layer or the one
     /// below, both shape functions clamp it inside the grid, and it spans `support` layers).
     pub fn node_range<D: Dim>(grid: &Grid<D>, s: usize, support: usize) -> Range<usize> {
-        let axis = grid.slab_axis;
-        let layer = grid.layer();
-        let first = s.saturating_sub(1);
-        let last = (s + support).min(grid.nodes[axis]);
-        first * layer..last * layer
+        let last = (s + support).min(grid.nodes[grid.slab_axis]);
+        grid.layer_node_ids(s.saturating_sub(1)..last)
     }
 }
 

@@ -259,8 +259,7 @@ impl<D: Dim, S: Shape> CellMean<D, S> {
 
 /// The cells (by their lowest node) of the node layers this rank shares with its
 /// neighbours; none with one rank.
-fn shared_cells<D: Dim>(ctx: &Context<D>) -> impl Iterator<Item = usize> {
-    let layer = ctx.grid.layer();
+fn shared_cells<D: Dim>(ctx: &Context<D>) -> impl Iterator<Item = usize> + '_ {
     let bands = if ctx.comm.size() > 1 {
         ctx.decomposition.bands()
     } else {
@@ -269,7 +268,7 @@ fn shared_cells<D: Dim>(ctx: &Context<D>) -> impl Iterator<Item = usize> {
     bands
         .into_iter()
         .flatten()
-        .flat_map(move |(_, l)| l.start * layer..l.end * layer)
+        .flat_map(|(_, l)| ctx.grid.layer_node_ids(l))
 }
 
 /// How many times a step returns the points that the shift of their mean took outside

@@ -70,9 +70,8 @@ pub(crate) fn share_bands<D: Dim>(
     pack: impl Fn(Range<usize>) -> Vec<f64>,
     mut unpack: impl FnMut(Range<usize>, &[f64], &[f64]),
 ) -> [Option<NodeBox>; 2] {
-    let layer = grid.layer();
     let [below, above] = decomposition.bands();
-    let ids = |b: &Option<(usize, Range<usize>)>| b.as_ref().map(|(_, l)| l.start * layer..l.end * layer);
+    let ids = |b: &Option<(usize, Range<usize>)>| b.as_ref().map(|(_, l)| grid.layer_node_ids(l.clone()));
     let (ids_below, ids_above) = (ids(&below), ids(&above));
     let mine_below = ids_below.clone().map(&pack).unwrap_or_default();
     let mine_above = ids_above.clone().map(&pack).unwrap_or_default();
