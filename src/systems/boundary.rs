@@ -92,8 +92,11 @@ impl<D: Dim> System<D> for Boundary {
                     .fold([0.0; 3], |s, p| std::array::from_fn(|a| s[a] + p[d][a]))
             })
             .collect();
-        // Each rank's owned nodes' part, added in rank order.
-        ctx.comm.sum(&mut reactions);
+        // Each rank's owned nodes' part, added in rank order (no collective in a run
+        // without motions: every rank has the same).
+        if !reactions.is_empty() {
+            ctx.comm.sum(&mut reactions);
+        }
         for (drive, r) in ctx.state.control.drives.iter_mut().zip(reactions.chunks(3)) {
             drive.reaction = [r[0], r[1], r[2]];
         }
