@@ -1,9 +1,9 @@
 //! Rigid bodies (`rigid_bodies`): contact held at the body's surface, the curve of static
 //! states, the same bits on any thread count, a resumed penetration, and the refusals.
 
-mod common;
+use crate::common;
 
-use common::{factors, forces, refusal, rel, run};
+use crate::common::{factors, forces, refusal, rel, run};
 
 /// `scenes/footing_rigid.ron`: the smooth strip footing of `footing.ron` as a rigid body
 /// pushed 0.1 m into weightless Tresca clay. Prandtl's limit pressure (2 + π) c = 51.42 kPa

@@ -1,7 +1,7 @@
 //! The discretisation error by refinement (`--refine` of `kdmpm run` and `kdmpm fos`),
 //! pinned on coarse settings; the shipped-resolution figures are in docs/verification.md.
 
-mod common;
+use crate::common;
 
 use kdmpm::refine::{factor_of_safety, finer, limit_pressure, pressure, RunQuantity};
 use kdmpm::scene::{LoadedScene, TimeStep};

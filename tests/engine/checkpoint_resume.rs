@@ -4,7 +4,7 @@
 //! the first, one inside the static-check window, the step before and the step of a
 //! kinetic-energy reset — and after Ctrl-C.
 
-mod common;
+use crate::common;
 
 use kdmpm::checkpoint::{self, Header};
 use kdmpm::scene::{build, LoadedScene};

@@ -1,9 +1,9 @@
 //! The volumetric treatments against locking: what `anti_locking: CellMean` keeps true at
 //! every step, and what it does to a dilatant soil's limit load.
 
-mod common;
+use crate::common;
 
-use common::kdmpm;
+use crate::common::kdmpm;
 use kdmpm::components::{Position, Stress, Volume};
 use kdmpm::infra::columns::{col, points_with};
 use kdmpm::scene::{build, LoadedScene};

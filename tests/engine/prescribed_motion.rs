@@ -1,9 +1,8 @@
 //! Prescribed motion of grid nodes (displacement control): the reaction it reports and the
 //! limit pressure of a footing.
 
-mod common;
 
-use common::{refusal, rel, run, run_text};
+use crate::common::{refusal, rel, run, run_text};
 
 /// An elastic column between rollers, its top pushed down by δ = 1 mm in one increment:
 /// the static state is uniaxial strain ε = δ/H, σ_yy = −M δ/H with

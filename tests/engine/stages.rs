@@ -1,8 +1,8 @@
 //! Loading stages: each runs to its static stop from the state the one before left.
 
-mod common;
+use crate::common;
 
-use common::{rel, run, run_text};
+use crate::common::{rel, run, run_text};
 
 /// The bar (the paper's example 1, linear elastic) loaded with F = 0.001 and then, in a
 /// second stage, 0.002: the second static state is the analytic one for 0.002,

@@ -1,8 +1,8 @@
 //! `Friction(δ)` faces: Coulomb friction between the soil and a grid face.
 
-mod common;
+use crate::common;
 
-use common::{refusal, rel, run};
+use crate::common::{refusal, rel, run};
 
 /// `scenes/sliding_block.ron`: once the block slides, the push that moves it is the base's
 /// friction, tan δ · W = tan 20° · 39.24 kN/m = 14.28 kN/m. At rest at the end of each

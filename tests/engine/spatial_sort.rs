@@ -13,7 +13,7 @@ use kdmpm::tensor::{PlanarSym3, StoredSym};
 use kdmpm::{Dim2, Simulation, StepError, System};
 use std::collections::BTreeMap;
 
-mod common;
+use crate::common;
 
 /// The failing bank of `common::bank_on_layer`, all of sand (one archetype).
 fn simulation(steps: u64, sort_every: u64) -> Simulation<Dim2> {

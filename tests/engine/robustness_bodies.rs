@@ -3,7 +3,7 @@
 //! non-finite output. Each gives the right answer or is refused naming the field and the
 //! rule (exit 2), or stops as a run that went wrong (exit 1).
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 

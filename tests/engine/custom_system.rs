@@ -1,7 +1,7 @@
 //! The example's user system runs inside the schedule, once per step, at its named place;
 //! and every step runs on a thread of the rayon pool.
 
-#[path = "../examples/custom_system.rs"]
+#[path = "../../examples/custom_system.rs"]
 #[allow(dead_code)]
 mod example;
 

@@ -3,7 +3,7 @@
 //! scene are refused with the reason (never a panic), and only the untouched file resumes,
 //! to the bits of the run that never stopped.
 
-mod common;
+use crate::common;
 
 use kdmpm::checkpoint::{self, Header};
 use kdmpm::components::{MaterialId, PointId};

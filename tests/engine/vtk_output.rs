@@ -11,7 +11,7 @@ use kdmpm::{Dim2, Simulation};
 use std::collections::BTreeMap;
 use std::path::Path;
 
-mod common;
+use crate::common;
 
 /// The failing bank of `common::bank_on_layer` on an elastic layer (two archetypes, the bank
 /// with plastic strain, and a load carrier, which is not a material point), run 300 steps

@@ -3,7 +3,7 @@
 //! exits 2 with a message naming the field and the rule; a run that goes wrong exits 1 and
 //! writes neither NaN nor null.
 
-mod common;
+use crate::common;
 
 use kdmpm::components::NodeAcceleration;
 use kdmpm::scene::{build, LoadedScene};

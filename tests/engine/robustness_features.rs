@@ -4,7 +4,7 @@
 //! the right answer or exits 2 (bad input) or 1 (a run that went wrong) naming the field and
 //! the rule.
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};

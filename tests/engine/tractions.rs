@@ -1,8 +1,8 @@
 //! Tractions: a distributed load on a body's surface, carried by its outermost points.
 
-mod common;
+use crate::common;
 
-use common::{refusal, rel, run_text};
+use crate::common::{refusal, rel, run_text};
 
 /// An elastic column between rollers under a uniform pressure p = 10 kPa on its top:
 /// uniaxial strain, σ_yy = −p throughout and a settlement of p y/M at height y, with

@@ -7,7 +7,7 @@
 //! The cases are drawn from a fixed seed, so a run is reproducible; `KDMPM_FUZZ_CASES`
 //! sets how many (default 100 000, about half a minute on two cores in a release build).
 
-mod common;
+use crate::common;
 
 use kdmpm::scene::{build, check, LoadedScene};
 use kdmpm::with_simulation;

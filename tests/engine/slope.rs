@@ -5,7 +5,7 @@
 //! Expected angle here: Davis's effective friction angle for non-associated flow in plane
 //! strain, tan φ* = sin φ cos ψ / (1 − sin φ sin ψ) = sin 20° → φ* = 18.9°.
 
-mod common;
+use crate::common;
 
 use kdmpm::components::Mass;
 use kdmpm::infra::columns::{col, points_with};

@@ -5,8 +5,7 @@
 //! With linear shape functions both points of a cell see the same strain, so a point's
 //! stress is that of its cell centre: the depth compared is the cell centre's.
 
-mod common;
-use common::{rel, run};
+use crate::common::{rel, run};
 
 #[test]
 fn soil_column_reaches_the_k0_state_and_the_oedometric_settlement() {

@@ -7,7 +7,7 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
-mod common;
+use crate::common;
 
 /// (time, file) of every DataSet of a collection, parsed as XML.
 fn read_pvd(path: &Path) -> Vec<(f64, String)> {

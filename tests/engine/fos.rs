@@ -1,6 +1,6 @@
 //! Factor of safety by strength reduction (`kdmpm fos`).
 
-mod common;
+use crate::common;
 
 use kdmpm::fos::{reduced, strength_reduction};
 use kdmpm::materials::MohrCoulombSpec;

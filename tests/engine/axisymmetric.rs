@@ -1,9 +1,9 @@
 //! `dimension: Axisymmetric`: the hoop strain and stress, volumes per radian, the axis as a
 //! symmetry face, and the refusals.
 
-mod common;
+use crate::common;
 
-use common::{factors, refusal, rel, run};
+use crate::common::{factors, refusal, rel, run};
 use kdmpm::model::CurvePoint;
 
 /// Lamé's thick cylinder (`scenes/cylinder.ron`: a = 1 m, b = 2 m, p = 100 kPa on the bore,

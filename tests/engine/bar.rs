@@ -5,8 +5,8 @@
 //! σxx = F/A = 1.0e-3. Paper: kinetic damping converges at t = 32.3, viscous damping with
 //! β = 0.10 at t = 89.7 (Table 2).
 
-mod common;
-use common::{rel, run};
+use crate::common;
+use crate::common::{rel, run};
 
 const U_A: f64 = 4.75e-3;
 const SIGMA: f64 = 1.0e-3;

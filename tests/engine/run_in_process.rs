@@ -2,9 +2,8 @@
 //! checkpoint, and resumed from it ends with the same files, bit for bit, as a run that was
 //! never stopped.
 
-mod common;
 
-use common::{scene, scratch};
+use crate::common::{scene, scratch};
 use kdmpm::output::Outcome;
 use kdmpm::run::Run;
 use kdmpm::scene::LoadedScene;

@@ -1,8 +1,8 @@
 //! A hydrostatic water table: effective stress, saturated weight, and the checks.
 
-mod common;
+use crate::common;
 
-use common::{refusal, rel, run};
+use crate::common::{refusal, rel, run};
 use kdmpm::output::Summary;
 
 const WATER: &str = r#"water=(table: Level(8.0), saturated_density: {"soil": 2000.0})"#;

@@ -8,8 +8,8 @@
 //!   σ_yy = −ρg(H − Y),  u_y = (e^{−a(H−Y)} − e^{−aH})/a − Y.
 //! The bar (scenes/bar.ron, paper example 1) has u(x) = F x/(EA) = 0.001 x.
 
-mod common;
-use common::run;
+use crate::common;
+use crate::common::run;
 use kdmpm::components::{Mass, Position, Stress, Volume};
 use kdmpm::output::Outcome;
 use kdmpm::scene::{build, LoadedScene};

@@ -1,6 +1,6 @@
 //! Mohr-Coulomb with strain softening (`MohrCoulombSoftening`) in whole runs.
 
-mod common;
+use crate::common;
 
 use kdmpm::fos::strength_reduction;
 use kdmpm::scene::LoadedScene;
