@@ -1,7 +1,6 @@
 //! Prescribed motion of grid nodes (displacement control): the reaction it reports and the
 //! limit pressure of a footing.
 
-
 use crate::common::{refusal, rel, run, run_text};
 
 /// An elastic column between rollers, its top pushed down by δ = 1 mm in one increment:

@@ -13,7 +13,8 @@ use std::time::{Duration, Instant};
 /// `kdmpm ARGS` with `--set`s, waited for at most `limit`: a hang fails the test.
 fn kdmpm_within(args: &[&str], sets: &[&str], limit: Duration) -> Output {
     let mut cmd = Command::new(env!("CARGO_BIN_EXE_kdmpm"));
-    cmd.args(args);
+    // One worker: the harness runs two tests at once.
+    cmd.env("RAYON_NUM_THREADS", "1").args(args);
     for s in sets {
         cmd.args(["--set", s]);
     }

@@ -2,7 +2,6 @@
 //! checkpoint, and resumed from it ends with the same files, bit for bit, as a run that was
 //! never stopped.
 
-
 use crate::common::{scene, scratch};
 use kdmpm::output::Outcome;
 use kdmpm::run::Run;
