@@ -13,7 +13,7 @@ use crate::state::Scheme;
 pub const USL_COURANT_LIMIT: f64 = 0.7;
 
 /// The largest Courant number (of the slowest material) accepted with mass scaling.
-/// Measured on a soil layer on rock a million times stiffer (`tests/extremes.rs`): it
+/// Measured on a soil layer on rock a million times stiffer (`tests/engine/extremes.rs`): it
 /// settles at Courant 0.5 to 0.9 and diverges at step 59 at Courant 1.
 pub const MASS_SCALING_COURANT_LIMIT: f64 = 0.9;
 
