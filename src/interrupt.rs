@@ -31,7 +31,9 @@ pub fn requested() -> bool {
 /// sets the process's stop flag; a second one while the first is being honoured ends the
 /// process at once with exit code 130 (every file is written whole or not at all, so
 /// nothing torn is left). A process that cannot install it (another handler is installed)
-/// keeps that handler.
+/// keeps that handler. On Unix SIGUSR1 also sets the flag, and never ends the process:
+/// the signal a batch system sends ahead of a job's time limit (Slurm's `--signal`), and
+/// one that `mpirun` passes on to every rank.
 pub fn catch_signals() {
     static INSTALL: Once = Once::new();
     INSTALL.call_once(|| {
@@ -40,6 +42,18 @@ pub fn catch_signals() {
                 std::process::exit(INTERRUPTED_EXIT.into());
             }
         });
+        #[cfg(unix)]
+        {
+            extern "C" fn on_usr1(_: libc::c_int) {
+                // Async-signal-safe: one atomic store.
+                REQUESTED.store(true, Ordering::SeqCst);
+            }
+            // SAFETY: `on_usr1` only stores to an atomic, which is async-signal-safe, and the
+            // disposition of SIGUSR1 is not otherwise used by this process.
+            unsafe {
+                libc::signal(libc::SIGUSR1, on_usr1 as *const () as libc::sighandler_t);
+            }
+        }
     });
 }
 

@@ -335,6 +335,9 @@ pub struct RankCounters {
     pub migrations: u64,
     /// How many times the cell layers were split again.
     pub rebalances: u64,
+    /// The step this process started from (a resumed run's checkpoint step; 0 otherwise):
+    /// the bytes sent are this process's, over the steps since.
+    pub first_step: u64,
 }
 
 impl SolverState {

@@ -489,3 +489,144 @@ fn snapshots_on_2_ranks_hold_every_point_once_as_one_rank_does() {
         );
     }
 }
+
+/// `mpirun -n RANKS kdmpm ARGS` (one thread each), waited for.
+fn kdmpm_on(ranks: usize, args: &[&str]) -> std::process::Output {
+    Command::new("mpirun")
+        .args(["--allow-run-as-root", "--oversubscribe", "-n", &ranks.to_string()])
+        .arg(env!("CARGO_BIN_EXE_kdmpm"))
+        .args(args)
+        .args(["--quiet", "--threads", "1"])
+        .output()
+        .expect("mpirun starts")
+}
+
+/// summary.json without the figures of the machine (wall time, memory, timings).
+fn summary_numbers(dir: &Path) -> Value {
+    let text = std::fs::read_to_string(dir.join("summary.json")).expect("summary.json");
+    let mut v: Value = serde_json::from_str(&text).expect("JSON");
+    for key in [
+        "wall_seconds",
+        "particle_steps_per_second",
+        "peak_memory_bytes",
+        "systems",
+        "output_wait_seconds",
+    ] {
+        v.as_object_mut().expect("an object").remove(key);
+    }
+    // The bytes sent are the process's, over the steps it made.
+    v["ranks"]
+        .as_object_mut()
+        .expect("a run over ranks")
+        .remove("bytes_per_step");
+    v
+}
+
+/// The results of run directories `a` and `b` over `ranks` ranks have the same bytes:
+/// history, curve, the final points (the `.pvtu` and every rank's piece) and the summary's
+/// figures.
+fn same_results_over(a: &Path, b: &Path, ranks: usize) {
+    let mut files: Vec<String> = vec!["history.csv".into(), "points.pvtu".into()];
+    files.extend((0..ranks).map(|r| format!("points_{r}.vtu")));
+    if a.join("curve.csv").exists() {
+        files.push("curve.csv".into());
+    }
+    for f in &files {
+        let (x, y) = (std::fs::read(a.join(f)), std::fs::read(b.join(f)));
+        assert!(
+            x.is_ok() && x.ok() == y.ok(),
+            "{f} differs between {} and {}",
+            a.display(),
+            b.display()
+        );
+    }
+    assert_eq!(summary_numbers(a), summary_numbers(b));
+}
+
+fn copy_dir(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).expect("a directory");
+    for e in std::fs::read_dir(from).expect("a directory").flatten() {
+        if e.file_type().expect("a file type").is_dir() {
+            copy_dir(&e.path(), &to.join(e.file_name()));
+        } else {
+            std::fs::copy(e.path(), to.join(e.file_name())).expect("copied");
+        }
+    }
+}
+
+/// The fast slope on 2 ranks with a checkpoint every 2 000 steps (it stops at 3 767): each
+/// rank writes its part, rank 0 the manifest; resumed from step 2 000 on 2 ranks it writes
+/// the bytes of the run that never stopped (points migrate and the split is made again
+/// after the checkpoint). On one rank or on 3 the checkpoint is refused with the count.
+#[test]
+fn the_slope_checkpointed_on_2_ranks_resumes_to_the_bytes_of_the_uninterrupted_run() {
+    let (run, _) = run_on(
+        "slope_fast.ron",
+        2,
+        "ckpt",
+        &["solver.checkpoint_every=Steps(2000)"],
+    );
+    let manifest = std::fs::read(run.join("checkpoint.kdc")).expect("the manifest");
+    assert!(manifest.starts_with(b"KDMPMMF\0"));
+    for r in 0..2 {
+        assert!(
+            run.join(format!("checkpoint.{:012}.{r}.kdc", 2000)).exists(),
+            "rank {r}'s part"
+        );
+    }
+    let parts = std::fs::read_dir(&run)
+        .expect("the run's directory")
+        .flatten()
+        .filter(|e| e.file_name().to_string_lossy().ends_with(".kdc"))
+        .count();
+    assert_eq!(parts, 3, "the manifest and the last checkpoint's two parts");
+    let full = run.with_file_name("ckpt-full");
+    let _ = std::fs::remove_dir_all(&full);
+    copy_dir(&run, &full);
+    let dir = run.to_str().expect("UTF-8");
+    for ranks in [1, 3] {
+        let o = kdmpm_on(ranks, &["resume", dir]);
+        let e = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "resumed on {ranks}: {e}");
+        assert!(e.contains("2 ranks"), "resumed on {ranks}: {e}");
+    }
+    let o = kdmpm_on(2, &["resume", dir]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    same_results_over(&run, &full, 2);
+}
+
+/// SIGTERM to `mpirun` (what a batch system sends at a job's time limit) mid-run: mpirun
+/// passes it to every rank, the ranks stop together after the same step and leave a
+/// checkpoint, and the run resumed on 2 ranks writes the bytes of the 2-rank run that was
+/// never interrupted.
+#[test]
+fn sigterm_to_mpirun_leaves_a_checkpoint_that_resumes_to_the_uninterrupted_bytes() {
+    let steps = "solver.max_steps=3000";
+    let (whole, _) = run_on("slope.ron", 2, "term-whole", &[steps]);
+    let cut = common::scratch("mpi", "term-cut");
+    let scene = common::scene("slope.ron");
+    let child = Command::new("mpirun")
+        .args(["--allow-run-as-root", "--oversubscribe", "-n", "2"])
+        .arg(env!("CARGO_BIN_EXE_kdmpm"))
+        .args(["run", scene.to_str().expect("UTF-8"), "--quiet", "--threads", "1"])
+        .args(["--set", steps, "--out"])
+        .arg(&cut)
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("mpirun starts");
+    common::wait_until_running(&cut);
+    common::signal(child.id(), "TERM");
+    let o = child.wait_with_output().expect("mpirun ends");
+    let summary = summary_numbers(&cut);
+    assert_eq!(
+        summary["outcome"],
+        "interrupted",
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(summary["steps"].as_u64().expect("steps") < 3000);
+    assert!(cut.join("checkpoint.kdc").exists());
+    let o = kdmpm_on(2, &["resume", cut.to_str().expect("UTF-8")]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    same_results_over(&cut, &whole, 2);
+}

@@ -136,7 +136,8 @@ pub struct Ranks {
     /// Each rank's first cell layer, and the end of the last (the final split).
     pub bounds: Vec<usize>,
     /// Bytes the ranks sent each other, all ranks together, per step (exchanges of shared
-    /// nodes and of moving points, and the reductions).
+    /// nodes and of moving points, and the reductions), over the steps this invocation
+    /// made (a resumed run's since its checkpoint).
     pub bytes_per_step: f64,
 }
 
@@ -250,7 +251,7 @@ impl Summary {
                 migrations: migrations[0] as u64,
                 rebalances: s.ranks.rebalances,
                 bounds: sim.ctx.decomposition.bounds.clone(),
-                bytes_per_step: migrations[1] / s.clock.step.max(1) as f64,
+                bytes_per_step: migrations[1] / (s.clock.step - s.ranks.first_step).max(1) as f64,
             }
         });
         let rigid_bodies = body_results(sim);

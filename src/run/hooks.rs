@@ -8,11 +8,13 @@ use crate::dim::Dim;
 use crate::error::StepError;
 use crate::interrupt::StopSignal;
 use crate::measure::max_displacements;
-use crate::output::{history, OutputDir, Progress, RowFile};
+use crate::output::dir::write_atomic;
+use crate::output::{history, Progress, RowFile};
 use crate::scene::CheckpointEvery;
 use crate::simulation::Simulation;
 use crate::state::StopReason;
 use std::io::Write;
+use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
@@ -54,7 +56,9 @@ pub(crate) struct StopOnRequest(pub StopSignal);
 
 impl<D: Dim> Hook<D> for StopOnRequest {
     fn after_step(&mut self, sim: &mut Simulation<D>) -> Result<(), StepError> {
-        if sim.ctx.state.stop.is_none() && self.0.requested() {
+        // Over several ranks every rank stops after the same step, the first after any
+        // rank's signal came (a collective).
+        if sim.ctx.state.stop.is_none() && sim.ctx.comm.any(self.0.requested()) {
             sim.ctx.state.stop = Some(StopReason::Interrupted);
         }
         Ok(())
@@ -63,38 +67,48 @@ impl<D: Dim> Hook<D> for StopOnRequest {
 
 /// Writes `checkpoint.kdc` at the scene's cadence and when the run is interrupted (it runs
 /// after [`StopOnRequest`]). The history is flushed first, and its committed length and
-/// CRC-32 go into the header, so that a resumed run continues exactly that history.
-pub(crate) struct Checkpoints<'d> {
-    pub dir: &'d OutputDir,
+/// CRC-32 go into the header, so that a resumed run continues exactly that history. Over
+/// several ranks every rank holds one, rank 0 the history's rows, and each checkpoint is
+/// the ranks' parts and rank 0's manifest ([`checkpoint::parts`]), taken after the same step.
+pub(crate) struct Checkpoints {
+    pub dir: PathBuf,
     pub every: Option<CheckpointEvery>,
     pub header: checkpoint::Header,
-    pub rows: Arc<Mutex<RowFile>>,
+    /// The history's rows (rank 0's; none on the other ranks).
+    pub rows: Option<Arc<Mutex<RowFile>>>,
     /// Wall seconds of the run before this invocation (a resumed run's).
     pub before: f64,
     pub start: Instant,
     pub last: Instant,
 }
 
-impl<D: Dim> Hook<D> for Checkpoints<'_> {
+impl<D: Dim> Hook<D> for Checkpoints {
     fn after_step(&mut self, sim: &mut Simulation<D>) -> Result<(), StepError> {
-        let st = &sim.ctx.state;
+        let (st, comm) = (&sim.ctx.state, &sim.ctx.comm);
         let interrupted = st.stop == Some(StopReason::Interrupted);
         let due = st.stop.is_none()
             && match self.every {
                 Some(CheckpointEvery::Steps(n)) => st.clock.step.is_multiple_of(n),
-                Some(CheckpointEvery::Seconds(t)) => self.last.elapsed().as_secs_f64() >= t,
+                // Each rank's clock, and any rank's decides (a collective).
+                Some(CheckpointEvery::Seconds(t)) => comm.any(self.last.elapsed().as_secs_f64() >= t),
                 None => false,
             };
-        if interrupted || due {
-            self.last = Instant::now();
-            let mut rows = history::lock(&self.rows);
+        if !(interrupted || due) {
+            return Ok(());
+        }
+        self.last = Instant::now();
+        if let Some(rows) = &self.rows {
+            let mut rows = history::lock(rows);
             rows.flush()?;
             self.header.history_bytes = rows.committed();
             self.header.history_crc = rows.committed_crc();
-            self.header.wall_seconds = self.before + self.start.elapsed().as_secs_f64();
+        }
+        self.header.wall_seconds = self.before + self.start.elapsed().as_secs_f64();
+        if comm.size() > 1 {
+            checkpoint::parts::write(sim, &self.header, &self.dir)?;
+        } else {
             let bytes = checkpoint::encode(sim, &self.header);
-            self.dir
-                .write_atomic(checkpoint::FILE_NAME, |out| out.write_all(&bytes))?;
+            write_atomic(&self.dir.join(checkpoint::FILE_NAME), |out| out.write_all(&bytes))?;
         }
         Ok(())
     }

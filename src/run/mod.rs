@@ -227,14 +227,14 @@ impl<'a> Run<'a> {
             Start::Scene(loaded) => {
                 let (mut sim, _) = build(&loaded)?;
                 if watch.comm.size() > 1 {
-                    return with_simulation!(&mut sim, s => ranks::go(s, &loaded, watch));
+                    return with_simulation!(&mut sim, s => ranks::go(s, &loaded, watch, None));
                 }
                 let dir = watch.out.as_deref().map(claim).transpose()?;
                 if let Some(dir) = &dir {
                     // A checkpoint left by an earlier run belongs to that run: resuming it
                     // would cut this run's history.csv at the old length and continue
                     // another problem.
-                    crate::output::dir::remove_if_there(&dir.file(checkpoint::FILE_NAME)).map_err(|e| {
+                    checkpoint::parts::remove_earlier(dir.path()).map_err(|e| {
                         RunError::OutputDir(format!("cannot remove the earlier run's checkpoint: {e}"))
                     })?;
                 }
@@ -246,6 +246,31 @@ impl<'a> Run<'a> {
                 };
                 with_simulation!(&mut sim, s => watch.drive(s, &loaded, dir.as_ref(), None, header))
             }
+            Start::Checkpoint(dir) if watch.comm.size() > 1 => {
+                let comm = watch.comm.clone();
+                // Every rank reads the manifest and its own part; one that cannot, stops all.
+                let read = checkpoint::parts::read(&dir, comm.rank(), comm.size());
+                if comm.any(read.is_err()) {
+                    return Err(match read {
+                        Err(e) => e.into(),
+                        Ok(_) => RunError::Ranks(format!(
+                            "{}: another rank could not read its part of the checkpoint",
+                            dir.display()
+                        )),
+                    });
+                }
+                let (manifest, part, file) = read.expect("read above");
+                let header = &manifest.header;
+                let loaded = LoadedScene::from_text(&header.scene_path, &header.scene_text, &[])?;
+                check_meshes(&loaded, header, &dir.join(checkpoint::FILE_NAME))?;
+                let (mut sim, _) = build(&loaded)?;
+                let resume = ranks::Resume {
+                    manifest: &manifest,
+                    part: &part,
+                    file: &file,
+                };
+                with_simulation!(&mut sim, s => ranks::go(s, &loaded, watch, Some(resume)))
+            }
             Start::Checkpoint(dir) => {
                 let file = dir.join(checkpoint::FILE_NAME);
                 let bytes = std::fs::read(&file).map_err(|source| CheckpointError::Io {
@@ -254,16 +279,7 @@ impl<'a> Run<'a> {
                 })?;
                 let header = checkpoint::header(&bytes, &file)?;
                 let loaded = LoadedScene::from_text(&header.scene_path, &header.scene_text, &[])?;
-                if loaded.mesh_crc() != header.meshes_crc {
-                    return Err(CheckpointError::Format {
-                        path: file,
-                        reason: "an STL mesh of the scene differs from the one the run was \
-                                 started with (replaced or moved since): put the file back, or \
-                                 start the run again"
-                            .into(),
-                    }
-                    .into());
-                }
+                check_meshes(&loaded, &header, &file)?;
                 let (mut sim, _) = build(&loaded)?;
                 let dir = claim(&dir)?;
                 with_simulation!(&mut sim, s => {
@@ -328,10 +344,10 @@ impl Watch<'_> {
         hooks.push(Box::new(StopOnRequest(self.stop)));
         if let (true, Some(dir), Some(recorder)) = (self.checkpoints, dir, &recorder) {
             hooks.push(Box::new(Checkpoints {
-                dir,
+                dir: dir.path().to_path_buf(),
                 every: loaded.scene.solver.checkpoint_every,
                 header,
-                rows: recorder.rows().clone(),
+                rows: Some(recorder.rows().clone()),
                 before,
                 start,
                 last: Instant::now(),
@@ -365,6 +381,20 @@ impl Watch<'_> {
             dir: dir.map(|d| d.path().to_path_buf()),
         })
     }
+}
+
+/// A resumed run's scene reads the STL meshes it was started with (`file`: the checkpoint).
+fn check_meshes(loaded: &LoadedScene, header: &checkpoint::Header, file: &Path) -> Result<(), RunError> {
+    if loaded.mesh_crc() == header.meshes_crc {
+        return Ok(());
+    }
+    Err(CheckpointError::Format {
+        path: file.to_path_buf(),
+        reason: "an STL mesh of the scene differs from the one the run was started with \
+                 (replaced or moved since): put the file back, or start the run again"
+            .into(),
+    }
+    .into())
 }
 
 /// Takes the output directory `path` for this run.

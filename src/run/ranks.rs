@@ -1,8 +1,8 @@
 //! A run over MPI ranks: each rank steps its part of the scene; rank 0 writes history.csv,
 //! summary.json (the ranks' figures) and points.pvtu, every rank its own
-//! `points_<rank>.vtu`.
+//! `points_<rank>.vtu` and its part of each checkpoint ([`checkpoint::parts`]).
 
-use super::hooks::Hook;
+use super::hooks::{Checkpoints, Hook, StopOnRequest};
 use super::{claim, RunError, RunReport, Watch};
 use crate::checkpoint;
 use crate::dim::Dim;
@@ -13,27 +13,51 @@ use crate::scene::LoadedScene;
 use crate::simulation::Simulation;
 use std::time::Instant;
 
-/// Steps this rank's part of `sim`; rank 0 through the runner's hooks and outputs.
+/// What a rank resumes from: the manifest, its own part's bytes and file.
+pub(super) struct Resume<'a> {
+    pub manifest: &'a checkpoint::parts::Manifest,
+    pub part: &'a [u8],
+    pub file: &'a std::path::Path,
+}
+
+/// Steps this rank's part of `sim` (built from the scene, or from the checkpoint's scene
+/// when `resume` is given); rank 0 through the runner's hooks and outputs.
 pub(super) fn go<D: Dim>(
     sim: &mut Simulation<D>,
     loaded: &LoadedScene,
     watch: Watch<'_>,
+    resume: Option<Resume<'_>>,
 ) -> Result<RunReport, RunError> {
     let comm = watch.comm.clone();
-    let refuse = |what: String| RunError::Ranks(format!("{}: {what}", loaded.path.display()));
-    if loaded.scene.solver.checkpoint_every.is_some() {
-        return Err(refuse(format!(
-            "a run over {} ranks does not yet write checkpoints: remove \
-             solver.checkpoint_every, or run on one rank",
-            comm.size()
-        )));
-    }
+    let total = sim.point_count();
     super::distribute::decompose(sim, comm.clone());
+    if let Some(r) = &resume {
+        // This rank's points, state and split as saved; a rank that cannot stops all.
+        let restored = checkpoint::restore_part(sim, r.part, r.file, total);
+        if comm.any(restored.is_err()) {
+            return Err(match restored {
+                Err(e) => e.into(),
+                Ok(_) => RunError::Ranks(format!(
+                    "{}: another rank could not restore its part of the checkpoint",
+                    r.file.display()
+                )),
+            });
+        }
+    }
     // Every rank gathers the traced points for rank 0's history, before it is written.
     let gather = TracedGather::new(&sim.traced);
     sim.schedule.push(gather);
     let dir = match (&watch.out, comm.is_root()) {
-        (Some(out), true) => Some(claim(out)),
+        (Some(out), true) => Some(claim(out).and_then(|d| {
+            // A fresh run's directory keeps no checkpoint of an earlier run: its parts would
+            // be taken for this run's. Removed before any rank writes one.
+            if resume.is_none() {
+                checkpoint::parts::remove_earlier(d.path()).map_err(|e| {
+                    RunError::OutputDir(format!("cannot remove the earlier run's checkpoint: {e}"))
+                })?;
+            }
+            Ok(d)
+        })),
         _ => None,
     };
     // Whether rank 0 holds the directory: the others write into it.
@@ -43,20 +67,26 @@ pub(super) fn go<D: Dim>(
             _ => RunError::OutputDir("rank 0 could not take the output directory".into()),
         });
     }
-    if comm.is_root() {
-        let dir = dir.transpose()?;
-        let header = checkpoint::Header {
+    let header = match &resume {
+        Some(r) => r.manifest.header.clone(),
+        None => checkpoint::Header {
             scene_path: loaded.path.clone(),
             scene_text: loaded.text.clone(),
+            meshes_crc: loaded.mesh_crc(),
             ..checkpoint::Header::default()
-        };
-        return watch.drive(sim, loaded, dir.as_ref(), None, header);
+        },
+    };
+    if comm.is_root() {
+        let dir = dir.transpose()?;
+        let mark = resume.map(|r| (r.manifest.header.history_bytes, r.manifest.header.history_crc));
+        return watch.drive(sim, loaded, dir.as_ref(), mark, header);
     }
     // This rank's part of each snapshot (rank 0's recorder writes the rest).
+    let resumed = resume.is_some().then_some(sim.ctx.state.clock.time);
     let snapshots = match (&watch.out, loaded.scene.output.snapshots) {
         (Some(out), Some(spec)) => {
             let ranks = (comm.rank(), comm.size());
-            let (system, writer) = Snapshots::<D>::start(out, spec, None, ranks).map_err(|e| {
+            let (system, writer) = Snapshots::<D>::start(out, spec, resumed, ranks).map_err(|e| {
                 RunError::Results(format!("rank {}: cannot start its snapshots: {e}", comm.rank()))
             })?;
             sim.schedule.push(system);
@@ -64,13 +94,26 @@ pub(super) fn go<D: Dim>(
         }
         _ => None,
     };
+    // The collective hooks of rank 0's, in its order: the stop request, the checkpoints
+    // (this rank's part of each), a strength-reduction trial's limit.
+    let mut hooks: Vec<Box<dyn Hook<D> + Send + '_>> = vec![Box::new(StopOnRequest(watch.stop.clone()))];
+    if let (true, Some(out)) = (watch.checkpoints, &watch.out) {
+        hooks.push(Box::new(Checkpoints {
+            dir: out.clone(),
+            every: loaded.scene.solver.checkpoint_every,
+            header: header.clone(),
+            rows: None,
+            before: header.wall_seconds,
+            start: Instant::now(),
+            last: Instant::now(),
+        }));
+    }
+    if let Some(limit) = watch.limit {
+        hooks.push(Box::new(limit));
+    }
     let start = Instant::now();
-    // A strength-reduction trial's limit is every rank's decision (a collective).
-    let mut limit = watch.limit;
-    let result = sim.run_with(|s| match &mut limit {
-        Some(l) => Hook::after_step(l, s),
-        None => Ok(()),
-    });
+    let result = sim.run_with(|s| hooks.iter_mut().try_for_each(|h| h.after_step(s)));
+    drop(hooks);
     // A state with a non-finite value comes with the run's error, reported with it.
     let unwritten = watch
         .out

@@ -70,6 +70,7 @@ fn command(command: Command, comm: &Arc<Comm>) -> Result<ExitCode, Fault> {
         && !matches!(
             command,
             Command::Run { .. }
+                | Command::Resume { .. }
                 | Command::Fos {
                     refining: cli::Refining { refine: None },
                     ..
@@ -77,16 +78,15 @@ fn command(command: Command, comm: &Arc<Comm>) -> Result<ExitCode, Fault> {
         )
     {
         return Err(Fault::bad(format!(
-            "kdmpm was started on {} ranks; only `kdmpm run` and `kdmpm fos` are split across \
-             ranks: start the other commands (and `--refine`) without mpirun",
+            "kdmpm was started on {} ranks; only `kdmpm run`, `kdmpm resume` and `kdmpm fos` \
+             are split across ranks: start the other commands (and `--refine`) without mpirun",
             comm.size()
         )));
     }
-    // Over several ranks a signal is mpirun's to pass on (a checkpoint would be rank 0's
-    // alone).
-    if comm.size() == 1 {
-        kdmpm::catch_signals();
-    }
+    // Over several ranks each rank catches the signal the launcher passes on (mpirun: SIGTERM
+    // before it kills the job, SIGUSR1 as it is; Slurm: SIGTERM at the time limit), and the
+    // ranks stop together after the same step.
+    kdmpm::catch_signals();
     let (threads, trace) = match &command {
         Command::Run { stepping, trace, .. } => (stepping.workers.threads, trace.clone()),
         Command::Resume { stepping, .. } => (stepping.workers.threads, None),
@@ -130,8 +130,8 @@ fn command(command: Command, comm: &Arc<Comm>) -> Result<ExitCode, Fault> {
             workers,
         } => run_fos(&scene, out, &overrides, refining.refine, workers.quiet, comm)?,
         Command::Resume { dir, stepping } => {
-            let run = Run::resume(dir).quiet(stepping.workers.quiet).go();
-            return report(run, stepping, comm);
+            let run = Run::resume(dir).quiet(stepping.workers.quiet).over(comm.clone());
+            return report(run.go(), stepping, comm);
         }
         Command::Run {
             scene,

@@ -14,24 +14,30 @@
 //! by this build of kdmpm (a fingerprint of its sources), carries the scene its hash says,
 //! continues the `history.csv` beside it (a CRC-32 of the rows it had written), and holds
 //! only ids within range: a damaged or foreign checkpoint is never resumed.
+//!
+//! A run over MPI ranks writes one such file per rank, of that rank's points, and a
+//! manifest written last that ties them together ([`parts`]).
+
+pub mod parts;
 
 use crate::components::*;
 use crate::dim::Dim;
 use crate::grid::NodeBox;
 use crate::infra::columns::points_with;
+use crate::infra::decomposition::Decomposition;
 use crate::model::{Control, CurvePoint, Drive, StageResult};
 use crate::parallel::SlabCache;
 use crate::rigid::BodyState;
 use crate::simulation::Simulation;
 use crate::state::{Clock, Convergence, EnergyWindow, Peak, RankCounters, Resets, SolverState, StaticWindow};
-use hecs::Archetype;
+use hecs::{Archetype, Entity, EntityBuilder};
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 
 /// The first bytes of a checkpoint file.
 const MAGIC: &[u8; 8] = b"KDMPMCK\0";
 /// Format version; a file of another version is refused.
-const VERSION: u32 = 12;
+const VERSION: u32 = 13;
 /// The build that writes and reads checkpoints: the crate's version and a fingerprint of
 /// its sources (build.rs).
 pub const BUILD_ID: &str = concat!(env!("CARGO_PKG_VERSION"), "+", env!("KDMPM_SOURCE_HASH"));
@@ -81,18 +87,9 @@ pub struct Header {
 /// Serialises the header, the solver state and every point column of `sim`.
 pub fn encode<D: Dim>(sim: &Simulation<D>, header: &Header) -> Vec<u8> {
     let mut w = Writer(Vec::new());
-    w.0.extend_from_slice(MAGIC);
-    w.u32(VERSION);
-    w.str(BUILD_ID);
-    w.u64(D::N as u64);
-    w.str(&header.scene_path.to_string_lossy());
-    w.str(&header.scene_text);
-    w.u32(crc32fast::hash(header.scene_text.as_bytes()));
-    w.u64(header.history_bytes);
-    w.u32(header.history_crc);
-    w.f64(header.wall_seconds);
-    w.u32(header.meshes_crc);
+    w.header(MAGIC, D::N as u64, header);
     encode_state(&mut w, &sim.ctx.state);
+    encode_ranks(&mut w, &sim.ctx.decomposition, &sim.ctx.state.ranks);
     let archs: Vec<&Archetype> = points_with::<Position<D::Vec>>(&sim.ctx.world).collect();
     w.u64(archs.len() as u64);
     for arch in archs {
@@ -118,15 +115,13 @@ pub fn encode<D: Dim>(sim: &Simulation<D>, header: &Header) -> Vec<u8> {
         }
         point_components!(D, save);
     }
-    let crc = crc32fast::hash(&w.0);
-    w.u32(crc);
-    w.0
+    w.finish()
 }
 
 /// Reads the header of checkpoint bytes (the scene to build before [`restore`]).
 pub fn header(bytes: &[u8], path: &Path) -> Result<Header, CheckpointError> {
     let mut r = Reader::new(bytes, path);
-    r.header()
+    r.header(MAGIC)
 }
 
 /// Puts the state saved in `bytes` into `sim`, freshly built from the checkpoint's scene.
@@ -135,26 +130,99 @@ pub fn restore<D: Dim>(
     bytes: &[u8],
     path: &Path,
 ) -> Result<Header, CheckpointError> {
+    let total = sim.point_count();
+    restore_part(sim, bytes, path, total)
+}
+
+/// Puts one rank's part of a run over ranks ([`parts`]), or the whole state of a run on
+/// one rank, into `sim`: built from the checkpoint's scene and, over ranks, split by
+/// [`crate::run::distribute::decompose`]. `total` is the scene's point count over every
+/// rank. Over ranks the rank's points are spawned again as saved (a rank holds the points
+/// that migrated to it, not those of the first split), with the cell layers each rank held.
+pub fn restore_part<D: Dim>(
+    sim: &mut Simulation<D>,
+    bytes: &[u8],
+    path: &Path,
+    total: usize,
+) -> Result<Header, CheckpointError> {
     let mut r = Reader::new(bytes, path);
-    let header = r.header()?;
+    let header = r.header(MAGIC)?;
     if r.dimension != D::N as u64 {
         return Err(r.fault(format!("saved in {}D, the scene is {}D", r.dimension, D::N)));
     }
-    let state = decode_state(&mut r)?;
+    let mut state = decode_state(&mut r)?;
+    let (ranks, rank, bounds) = decode_ranks(&mut r, &mut state.ranks)?;
+    let (size, here) = (sim.ctx.comm.size(), sim.ctx.comm.rank());
+    if (ranks, rank) != (size, here) {
+        return Err(r.fault(format!(
+            "rank {rank} of a run over {ranks} ranks, read by rank {here} of {size}: resume a \
+             run with the rank count it was started with"
+        )));
+    }
+    let layers = sim.ctx.grid.axes[sim.ctx.grid.slab_axis].cells;
+    if bounds.len() != ranks + 1
+        || bounds[0] != 0
+        || bounds[ranks] != layers
+        || bounds.windows(2).any(|b| b[0] > b[1])
+    {
+        return Err(r.fault("the saved cell layers of the ranks do not fit the grid".into()));
+    }
+    if ranks > 1 {
+        respawn(sim, &mut r)?;
+    } else {
+        overwrite(sim, &mut r)?;
+    }
+    if r.at != r.bytes.len() {
+        return Err(r.fault("bytes left after the last column".into()));
+    }
+    check_ids(sim, &state, total).map_err(|reason| r.fault(reason))?;
+    state.ranks.first_step = state.clock.step;
+    sim.ctx.state = state;
+    sim.ctx.decomposition = Decomposition {
+        bounds,
+        ..sim.ctx.decomposition.clone()
+    };
+    // Nodes are zero and no box is active right after building, as after a grid reset.
+    sim.ctx.state.active_nodes = NodeBox::default();
+    sim.ctx.slabs = SlabCache::default();
+    for t in &mut sim.traced {
+        // Over ranks a traced point is on one rank only (the others gather it each step).
+        if let Some(e) = t.find(&sim.ctx.world) {
+            t.entity = e;
+        } else if ranks == 1 {
+            t.entity = t.current_entity(&sim.ctx.world);
+        }
+    }
+    Ok(header)
+}
+
+/// The saved columns of one archetype: the row count and each column's type name and bytes.
+type SavedArchetype<'a> = (u64, Vec<(String, &'a [u8])>);
+
+/// Reads one archetype's columns.
+fn saved_archetype<'a>(r: &mut Reader<'a>) -> Result<SavedArchetype<'a>, CheckpointError> {
+    let rows = r.u64()?;
+    let columns = r.u64()?;
+    let mut saved = Vec::new();
+    for _ in 0..columns {
+        let name = r.str()?;
+        let n = r.u64()? as usize;
+        saved.push((name, r.take(n)?));
+    }
+    Ok((rows, saved))
+}
+
+/// Overwrites the point columns of `sim`, built from the scene with the saved row counts
+/// (a run on one rank).
+fn overwrite<D: Dim>(sim: &mut Simulation<D>, r: &mut Reader) -> Result<(), CheckpointError> {
     let archs: Vec<&Archetype> = points_with::<Position<D::Vec>>(&sim.ctx.world).collect();
     if r.u64()? != archs.len() as u64 {
         return Err(r.fault("the scene's point archetypes differ from the saved ones".into()));
     }
     for arch in archs {
-        if r.u64()? != arch.len() as u64 {
+        let (rows, mut saved) = saved_archetype(r)?;
+        if rows != arch.len() as u64 {
             return Err(r.fault("a point archetype's row count differs from the saved one".into()));
-        }
-        let columns = r.u64()?;
-        let mut saved = Vec::new();
-        for _ in 0..columns {
-            let name = r.str()?;
-            let n = r.u64()? as usize;
-            saved.push((name, r.take(n)?));
         }
         macro_rules! load {
             ($($t:ty),*) => {$(
@@ -182,18 +250,65 @@ pub fn restore<D: Dim>(
             return Err(r.fault(format!("column {name} is saved but the scene's points lack it")));
         }
     }
-    if r.at != r.bytes.len() {
-        return Err(r.fault("bytes left after the last column".into()));
+    Ok(())
+}
+
+/// Replaces this rank's points by the saved ones, archetype by archetype and row by row in
+/// the saved order (a run over ranks: its points are those that migrated to it). Every
+/// point archetype exists already (each rank built the whole scene), so each saved one is
+/// appended to the same archetype, in the same order, as in the run that wrote it.
+fn respawn<D: Dim>(sim: &mut Simulation<D>, r: &mut Reader) -> Result<(), CheckpointError> {
+    let world = &mut sim.ctx.world;
+    let held: Vec<Entity> = world
+        .query::<(Entity, &Position<D::Vec>)>()
+        .iter()
+        .map(|(e, _)| e)
+        .collect();
+    for e in held {
+        world.despawn(e).expect("a point found above");
     }
-    check_ids(sim, &state).map_err(|reason| r.fault(reason))?;
-    sim.ctx.state = state;
-    // Nodes are zero and no box is active right after building, as after a grid reset.
-    sim.ctx.state.active_nodes = NodeBox::default();
-    sim.ctx.slabs = SlabCache::default();
-    for t in &mut sim.traced {
-        t.entity = t.current_entity(&sim.ctx.world);
+    for _ in 0..r.u64()? {
+        let (rows, saved) = saved_archetype(r)?;
+        let rows = usize::try_from(rows).map_err(|_| r.fault("a row count out of range".into()))?;
+        // Each saved column by its type: its values, one a row.
+        let mut found = vec![false; saved.len()];
+        let mut builders: Vec<EntityBuilder> = (0..rows).map(|_| EntityBuilder::new()).collect();
+        macro_rules! add {
+            ($($t:ty),*) => {$(
+                let name = std::any::type_name::<$t>();
+                if let Some(at) = saved.iter().position(|(s, _)| s == name) {
+                    let src = saved[at].1;
+                    let n = std::mem::size_of::<$t>();
+                    if src.len() != n * rows {
+                        return Err(r.fault(format!("column {name} has another length")));
+                    }
+                    found[at] = true;
+                    for (i, b) in builders.iter_mut().enumerate() {
+                        // SAFETY: `src` holds `rows` values of this type, written by `encode`
+                        // from a column of it (a plain struct of f64, u32 or u16 fields for
+                        // which every bit pattern it was written with is valid, the file's
+                        // checksum whole); the read is unaligned-safe.
+                        let v: $t = unsafe { std::ptr::read_unaligned(src[i * n..].as_ptr().cast::<$t>()) };
+                        b.add(v);
+                    }
+                }
+            )*};
+        }
+        point_components!(D, add);
+        if let Some(at) = found.iter().position(|f| !f) {
+            return Err(r.fault(format!("column {} is saved but no point has it", saved[at].0)));
+        }
+        if !saved
+            .iter()
+            .any(|(s, _)| s == std::any::type_name::<Position<D::Vec>>())
+        {
+            return Err(r.fault("a saved archetype has no positions".into()));
+        }
+        for mut b in builders {
+            world.spawn(b.build());
+        }
     }
-    Ok(header)
+    Ok(())
 }
 
 /// The ids and counts the restored columns and state hold are within the scene's ranges:
@@ -201,7 +316,7 @@ pub fn restore<D: Dim>(
 /// count, the motions, stages and loads under control are the scene's. Whole files of
 /// this build never fail this; it guards what the checksum cannot (a file of another
 /// scene made to fit).
-fn check_ids<D: Dim>(sim: &Simulation<D>, state: &SolverState) -> Result<(), String> {
+fn check_ids<D: Dim>(sim: &Simulation<D>, state: &SolverState, count: usize) -> Result<(), String> {
     let world = &sim.ctx.world;
     let materials = sim.ctx.materials.len();
     for arch in points_with::<MaterialId>(world) {
@@ -215,7 +330,6 @@ fn check_ids<D: Dim>(sim: &Simulation<D>, state: &SolverState) -> Result<(), Str
             ));
         }
     }
-    let count = sim.point_count();
     let mut seen = vec![false; count];
     for arch in points_with::<PointId>(world) {
         for id in crate::infra::columns::col::<PointId>(arch).iter() {
@@ -319,6 +433,36 @@ fn decode_state(r: &mut Reader) -> Result<SolverState, CheckpointError> {
         active_nodes: NodeBox::default(),
         points_reordered: r.u8()? == 1,
     })
+}
+
+/// The split over ranks: the rank count, this rank, every rank's first cell layer (and
+/// the end), and this rank's migration counters (in the summary).
+fn encode_ranks(w: &mut Writer, d: &Decomposition, counters: &RankCounters) {
+    w.u64(d.ranks() as u64);
+    w.u64(d.rank as u64);
+    w.u64(d.bounds.len() as u64);
+    d.bounds.iter().for_each(|&b| w.u64(b as u64));
+    w.u64(counters.migrations);
+    w.u64(counters.rebalances);
+}
+
+/// Reads the split ([`encode_ranks`]) into its rank count, rank and bounds, and the counters.
+fn decode_ranks(
+    r: &mut Reader,
+    counters: &mut RankCounters,
+) -> Result<(usize, usize, Vec<usize>), CheckpointError> {
+    let ranks = r.u64()? as usize;
+    let rank = r.u64()? as usize;
+    let n = r.u64()?;
+    if n > 1 << 32 {
+        return Err(r.fault("the saved cell layers of the ranks do not fit the grid".into()));
+    }
+    let bounds = (0..n)
+        .map(|_| Ok(r.u64()? as usize))
+        .collect::<Result<Vec<_>, _>>()?;
+    counters.migrations = r.u64()?;
+    counters.rebalances = r.u64()?;
+    Ok((ranks, rank, bounds))
 }
 
 fn encode_clock(w: &mut Writer, c: &Clock) {
@@ -614,6 +758,27 @@ impl Writer {
         self.u64(v.len() as u64);
         self.0.extend_from_slice(v.as_bytes());
     }
+    /// The first bytes of a file: `magic`, the format, the build, the dimension and the
+    /// header ([`Reader::header`] reads them).
+    fn header(&mut self, magic: &[u8; 8], dimension: u64, header: &Header) {
+        self.0.extend_from_slice(magic);
+        self.u32(VERSION);
+        self.str(BUILD_ID);
+        self.u64(dimension);
+        self.str(&header.scene_path.to_string_lossy());
+        self.str(&header.scene_text);
+        self.u32(crc32fast::hash(header.scene_text.as_bytes()));
+        self.u64(header.history_bytes);
+        self.u32(header.history_crc);
+        self.f64(header.wall_seconds);
+        self.u32(header.meshes_crc);
+    }
+    /// Ends the file with the CRC-32 of every byte before it.
+    fn finish(mut self) -> Vec<u8> {
+        let crc = crc32fast::hash(&self.0);
+        self.u32(crc);
+        self.0
+    }
 }
 
 struct Reader<'a> {
@@ -667,9 +832,16 @@ impl<'a> Reader<'a> {
     fn u32(&mut self) -> Result<u32, CheckpointError> {
         Ok(u32::from_le_bytes(self.take(4)?.try_into().expect("4 bytes")))
     }
-    fn header(&mut self) -> Result<Header, CheckpointError> {
-        if self.take(MAGIC.len()).ok() != Some(MAGIC.as_slice()) {
-            return Err(self.fault("not a kdmpm checkpoint".into()));
+    /// Reads the header [`Writer::header`] wrote after `magic`, once the file's checksum is
+    /// found whole.
+    fn header(&mut self, magic: &[u8; 8]) -> Result<Header, CheckpointError> {
+        let first = self.take(magic.len()).ok();
+        if first != Some(magic.as_slice()) {
+            return Err(self.fault(match first {
+                Some(m) if m == parts::MANIFEST_MAGIC => parts::written_over_ranks(self.bytes, self.path),
+                Some(m) if m == MAGIC => "written by a run on one rank: resume it without mpirun".into(),
+                _ => "not a kdmpm checkpoint".into(),
+            }));
         }
         let version = self.u32()?;
         if version != VERSION {
