@@ -165,7 +165,11 @@ pub fn restore_part<D: Dim>(
         || bounds[ranks] != layers
         || bounds.windows(2).any(|b| b[0] > b[1])
     {
-        return Err(r.fault("the saved cell layers of the ranks do not fit the grid".into()));
+        return Err(r.fault(format!(
+            "the saved split of {} cell layers differs from the scene's grid ({layers} layers \
+             along its slab axis): a checkpoint of another scene",
+            bounds.last().copied().unwrap_or_default()
+        )));
     }
     if ranks > 1 {
         respawn(sim, &mut r)?;
