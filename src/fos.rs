@@ -198,13 +198,7 @@ pub fn strength_reduction_over(
     }
     let start = Instant::now();
     let io = |e: std::io::Error| FosError::Output(out.to_path_buf(), e);
-    // The analysis's own directory, held for its whole run: one that cannot be made (a
-    // file of that name, no permission) or that another run holds is bad input.
-    let _dir = comm
-        .is_root()
-        .then(|| OutputDir::claim(out))
-        .transpose()
-        .map_err(|e| FosError::OutputDir(e.to_string()))?;
+    let _dir = claim_over(out, comm)?;
     let mut trials: Vec<Trial> = Vec::new();
     let mut trial = |f: f64| run_trial(loaded, &spec, f, out, comm, &mut report, &mut trials);
     let [lo, hi] = [spec.bracket[0], spec.bracket[1]];
@@ -255,6 +249,19 @@ pub fn narrow(
     out: &Path,
     fos: &mut FosReport,
     tolerance: f64,
+    report: impl FnMut(&Trial),
+) -> Result<(), FosError> {
+    narrow_over(loaded, out, fos, tolerance, &Arc::new(Comm::single()), report)
+}
+
+/// [`narrow`] with every trial split over the ranks of `comm`, as
+/// [`strength_reduction_over`]; rank 0 writes the files.
+pub fn narrow_over(
+    loaded: &LoadedScene,
+    out: &Path,
+    fos: &mut FosReport,
+    tolerance: f64,
+    comm: &Arc<Comm>,
     mut report: impl FnMut(&Trial),
 ) -> Result<(), FosError> {
     let spec = loaded.scene.strength_reduction.clone().ok_or_else(|| {
@@ -264,11 +271,10 @@ pub fn narrow(
         ))
     })?;
     let start = Instant::now();
-    let _dir = OutputDir::claim(out).map_err(|e| FosError::OutputDir(e.to_string()))?;
+    let _dir = claim_over(out, comm)?;
     let mut trials = Vec::new();
-    let one = Arc::new(Comm::single());
     let [lo, hi] = bisect(fos.bracket, tolerance, &mut |f| {
-        run_trial(loaded, &spec, f, out, &one, &mut report, &mut trials)
+        run_trial(loaded, &spec, f, out, comm, &mut report, &mut trials)
     })?;
     fos.steps += trials.iter().map(|t| t.steps).sum::<u64>();
     fos.trials.extend(trials);
@@ -277,7 +283,24 @@ pub fn narrow(
     fos.tolerance = tolerance;
     fos.mechanism = trial_dir(hi);
     fos.wall_seconds += start.elapsed().as_secs_f64();
+    if !comm.is_root() {
+        return Ok(());
+    }
     write_report(fos, out).map_err(|e| FosError::Output(out.to_path_buf(), e))
+}
+
+/// The analysis's own directory, held by rank 0 for its whole run: one that cannot be made
+/// (a file of that name, no permission) or that another run holds is bad input, on every
+/// rank (a collective).
+fn claim_over(out: &Path, comm: &Comm) -> Result<Option<OutputDir>, FosError> {
+    let dir = comm.is_root().then(|| OutputDir::claim(out)).transpose();
+    if comm.any(dir.is_err()) {
+        return Err(FosError::OutputDir(match dir {
+            Err(e) => e.to_string(),
+            Ok(_) => format!("rank 0 could not take {}", out.display()),
+        }));
+    }
+    Ok(dir.expect("checked above"))
 }
 
 /// Halves `[lo, hi]` (the slope stands at lo and fails at hi) by a trial at its middle

@@ -21,6 +21,7 @@
 
 use crate::error::Ending;
 use crate::fos::{FosError, FosReport, Trial};
+use crate::infra::comm::Comm;
 use crate::output::dir::write_atomic;
 use crate::output::Outcome;
 use crate::run::{Run, RunError, RunReport};
@@ -28,6 +29,7 @@ use crate::scene::{CheckpointEvery, LoadedScene, Scene, TimeStep};
 use serde::Serialize;
 use std::io::Write;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 use std::time::Instant;
 
 /// Cell sizes an estimate may use: the scene's and one or two halvings.
@@ -324,6 +326,7 @@ fn refine<T>(
     loaded: &LoadedScene,
     out: &Path,
     count: u32,
+    comm: &Comm,
     (quantity, unit): (&str, &str),
     mut at: impl FnMut(LoadedScene, PathBuf, f64) -> Result<Answer<T>, RefineError>,
     mut narrow: impl FnMut(&mut T, &mut Level) -> Result<bool, RefineError>,
@@ -331,10 +334,17 @@ fn refine<T>(
 ) -> Result<(T, Refinement), RefineError> {
     // The finer levels of an earlier analysis into the same folder (`--refine 3`, then
     // `--refine 2`) would stand beside this one's as if they were its own.
+    // Rank 0's to remove, before any rank writes (the first run's start is a collective).
     let earlier = out.join("refine");
-    match std::fs::remove_dir_all(&earlier) {
-        Err(e) if e.kind() != std::io::ErrorKind::NotFound => return Err(RefineError::Output(earlier, e)),
-        _ => {}
+    let removed = match comm.is_root().then(|| std::fs::remove_dir_all(&earlier)) {
+        Some(Err(e)) if e.kind() != std::io::ErrorKind::NotFound => Err(e),
+        _ => Ok(()),
+    };
+    if comm.any(removed.is_err()) {
+        let e = removed
+            .err()
+            .unwrap_or_else(|| std::io::Error::other("rank 0 could not remove it"));
+        return Err(RefineError::Output(earlier, e));
     }
     let mut reports = Vec::new();
     let mut levels = Vec::new();
@@ -368,7 +378,9 @@ fn refine<T>(
         }
     }
     let refinement = estimate(quantity, unit, levels);
-    add_to_summary(out, &refinement)?;
+    if comm.is_root() {
+        add_to_summary(out, &refinement)?;
+    }
     Ok((reports.swap_remove(0), refinement))
 }
 
@@ -414,6 +426,20 @@ pub fn pressure(
     what: &RunQuantity,
     show: impl FnMut(&Level),
 ) -> Result<(RunReport, Refinement), RefineError> {
+    pressure_over(loaded, out, count, quiet, what, &Arc::new(Comm::single()), show)
+}
+
+/// [`pressure`] with every run split over the ranks of `comm` (under `mpirun`): the ranks
+/// find the same answers (a run's figures are the ranks'); rank 0 writes the files.
+pub fn pressure_over(
+    loaded: &LoadedScene,
+    out: &Path,
+    count: u32,
+    quiet: bool,
+    what: &RunQuantity,
+    comm: &Arc<Comm>,
+    show: impl FnMut(&Level),
+) -> Result<(RunReport, Refinement), RefineError> {
     check_levels(count)?;
     let name = loaded.path.display();
     let quantity = match what {
@@ -435,6 +461,7 @@ pub fn pressure(
         let report = Run::scene(scene)
             .into_dir(dir)
             .quiet(quiet)
+            .over(comm.clone())
             .go()
             .map_err(|e| RefineError::Run(h, Box::new(e)))?;
         if report.summary.outcome == Outcome::Interrupted {
@@ -474,7 +501,16 @@ pub fn pressure(
     };
     // A pressure is known to the stopping tolerance; a run at a finer one would be a new
     // run, not a continuation.
-    refine(loaded, out, count, (quantity, "Pa"), run, |_, _| Ok(false), show)
+    refine(
+        loaded,
+        out,
+        count,
+        comm,
+        (quantity, "Pa"),
+        run,
+        |_, _| Ok(false),
+        show,
+    )
 }
 
 /// The mean of `states` (Pa) and how finely it is known: the stopping `tolerance` times
@@ -502,6 +538,18 @@ pub fn factor_of_safety(
     count: u32,
     show: impl FnMut(f64, &Trial),
 ) -> Result<(FosReport, Refinement), RefineError> {
+    factor_of_safety_over(loaded, out, count, &Arc::new(Comm::single()), show)
+}
+
+/// [`factor_of_safety`] with every trial split over the ranks of `comm` (under `mpirun`),
+/// as [`crate::fos::strength_reduction_over`]; rank 0 writes the files.
+pub fn factor_of_safety_over(
+    loaded: &LoadedScene,
+    out: &Path,
+    count: u32,
+    comm: &Arc<Comm>,
+    show: impl FnMut(f64, &Trial),
+) -> Result<(FosReport, Refinement), RefineError> {
     check_levels(count)?;
     let show = std::cell::RefCell::new(show);
     let fail = |h: f64| {
@@ -519,8 +567,8 @@ pub fn factor_of_safety(
         )
     };
     let analyse = |scene: LoadedScene, dir: PathBuf, h: f64| {
-        let report =
-            crate::fos::strength_reduction(&scene, &dir, |t| (show.borrow_mut())(h, t)).map_err(fail(h))?;
+        let report = crate::fos::strength_reduction_over(&scene, &dir, comm, |t| (show.borrow_mut())(h, t))
+            .map_err(fail(h))?;
         let (value, resolution, wall) = answer(&report);
         Ok(((report, scene, dir), value, resolution, wall))
     };
@@ -536,7 +584,8 @@ pub fn factor_of_safety(
             return Ok(false);
         }
         let h = level.cell_size;
-        crate::fos::narrow(scene, dir, report, tolerance, |t| (show.borrow_mut())(h, t)).map_err(fail(h))?;
+        crate::fos::narrow_over(scene, dir, report, tolerance, comm, |t| (show.borrow_mut())(h, t))
+            .map_err(fail(h))?;
         (level.value, level.resolution, level.wall_seconds) = answer(report);
         Ok(true)
     };
@@ -544,6 +593,7 @@ pub fn factor_of_safety(
         loaded,
         out,
         count,
+        comm,
         ("factor_of_safety", ""),
         analyse,
         narrow,

@@ -630,3 +630,42 @@ fn sigterm_to_mpirun_leaves_a_checkpoint_that_resumes_to_the_uninterrupted_bytes
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     same_results_over(&cut, &whole, 2);
 }
+
+/// `kdmpm fos --refine 2` on 2 ranks: every trial of both cell sizes over the ranks, to one
+/// rank's answers and estimate (the slope from h = 1 m, as `refine::two_cell_sizes_of_the_slope_…`
+/// pins on one rank: 1.4140625 and 1.3828125, extrapolated 1.3515625).
+#[test]
+fn the_factor_of_safety_refined_on_2_ranks_is_one_ranks() {
+    let scene = common::scene("slope_fos.ron");
+    let refined = |ranks: usize| -> Value {
+        let out = common::scratch("mpi", &format!("fos-refine-{ranks}"));
+        let (s, o) = (scene.to_str().expect("UTF-8"), out.to_str().expect("UTF-8"));
+        let args = [
+            "fos",
+            s,
+            "--out",
+            o,
+            "--refine",
+            "2",
+            "--set",
+            "grid.cell_size=1.0",
+        ];
+        let r = kdmpm_on(ranks, &[&args[..], &["--set", "grid.cells=[55, 12]"]].concat());
+        assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+        let text = std::fs::read_to_string(out.join("summary.json")).expect("summary.json");
+        let v: Value = serde_json::from_str(&text).expect("JSON");
+        v["refinement"].clone()
+    };
+    let (one, two) = (refined(1), refined(2));
+    let values = |r: &Value| -> Vec<Value> {
+        r["levels"]
+            .as_array()
+            .expect("levels")
+            .iter()
+            .map(|l| l["value"].clone())
+            .collect()
+    };
+    assert_eq!(values(&one), values(&two));
+    assert_eq!(values(&two), [Value::from(1.4140625), Value::from(1.3828125)]);
+    assert_eq!(one["extrapolated"], two["extrapolated"]);
+}

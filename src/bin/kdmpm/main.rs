@@ -69,17 +69,12 @@ fn command(command: Command, comm: &Arc<Comm>) -> Result<ExitCode, Fault> {
     if comm.size() > 1
         && !matches!(
             command,
-            Command::Run { .. }
-                | Command::Resume { .. }
-                | Command::Fos {
-                    refining: cli::Refining { refine: None },
-                    ..
-                }
+            Command::Run { .. } | Command::Resume { .. } | Command::Fos { .. }
         )
     {
         return Err(Fault::bad(format!(
             "kdmpm was started on {} ranks; only `kdmpm run`, `kdmpm resume` and `kdmpm fos` \
-             are split across ranks: start the other commands (and `--refine`) without mpirun",
+             are split across ranks: start the other commands without mpirun",
             comm.size()
         )));
     }
@@ -239,17 +234,16 @@ fn run_refined(
     levels: u32,
     what: &kdmpm::refine::RunQuantity,
     quiet: bool,
-    comm: &Comm,
+    comm: &Arc<Comm>,
 ) -> Result<ExitCode, Fault> {
-    if comm.size() > 1 {
-        return Err(Fault::bad("--refine runs on one rank: start it without mpirun"));
-    }
+    // Over several ranks rank 0 speaks for all.
+    let quiet = quiet || !comm.is_root();
     let show = |l: &kdmpm::refine::Level| {
         if !quiet {
             eprintln!("h = {} m done ({:.1} s)", l.cell_size, l.wall_seconds);
         }
     };
-    let (r, refinement) = kdmpm::refine::pressure(loaded, out, levels, quiet, what, show)
+    let (r, refinement) = kdmpm::refine::pressure_over(loaded, out, levels, quiet, what, comm, show)
         .map_err(|e| Fault(e.to_string(), e.ending()))?;
     if !quiet {
         println!("{}\n{}", r.describe(), refinement.describe());
@@ -277,7 +271,7 @@ fn run_fos(
                 eprintln!("h = {h} m, {}", t.describe());
             }
         };
-        let (r, refinement) = kdmpm::refine::factor_of_safety(&loaded, &out, levels, show)
+        let (r, refinement) = kdmpm::refine::factor_of_safety_over(&loaded, &out, levels, comm, show)
             .map_err(|e| Fault(e.to_string(), e.ending()))?;
         if !quiet {
             println!("{} → {}\n{}", r.describe(), out.display(), refinement.describe());
