@@ -318,15 +318,15 @@ type Answer<T> = (T, f64, f64, f64);
 /// Makes the analysis `at` (the scene at a cell size, its folder, the cell size) at
 /// `count` cell sizes (checked by the caller), adds Richardson's estimate of `quantity` (in `unit`) to the
 /// `summary.json` in `out`, and returns the report at the scene's own cell size with it.
+/// Over the ranks of `comm` every rank makes every analysis; rank 0 writes.
 ///
 /// Where two neighbouring answers lie closer than they resolve, `narrow` is asked to know
 /// each of them more finely (a factor of safety bisects on); it says whether it could.
 /// They are compared again until they are resolved or neither can narrow.
 fn refine<T>(
     loaded: &LoadedScene,
-    out: &Path,
+    (out, comm): (&Path, &Comm),
     count: u32,
-    comm: &Comm,
     (quantity, unit): (&str, &str),
     mut at: impl FnMut(LoadedScene, PathBuf, f64) -> Result<Answer<T>, RefineError>,
     mut narrow: impl FnMut(&mut T, &mut Level) -> Result<bool, RefineError>,
@@ -503,9 +503,8 @@ pub fn pressure_over(
     // run, not a continuation.
     refine(
         loaded,
-        out,
+        (out, comm),
         count,
-        comm,
         (quantity, "Pa"),
         run,
         |_, _| Ok(false),
@@ -591,9 +590,8 @@ pub fn factor_of_safety_over(
     };
     let ((report, _, _), refinement) = refine(
         loaded,
-        out,
+        (out, comm),
         count,
-        comm,
         ("factor_of_safety", ""),
         analyse,
         narrow,
