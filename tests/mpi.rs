@@ -77,6 +77,15 @@ fn ranks_agree_on_sums_maxima_and_exchanges() {
     assert!(nan[0].is_nan());
     assert!(comm.any(r == 0));
     assert!(!comm.any(false));
+    // The lowest rank's message reaches every rank, whole.
+    assert_eq!(comm.first_message(None), None);
+    let message = format!("rank {r} says «ü»");
+    let from_odd = (r % 2 == 1 || n == 1).then_some(message.as_str());
+    let lowest = if n == 1 { 0 } else { 1 };
+    assert_eq!(
+        comm.first_message(from_odd),
+        Some((lowest, format!("rank {lowest} says «ü»")))
+    );
     // Up the ranks, then down, messages of the sender's rank + 1 values.
     let up = comm.exchange(
         (r + 1 < n).then_some(r + 1),
@@ -589,6 +598,30 @@ fn the_slope_checkpointed_on_2_ranks_resumes_to_the_bytes_of_the_uninterrupted_r
         let e = String::from_utf8_lossy(&o.stderr);
         assert_eq!(o.status.code(), Some(2), "resumed on {ranks}: {e}");
         assert!(e.contains("2 ranks"), "resumed on {ranks}: {e}");
+    }
+    // A part changed after the manifest was written, or gone: refused on every rank (bad
+    // input, exit 2), never a hang of the ranks that could read theirs.
+    let part = format!("checkpoint.{:012}.1.kdc", 2000);
+    for (case, spoil) in [
+        (
+            "changed",
+            &(|p: &Path| {
+                let mut b = std::fs::read(p).expect("the part");
+                let at = b.len() / 2;
+                b[at] ^= 1;
+                std::fs::write(p, b).expect("written");
+            }) as &dyn Fn(&Path),
+        ),
+        ("gone", &|p: &Path| std::fs::remove_file(p).expect("removed")),
+    ] {
+        let spoilt = run.with_file_name(format!("ckpt-{case}"));
+        let _ = std::fs::remove_dir_all(&spoilt);
+        copy_dir(&run, &spoilt);
+        spoil(&spoilt.join(&part));
+        let o = kdmpm_on(2, &["resume", spoilt.to_str().expect("UTF-8")]);
+        let e = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "a part {case}: {e}");
+        assert!(e.contains(&part), "a part {case}: {e}");
     }
     let o = kdmpm_on(2, &["resume", dir]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));

@@ -98,40 +98,37 @@ pub fn write<D: Dim>(sim: &Simulation<D>, header: &Header, dir: &Path) -> std::i
     let bytes = encode(sim, header);
     let written = write_atomic(&dir.join(part_name(step, rank)), |out| out.write_all(&bytes));
     // Lengths and CRC-32s are exact in f64.
-    let mine = [
-        written.is_ok() as u8 as f64,
-        bytes.len() as f64,
-        crc32fast::hash(&bytes) as f64,
-    ];
+    let mine = [bytes.len() as f64, crc32fast::hash(&bytes) as f64];
     drop(bytes);
     let all = comm.gather_all(&mine);
-    if let Some(r) = (0..comm.size()).find(|&r| all[3 * r] == 0.0) {
-        return Err(written.err().unwrap_or_else(|| {
-            std::io::Error::other(format!("rank {r} could not write its part of the checkpoint"))
-        }));
+    let failed = written.as_ref().err().map(|e| e.to_string());
+    if let Some((r, e)) = comm.first_message(failed.as_deref()) {
+        return Err(std::io::Error::other(format!(
+            "rank {r}: its part of the checkpoint: {e}"
+        )));
     }
     let manifest = if comm.is_root() {
         let m = Manifest {
             header: header.clone(),
             step,
-            parts: all.chunks_exact(3).map(|p| (p[1] as u64, p[2] as u32)).collect(),
+            parts: all.chunks_exact(2).map(|p| (p[0] as u64, p[1] as u32)).collect(),
         };
         let bytes = m.encode(D::N as u64);
         write_atomic(&dir.join(FILE_NAME), |out| out.write_all(&bytes))
     } else {
         Ok(())
     };
-    if comm.any(manifest.is_err()) {
-        return Err(manifest
-            .err()
-            .unwrap_or_else(|| std::io::Error::other("rank 0 could not write the checkpoint's manifest")));
+    let failed = manifest.as_ref().err().map(|e| e.to_string());
+    if let Some((_, e)) = comm.first_message(failed.as_deref()) {
+        return Err(std::io::Error::other(format!("the checkpoint's manifest: {e}")));
     }
     // The manifest names this step's parts: the earlier ones are no longer needed.
     let removed = remove_parts(dir, |s, r| r == rank && s != step);
-    if comm.any(removed.is_err()) {
-        return Err(removed.err().unwrap_or_else(|| {
-            std::io::Error::other("another rank could not remove its earlier checkpoint parts")
-        }));
+    let failed = removed.as_ref().err().map(|e| e.to_string());
+    if let Some((r, e)) = comm.first_message(failed.as_deref()) {
+        return Err(std::io::Error::other(format!(
+            "rank {r}: its earlier checkpoint parts: {e}"
+        )));
     }
     Ok(())
 }

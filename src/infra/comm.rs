@@ -165,6 +165,31 @@ impl Comm {
         v[0] > 0.0
     }
 
+    /// The lowest rank's message among those given, with that rank, on every rank: what a
+    /// collective step that failed on some ranks reports (rank 0 speaks for all). `None`
+    /// when no rank has one.
+    pub fn first_message(&self, mine: Option<&str>) -> Option<(usize, String)> {
+        if self.size == 1 {
+            return mine.map(|m| (0, m.to_string()));
+        }
+        // Lengths first (+1: an empty message is still one), then the texts padded to the
+        // longest, one byte a word (exact in f64).
+        let lengths = self.gather_all(&[mine.map_or(0.0, |m| m.len() as f64 + 1.0)]);
+        let from = lengths.iter().position(|&l| l > 0.0)?;
+        let width = lengths.iter().fold(0.0f64, |a, &b| a.max(b)) as usize;
+        let mut padded = vec![0.0; width];
+        for (w, b) in padded.iter_mut().zip(mine.unwrap_or_default().bytes()) {
+            *w = b as f64;
+        }
+        let all = self.gather_all(&padded);
+        let len = lengths[from] as usize - 1;
+        let bytes: Vec<u8> = all[from * width..from * width + len]
+            .iter()
+            .map(|&b| b as u8)
+            .collect();
+        Some((from, String::from_utf8_lossy(&bytes).into_owned()))
+    }
+
     fn combine(&self, values: &mut [f64], op: impl Fn(f64, f64) -> f64) {
         if self.size == 1 {
             return;

@@ -250,14 +250,9 @@ impl<'a> Run<'a> {
                 let comm = watch.comm.clone();
                 // Every rank reads the manifest and its own part; one that cannot, stops all.
                 let read = checkpoint::parts::read(&dir, comm.rank(), comm.size());
-                if comm.any(read.is_err()) {
-                    return Err(match read {
-                        Err(e) => e.into(),
-                        Ok(_) => RunError::Ranks(format!(
-                            "{}: another rank could not read its part of the checkpoint",
-                            dir.display()
-                        )),
-                    });
+                let failed = read.as_ref().err().map(|e| e.to_string());
+                if let Some((rank, e)) = comm.first_message(failed.as_deref()) {
+                    return Err(RunError::Ranks(format!("rank {rank}: {e}")));
                 }
                 let (manifest, part, file) = read.expect("read above");
                 let header = &manifest.header;

@@ -34,14 +34,9 @@ pub(super) fn go<D: Dim>(
     if let Some(r) = &resume {
         // This rank's points, state and split as saved; a rank that cannot stops all.
         let restored = checkpoint::restore_part(sim, r.part, r.file, total);
-        if comm.any(restored.is_err()) {
-            return Err(match restored {
-                Err(e) => e.into(),
-                Ok(_) => RunError::Ranks(format!(
-                    "{}: another rank could not restore its part of the checkpoint",
-                    r.file.display()
-                )),
-            });
+        let failed = restored.as_ref().err().map(|e| e.to_string());
+        if let Some((rank, e)) = comm.first_message(failed.as_deref()) {
+            return Err(RunError::Ranks(format!("rank {rank}: {e}")));
         }
     }
     // Every rank gathers the traced points for rank 0's history, before it is written.
