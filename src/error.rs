@@ -217,6 +217,15 @@ pub enum StepError {
     /// Writing output failed.
     #[error("writing output: {0}")]
     Io(#[from] std::io::Error),
+    /// Over MPI ranks, a system failed on another rank (a point left the grid in its
+    /// layers): every rank stops at the same system with the lowest failing rank's message.
+    #[error("rank {rank}: {message}")]
+    OnRank {
+        /// The lowest rank whose system failed.
+        rank: usize,
+        /// Its error.
+        message: String,
+    },
     /// A user system failed.
     #[error("step {step}, system `{system}`: {message}")]
     User {

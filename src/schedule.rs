@@ -25,6 +25,13 @@ pub trait System<D: Dim>: Send {
         let _ = ctx;
         Ok(())
     }
+    /// Whether every rank of a run over MPI runs this system (the engine's systems do):
+    /// its failure on one rank then stops every rank at it. A system that only some ranks
+    /// run (rank 0's history writer) says false: its failure stops every rank at the next
+    /// system they all run, or at the end of the step.
+    fn on_every_rank(&self) -> bool {
+        true
+    }
 }
 
 /// A system made from a closure, for user code (see `examples/custom_system.rs`).
@@ -144,9 +151,12 @@ impl<D: Dim> Schedule<D> {
     /// Runs every system once, in order, timing each (after their `prepare`, the first
     /// time).
     pub fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
+        // A failure of a system that not every rank runs, held for the next check.
+        let mut held = None;
         if !self.prepared {
             for system in &mut self.systems {
-                system.prepare(ctx)?;
+                let result = system.prepare(ctx);
+                every_rank(ctx, system.on_every_rank(), result, &mut held)?;
             }
             self.prepared = true;
         }
@@ -157,9 +167,9 @@ impl<D: Dim> Schedule<D> {
             let result = system.run(ctx);
             self.time[i] += start.elapsed();
             self.calls[i] += 1;
-            result?;
+            every_rank(ctx, system.on_every_rank(), result, &mut held)?;
         }
-        Ok(())
+        every_rank(ctx, true, Ok(()), &mut held)
     }
 
     /// Accumulated cost of every system, in schedule order.
@@ -173,5 +183,35 @@ impl<D: Dim> Schedule<D> {
                 seconds: t.as_secs_f64(),
             })
             .collect()
+    }
+}
+
+/// A system's outcome made every rank's: over MPI ranks a system that fails on one rank (a
+/// point of its layers left the grid or turned non-finite) stops every rank at the same
+/// system, the others with the lowest failing rank's message ([`StepError::OnRank`]);
+/// otherwise the ranks still stepping would wait for it in the next collective for ever.
+/// The failure of a system that not every rank runs (`shared` false) is `held` until the
+/// next system they all run, or the end of the step. One small collective a shared system
+/// a step; nothing on one rank.
+fn every_rank<D: Dim>(
+    ctx: &Context<D>,
+    shared: bool,
+    result: Result<(), StepError>,
+    held: &mut Option<StepError>,
+) -> Result<(), StepError> {
+    if ctx.comm.size() == 1 {
+        return result;
+    }
+    if let Err(e) = result {
+        held.get_or_insert(e);
+    }
+    if !shared {
+        return Ok(());
+    }
+    let mine = held.as_ref().map(|e| e.to_string());
+    match (held.take(), ctx.comm.first_message(mine.as_deref())) {
+        (Some(e), _) => Err(e),
+        (None, Some((rank, message))) => Err(StepError::OnRank { rank, message }),
+        (None, None) => Ok(()),
     }
 }

@@ -702,3 +702,47 @@ fn the_factor_of_safety_refined_on_2_ranks_is_one_ranks() {
     assert_eq!(values(&two), [Value::from(1.4140625), Value::from(1.3828125)]);
     assert_eq!(one["extrapolated"], two["extrapolated"]);
 }
+
+/// A point that leaves the grid in one rank's layers (the column flung upwards by a
+/// gravity of 10⁵ m/s², on 2 and 4 ranks: the top rank's points leave first) stops every
+/// rank at the same system: the run ends as failed with that rank's error, in rank 0's
+/// summary and on stderr once, and no rank waits for the others for ever.
+#[test]
+fn a_point_leaving_the_grid_on_one_rank_stops_every_rank_with_its_error() {
+    for ranks in [2, 4] {
+        let out = common::scratch("mpi", &format!("flung-{ranks}"));
+        let mut child = Command::new("mpirun")
+            .args(["--allow-run-as-root", "--oversubscribe", "-n", &ranks.to_string()])
+            .arg(env!("CARGO_BIN_EXE_kdmpm"))
+            .args(["run", common::scene("soil_column.ron").to_str().expect("UTF-8")])
+            .args([
+                "--quiet",
+                "--threads",
+                "1",
+                "--set",
+                "gravity.acceleration=[0.0, 1e5]",
+                "--out",
+            ])
+            .arg(&out)
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .expect("mpirun starts");
+        let start = std::time::Instant::now();
+        while child.try_wait().expect("mpirun").is_none() {
+            if start.elapsed().as_secs() > 120 {
+                let _ = child.kill();
+                panic!("{ranks} ranks: the ranks still wait after 120 s");
+            }
+            std::thread::sleep(std::time::Duration::from_millis(50));
+        }
+        let o = child.wait_with_output().expect("mpirun ends");
+        let e = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{ranks} ranks: {e}");
+        let last = format!("rank {}: step 2, system `kinematics`", ranks - 1);
+        assert_eq!(e.matches("left the grid").count(), 1, "{ranks} ranks: {e}");
+        assert!(e.contains(&last), "{ranks} ranks: {e}");
+        let s = summary_numbers(&out);
+        assert_eq!(s["outcome"], "failed");
+        assert!(s["error"].as_str().expect("the error").starts_with(&last), "{s}");
+    }
+}

@@ -119,6 +119,10 @@ impl<D: Dim> System<D> for History<D> {
     fn name(&self) -> &str {
         "history"
     }
+    /// Rank 0's alone over MPI ranks.
+    fn on_every_rank(&self) -> bool {
+        false
+    }
     fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
         let s = &ctx.state;
         let last = s.stop.is_some();

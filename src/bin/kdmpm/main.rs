@@ -190,8 +190,10 @@ fn report(run: Result<RunReport, RunError>, stepping: Stepping, comm: &Comm) -> 
         print!("{}", r.summary.profile_table());
     }
     if let Some(e) = &r.error {
-        eprintln!("error: {rank}{e}");
+        // A step's error is every rank's (the failing rank's message reaches rank 0):
+        // rank 0 speaks for all.
         if comm.is_root() {
+            eprintln!("error: {e}");
             r.notes.iter().for_each(|n| eprintln!("  {n}"));
         }
         return Ok(ExitCode::from(Ending::Failed.code()));
