@@ -172,23 +172,23 @@ impl Recorder {
 
     /// Flushes the history, waits for the snapshot writer, writes `points.vtu` (unless the
     /// state holds a non-finite value: nothing is ever written as NaN) and `summary.json`,
-    /// and returns the summary with what was left out.
+    /// and returns the summary with what was left out. `checkpointed`: the directory holds
+    /// a checkpoint of the run (the note of a state not written says it can be resumed).
     pub fn finish<D: Dim>(
         self,
         sim: &Simulation<D>,
         dir: &OutputDir,
         scene: &str,
-        wall_seconds: f64,
+        (wall_seconds, checkpointed): (f64, bool),
         error: Option<String>,
     ) -> std::io::Result<(Summary, Notes)> {
         history::lock(&self.rows).flush()?;
         let series = self.snapshots.map(SnapshotWriter::finish).transpose()?;
         let mut notes = Notes::default();
         if let Some(note) = write_final_points(sim, dir.path())? {
-            let resume = dir.file(crate::checkpoint::FILE_NAME).exists();
             notes.0.push(format!(
                 "{note}{}",
-                if resume {
+                if checkpointed {
                     "; the last checkpoint holds a finite state (kdmpm resume)"
                 } else {
                     ""

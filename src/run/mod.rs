@@ -357,14 +357,17 @@ impl Watch<'_> {
         let wall = before + start.elapsed().as_secs_f64();
         let error = result.err();
         let message = error.as_ref().map(|e| e.to_string());
+        let checkpointed = dir.is_some_and(|d| d.file(checkpoint::FILE_NAME).exists());
         let (summary, notes) = match (recorder, dir) {
             (Some(recorder), Some(dir)) => {
-                let (summary, notes) = recorder.finish(sim, dir, &scene, wall, message).map_err(|e| {
-                    RunError::Results(format!(
-                        "cannot write the results into {}: {e}",
-                        dir.path().display()
-                    ))
-                })?;
+                let (summary, notes) = recorder
+                    .finish(sim, dir, &scene, (wall, checkpointed), message)
+                    .map_err(|e| {
+                        RunError::Results(format!(
+                            "cannot write the results into {}: {e}",
+                            dir.path().display()
+                        ))
+                    })?;
                 (summary, notes.0)
             }
             _ => (Summary::collect(&scene, sim, wall, message), Vec::new()),
