@@ -461,6 +461,11 @@ fn snapshots_on_2_ranks_hold_every_point_once_as_one_rank_does() {
     let (a, one) = run_on("footing_rigid.ron", 1, "snap", &snapshots);
     let (b, two) = run_on("footing_rigid.ron", 2, "snap", &snapshots);
     assert_eq!(one["snapshots"], two["snapshots"]);
+    // The displacement field is drawn from the ranks' pieces of the final points.
+    assert!(
+        b.join("displacement_field.svg").exists(),
+        "no displacement field drawn"
+    );
     let pvd = std::fs::read_to_string(b.join("points.pvd")).expect("points.pvd");
     let step = "000005000";
     assert!(pvd.contains(&format!("snapshots/points_{step}.pvtu")), "{pvd}");

@@ -58,6 +58,25 @@ impl History {
 /// Positions (m) and displacements (m) of every point, in file order.
 type PointField = (Vec<[f64; 3]>, Vec<[f64; 3]>);
 
+/// Positions and displacements of a run's final points: `points.vtu`, or over MPI ranks
+/// every piece `points.pvtu` names (each rank's points).
+fn read_run_field(dir: &Path) -> std::io::Result<PointField> {
+    let whole = dir.join("points.vtu");
+    let parallel = dir.join("points.pvtu");
+    if whole.exists() || !parallel.exists() {
+        return read_field(&whole);
+    }
+    let text = std::fs::read_to_string(&parallel)?;
+    let (mut x, mut u) = (Vec::new(), Vec::new());
+    for piece in text.split("Source=\"").skip(1) {
+        let name = piece.split('"').next().unwrap_or_default();
+        let (px, pu) = read_field(&dir.join(name))?;
+        x.extend(px);
+        u.extend(pu);
+    }
+    Ok((x, u))
+}
+
 /// Positions and displacements of the points of a `.vtu` this crate wrote.
 fn read_field(path: &Path) -> std::io::Result<PointField> {
     let bytes = std::fs::read(path)?;
@@ -147,7 +166,7 @@ pub fn draw(dir: &Path) -> std::io::Result<(Vec<&'static str>, Vec<String>)> {
         save(FILES[2], traced_plot(&t, &traced))?;
         written.push(FILES[2]);
     }
-    match read_field(&dir.join("points.vtu")) {
+    match read_run_field(dir) {
         Ok((x, u)) if !u.is_empty() => {
             save(FILES[3], field(&x, &u))?;
             written.push(FILES[3]);
