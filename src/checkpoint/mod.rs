@@ -23,14 +23,14 @@ pub mod parts;
 use crate::components::*;
 use crate::dim::Dim;
 use crate::grid::NodeBox;
-use crate::infra::columns::points_with;
+use crate::infra::columns::{fill, points_with};
 use crate::infra::decomposition::Decomposition;
 use crate::model::{Control, CurvePoint, Drive, StageResult};
 use crate::parallel::SlabCache;
 use crate::rigid::BodyState;
 use crate::simulation::Simulation;
 use crate::state::{Clock, Convergence, EnergyWindow, Peak, RankCounters, Resets, SolverState, StaticWindow};
-use hecs::{Archetype, Entity, EntityBuilder};
+use hecs::{Archetype, ColumnBatchType, Entity};
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 
@@ -260,7 +260,8 @@ fn overwrite<D: Dim>(sim: &mut Simulation<D>, r: &mut Reader) -> Result<(), Chec
 /// Replaces this rank's points by the saved ones, archetype by archetype and row by row in
 /// the saved order (a run over ranks: its points are those that migrated to it). Every
 /// point archetype exists already (each rank built the whole scene), so each saved one is
-/// appended to the same archetype, in the same order, as in the run that wrote it.
+/// appended to the same archetype, in the same order, as in the run that wrote it: one
+/// column batch a saved archetype, filled column by column as the set-up fills its own.
 fn respawn<D: Dim>(sim: &mut Simulation<D>, r: &mut Reader) -> Result<(), CheckpointError> {
     let world = &mut sim.ctx.world;
     let held: Vec<Entity> = world
@@ -273,28 +274,26 @@ fn respawn<D: Dim>(sim: &mut Simulation<D>, r: &mut Reader) -> Result<(), Checkp
     }
     for _ in 0..r.u64()? {
         let (rows, saved) = saved_archetype(r)?;
-        let rows = usize::try_from(rows).map_err(|_| r.fault("a row count out of range".into()))?;
-        // Each saved column by its type: its values, one a row.
+        // The positions' column bounds the row count by the file's length.
+        let position = std::any::type_name::<Position<D::Vec>>();
+        let per_row = std::mem::size_of::<Position<D::Vec>>() as u64;
+        match saved.iter().find(|(s, _)| s == position) {
+            Some((_, src)) if src.len() as u64 == rows * per_row => {}
+            _ => return Err(r.fault("a saved archetype's positions do not fit its row count".into())),
+        }
+        let rows = u32::try_from(rows).map_err(|_| r.fault("a row count out of range".into()))?;
+        // The batch's columns: each saved one by its type (once, should a type be listed twice).
+        let mut types = ColumnBatchType::new();
         let mut found = vec![false; saved.len()];
-        let mut builders: Vec<EntityBuilder> = (0..rows).map(|_| EntityBuilder::new()).collect();
         macro_rules! add {
             ($($t:ty),*) => {$(
                 let name = std::any::type_name::<$t>();
-                if let Some(at) = saved.iter().position(|(s, _)| s == name) {
-                    let src = saved[at].1;
-                    let n = std::mem::size_of::<$t>();
-                    if src.len() != n * rows {
+                if let Some(at) = saved.iter().position(|(s, _)| s == name).filter(|&at| !found[at]) {
+                    if saved[at].1.len() != std::mem::size_of::<$t>() * rows as usize {
                         return Err(r.fault(format!("column {name} has another length")));
                     }
                     found[at] = true;
-                    for (i, b) in builders.iter_mut().enumerate() {
-                        // SAFETY: `src` holds `rows` values of this type, written by `encode`
-                        // from a column of it (a plain struct of f64, u32 or u16 fields for
-                        // which every bit pattern it was written with is valid, the file's
-                        // checksum whole); the read is unaligned-safe.
-                        let v: $t = unsafe { std::ptr::read_unaligned(src[i * n..].as_ptr().cast::<$t>()) };
-                        b.add(v);
-                    }
+                    types.add::<$t>();
                 }
             )*};
         }
@@ -302,15 +301,27 @@ fn respawn<D: Dim>(sim: &mut Simulation<D>, r: &mut Reader) -> Result<(), Checkp
         if let Some(at) = found.iter().position(|f| !f) {
             return Err(r.fault(format!("column {} is saved but no point has it", saved[at].0)));
         }
-        if !saved
-            .iter()
-            .any(|(s, _)| s == std::any::type_name::<Position<D::Vec>>())
-        {
-            return Err(r.fault("a saved archetype has no positions".into()));
+        let batch = types.into_batch(rows);
+        let mut filled = vec![false; saved.len()];
+        macro_rules! fill_saved {
+            ($($t:ty),*) => {$(
+                let name = std::any::type_name::<$t>();
+                if let Some(at) = saved.iter().position(|(s, _)| s == name).filter(|&at| !filled[at]) {
+                    filled[at] = true;
+                    let (n, src) = (std::mem::size_of::<$t>(), saved[at].1);
+                    // SAFETY: `src` holds `rows` values of this type (its length checked
+                    // above), written by `encode` from a column of it: a plain struct of
+                    // f64, u32 or u16 fields for which every bit pattern it was written with
+                    // is valid, the file's checksum whole; the read is unaligned-safe.
+                    fill(&batch, src.chunks_exact(n).map(|b| unsafe { std::ptr::read_unaligned(b.as_ptr().cast::<$t>()) }));
+                }
+            )*};
         }
-        for mut b in builders {
-            world.spawn(b.build());
-        }
+        point_components!(D, fill_saved);
+        let batch = batch
+            .build()
+            .map_err(|_| r.fault("a saved archetype's columns are incomplete".into()))?;
+        world.spawn_column_batch(batch);
     }
     Ok(())
 }

@@ -4,7 +4,7 @@
 //! `&[T]` / `&mut [T]` through these helpers and index them together.
 
 use crate::components::NodeMass;
-use hecs::{Archetype, ArchetypeColumn, ArchetypeColumnMut, Component, World};
+use hecs::{Archetype, ArchetypeColumn, ArchetypeColumnMut, ColumnBatchBuilder, Component, World};
 
 /// Read access to column `T` of `arch`. Panics if the archetype lacks it: systems only ask
 /// for columns that the archetype filter guarantees.
@@ -35,4 +35,16 @@ pub fn points_with<T: Component>(world: &World) -> impl Iterator<Item = &Archety
     world
         .archetypes()
         .filter(|a| a.has::<T>() && !a.is_empty() && !a.has::<NodeMass>())
+}
+
+/// Writes `values` into the column of `T` of a batch of points about to be spawned, if the
+/// batch has one (the set-up's spawn, a checkpoint's points spawned again on their rank).
+pub fn fill<T: Component>(batch: &ColumnBatchBuilder, values: impl Iterator<Item = T>) {
+    if let Some(mut w) = batch.writer::<T>() {
+        for v in values {
+            if w.push(v).is_err() {
+                unreachable!("a batch holds exactly its points");
+            }
+        }
+    }
 }

@@ -10,7 +10,7 @@ use crate::context::Context;
 use crate::dim::{Dim, Dim2, Dim3, DimAxi, Vector};
 use crate::error::SceneError;
 use crate::grid::Grid;
-use crate::infra::columns::{col, points_with};
+use crate::infra::columns::{col, fill, points_with};
 use crate::infra::decomposition::Decomposition;
 use crate::materials::{MaterialModel, MaterialState, StateVisitor};
 use crate::model::{Control, Gravity, LoadStage, Model, MotionSpec};
@@ -85,17 +85,6 @@ fn fill_points<'a, D: Dim>(
             })
         })
     })
-}
-
-/// Writes `values` into the batch's column of `T`, if the batch has one.
-fn fill<T: hecs::Component>(batch: &ColumnBatchBuilder, values: impl Iterator<Item = T>) {
-    if let Some(mut w) = batch.writer::<T>() {
-        for v in values {
-            if w.push(v).is_err() {
-                unreachable!("a batch holds exactly its points");
-            }
-        }
-    }
 }
 
 /// Adds the column of a material's state to a point batch (none for a model without one).
