@@ -101,8 +101,7 @@ pub fn write<D: Dim>(sim: &Simulation<D>, header: &Header, dir: &Path) -> std::i
     let mine = [bytes.len() as f64, crc32fast::hash(&bytes) as f64];
     drop(bytes);
     let all = comm.gather_all(&mine);
-    let failed = written.as_ref().err().map(|e| e.to_string());
-    if let Some((r, e)) = comm.first_message(failed.as_deref()) {
+    if let Some((r, e)) = comm.first_error(&written) {
         return Err(std::io::Error::other(format!(
             "rank {r}: its part of the checkpoint: {e}"
         )));
@@ -118,14 +117,12 @@ pub fn write<D: Dim>(sim: &Simulation<D>, header: &Header, dir: &Path) -> std::i
     } else {
         Ok(())
     };
-    let failed = manifest.as_ref().err().map(|e| e.to_string());
-    if let Some((_, e)) = comm.first_message(failed.as_deref()) {
+    if let Some((_, e)) = comm.first_error(&manifest) {
         return Err(std::io::Error::other(format!("the checkpoint's manifest: {e}")));
     }
     // The manifest names this step's parts: the earlier ones are no longer needed.
     let removed = remove_parts(dir, |s, r| r == rank && s != step);
-    let failed = removed.as_ref().err().map(|e| e.to_string());
-    if let Some((r, e)) = comm.first_message(failed.as_deref()) {
+    if let Some((r, e)) = comm.first_error(&removed) {
         return Err(std::io::Error::other(format!(
             "rank {r}: its earlier checkpoint parts: {e}"
         )));

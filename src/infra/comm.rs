@@ -190,6 +190,13 @@ impl Comm {
         Some((from, String::from_utf8_lossy(&bytes).into_owned()))
     }
 
+    /// [`Comm::first_message`] of every rank's `result`: the lowest failing rank and its
+    /// error, as text, on every rank.
+    pub fn first_error<T, E: std::fmt::Display>(&self, result: &Result<T, E>) -> Option<(usize, String)> {
+        let mine = result.as_ref().err().map(|e| e.to_string());
+        self.first_message(mine.as_deref())
+    }
+
     fn combine(&self, values: &mut [f64], op: impl Fn(f64, f64) -> f64) {
         if self.size == 1 {
             return;

@@ -250,8 +250,7 @@ impl<'a> Run<'a> {
                 let comm = watch.comm.clone();
                 // Every rank reads the manifest and its own part; one that cannot, stops all.
                 let read = checkpoint::parts::read(&dir, comm.rank(), comm.size());
-                let failed = read.as_ref().err().map(|e| e.to_string());
-                if let Some((rank, e)) = comm.first_message(failed.as_deref()) {
+                if let Some((rank, e)) = comm.first_error(&read) {
                     return Err(RunError::Ranks(format!("rank {rank}: {e}")));
                 }
                 let (manifest, part, file) = read.expect("read above");

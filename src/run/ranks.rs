@@ -34,8 +34,7 @@ pub(super) fn go<D: Dim>(
     if let Some(r) = &resume {
         // This rank's points, state and split as saved; a rank that cannot stops all.
         let restored = checkpoint::restore_part(sim, r.part, r.file, total);
-        let failed = restored.as_ref().err().map(|e| e.to_string());
-        if let Some((rank, e)) = comm.first_message(failed.as_deref()) {
+        if let Some((rank, e)) = comm.first_error(&restored) {
             return Err(RunError::Ranks(format!("rank {rank}: {e}")));
         }
     }
