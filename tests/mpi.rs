@@ -515,27 +515,6 @@ fn kdmpm_on(ranks: usize, args: &[&str]) -> std::process::Output {
         .expect("mpirun starts")
 }
 
-/// summary.json without the figures of the machine (wall time, memory, timings).
-fn summary_numbers(dir: &Path) -> Value {
-    let text = std::fs::read_to_string(dir.join("summary.json")).expect("summary.json");
-    let mut v: Value = serde_json::from_str(&text).expect("JSON");
-    for key in [
-        "wall_seconds",
-        "particle_steps_per_second",
-        "peak_memory_bytes",
-        "systems",
-        "output_wait_seconds",
-    ] {
-        v.as_object_mut().expect("an object").remove(key);
-    }
-    // The bytes sent are the process's, over the steps it made.
-    v["ranks"]
-        .as_object_mut()
-        .expect("a run over ranks")
-        .remove("bytes_per_step");
-    v
-}
-
 /// The results of run directories `a` and `b` over `ranks` ranks have the same bytes:
 /// history, curve, the final points (the `.pvtu` and every rank's piece) and the summary's
 /// figures.
@@ -554,18 +533,7 @@ fn same_results_over(a: &Path, b: &Path, ranks: usize) {
             b.display()
         );
     }
-    assert_eq!(summary_numbers(a), summary_numbers(b));
-}
-
-fn copy_dir(from: &Path, to: &Path) {
-    std::fs::create_dir_all(to).expect("a directory");
-    for e in std::fs::read_dir(from).expect("a directory").flatten() {
-        if e.file_type().expect("a file type").is_dir() {
-            copy_dir(&e.path(), &to.join(e.file_name()));
-        } else {
-            std::fs::copy(e.path(), to.join(e.file_name())).expect("copied");
-        }
-    }
+    assert_eq!(common::summary_numbers(a), common::summary_numbers(b));
 }
 
 /// The fast slope on 2 ranks with a checkpoint every 2 000 steps (it stops at 3 767): each
@@ -596,7 +564,7 @@ fn the_slope_checkpointed_on_2_ranks_resumes_to_the_bytes_of_the_uninterrupted_r
     assert_eq!(parts, 3, "the manifest and the last checkpoint's two parts");
     let full = run.with_file_name("ckpt-full");
     let _ = std::fs::remove_dir_all(&full);
-    copy_dir(&run, &full);
+    common::copy_dir(&run, &full);
     let dir = run.to_str().expect("UTF-8");
     for ranks in [1, 3] {
         let o = kdmpm_on(ranks, &["resume", dir]);
@@ -621,7 +589,7 @@ fn the_slope_checkpointed_on_2_ranks_resumes_to_the_bytes_of_the_uninterrupted_r
     ] {
         let spoilt = run.with_file_name(format!("ckpt-{case}"));
         let _ = std::fs::remove_dir_all(&spoilt);
-        copy_dir(&run, &spoilt);
+        common::copy_dir(&run, &spoilt);
         spoil(&spoilt.join(&part));
         let o = kdmpm_on(2, &["resume", spoilt.to_str().expect("UTF-8")]);
         let e = String::from_utf8_lossy(&o.stderr);
@@ -655,7 +623,7 @@ fn sigterm_to_mpirun_leaves_a_checkpoint_that_resumes_to_the_uninterrupted_bytes
     common::wait_until_running(&cut);
     common::signal(child.id(), "TERM");
     let o = child.wait_with_output().expect("mpirun ends");
-    let summary = summary_numbers(&cut);
+    let summary = common::summary_numbers(&cut);
     assert_eq!(
         summary["outcome"],
         "interrupted",
@@ -746,7 +714,7 @@ fn a_point_leaving_the_grid_on_one_rank_stops_every_rank_with_its_error() {
         let last = format!("rank {}: step 2, system `kinematics`", ranks - 1);
         assert_eq!(e.matches("left the grid").count(), 1, "{ranks} ranks: {e}");
         assert!(e.contains(&last), "{ranks} ranks: {e}");
-        let s = summary_numbers(&out);
+        let s = common::summary_numbers(&out);
         assert_eq!(s["outcome"], "failed");
         assert!(s["error"].as_str().expect("the error").starts_with(&last), "{s}");
     }

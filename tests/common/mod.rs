@@ -260,3 +260,36 @@ pub fn read_vtu(path: &Path) -> BTreeMap<String, (usize, Vec<f64>)> {
     }
     out
 }
+
+/// summary.json in `dir` without the figures of the machine (wall time, rate, memory,
+/// per-system cost, output wait, and over MPI ranks the bytes sent a step, a measure of
+/// the process): what two runs of the same state must agree on.
+pub fn summary_numbers(dir: &Path) -> serde_json::Value {
+    let text = std::fs::read_to_string(dir.join("summary.json")).expect("summary.json");
+    let mut v: serde_json::Value = serde_json::from_str(&text).expect("JSON");
+    for key in [
+        "wall_seconds",
+        "particle_steps_per_second",
+        "peak_memory_bytes",
+        "systems",
+        "output_wait_seconds",
+    ] {
+        v.as_object_mut().expect("an object").remove(key);
+    }
+    if let Some(ranks) = v.get_mut("ranks").and_then(|r| r.as_object_mut()) {
+        ranks.remove("bytes_per_step");
+    }
+    v
+}
+
+/// Copies directory `from` (and its folders) to `to`.
+pub fn copy_dir(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).expect("a directory");
+    for e in std::fs::read_dir(from).expect("a directory").flatten() {
+        if e.file_type().expect("a file type").is_dir() {
+            copy_dir(&e.path(), &to.join(e.file_name()));
+        } else {
+            std::fs::copy(e.path(), to.join(e.file_name())).expect("copied");
+        }
+    }
+}

@@ -172,22 +172,6 @@ fn a_checkpoint_of_another_scene_is_refused() {
 
 // ---- The binary: files on disk -------------------------------------------------------
 
-/// summary.json without the figures of wall time, memory and per-system cost.
-fn summary_numbers(dir: &Path) -> serde_json::Value {
-    let text = std::fs::read_to_string(dir.join("summary.json")).unwrap();
-    let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
-    for key in [
-        "wall_seconds",
-        "particle_steps_per_second",
-        "peak_memory_bytes",
-        "systems",
-        "output_wait_seconds",
-    ] {
-        v.as_object_mut().unwrap().remove(key);
-    }
-    v
-}
-
 /// Every output of run directory `a` equals that of `b`, snapshot series included.
 fn same_results(a: &Path, b: &Path) {
     let mut files = vec!["points.vtu".to_string(), "history.csv".to_string()];
@@ -214,19 +198,7 @@ fn same_results(a: &Path, b: &Path) {
             b.display()
         );
     }
-    assert_eq!(summary_numbers(a), summary_numbers(b));
-}
-
-fn copy_dir(from: &Path, to: &Path) {
-    std::fs::create_dir_all(to).unwrap();
-    for e in std::fs::read_dir(from).unwrap() {
-        let e = e.unwrap();
-        if e.file_type().unwrap().is_dir() {
-            copy_dir(&e.path(), &to.join(e.file_name()));
-        } else {
-            std::fs::copy(e.path(), to.join(e.file_name())).unwrap();
-        }
-    }
+    assert_eq!(common::summary_numbers(a), common::summary_numbers(b));
 }
 
 /// Runs `scene` to its end on 2 threads with checkpoints every `every` steps, keeps its
@@ -251,7 +223,7 @@ fn resume_from_last_checkpoint(scene: &str, every: u64, sets: &[&str]) {
     let o = common::kdmpm(&args);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let full = dir.join("full");
-    copy_dir(&out, &full);
+    common::copy_dir(&out, &full);
     let o = common::kdmpm(&["resume", out.to_str().unwrap(), "--quiet", "--threads", "1"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     same_results(&out, &full);
@@ -342,7 +314,7 @@ fn ctrl_c_checkpoints_and_a_resumed_run_writes_the_files_of_one_never_interrupte
         .unwrap();
     // Interrupt once the run is under way (its history has rows beyond the header).
     common::interrupt(child, &cut, "INT");
-    let summary = summary_numbers(&cut);
+    let summary = common::summary_numbers(&cut);
     assert_eq!(summary["outcome"], "interrupted");
     assert!(summary["steps"].as_u64().unwrap() < 3000);
     assert!(cut.join("checkpoint.kdc").exists());
