@@ -136,7 +136,7 @@ pub fn restore<D: Dim>(
 
 /// Puts one rank's part of a run over ranks ([`parts`]), or the whole state of a run on
 /// one rank, into `sim`: built from the checkpoint's scene and, over ranks, split by
-/// [`crate::run::distribute::decompose`]. `total` is the scene's point count over every
+/// [`crate::run::distribute::join`]. `total` is the scene's point count over every
 /// rank. Over ranks the rank's points are spawned again as saved (a rank holds the points
 /// that migrated to it, not those of the first split), with the cell layers each rank held.
 pub fn restore_part<D: Dim>(
@@ -258,10 +258,11 @@ fn overwrite<D: Dim>(sim: &mut Simulation<D>, r: &mut Reader) -> Result<(), Chec
 }
 
 /// Replaces this rank's points by the saved ones, archetype by archetype and row by row in
-/// the saved order (a run over ranks: its points are those that migrated to it). Every
-/// point archetype exists already (each rank built the whole scene), so each saved one is
-/// appended to the same archetype, in the same order, as in the run that wrote it: one
-/// column batch a saved archetype, filled column by column as the set-up fills its own.
+/// the saved order (a run over ranks: its points are those that migrated to it). The
+/// archetypes the set-up made exist already and the saved ones come in the world's order
+/// (set-up's, then those points brought by migrating), so each saved one is appended to
+/// the same archetype, in the same order, as in the run that wrote it: one column batch a
+/// saved archetype, filled column by column as the set-up fills its own.
 fn respawn<D: Dim>(sim: &mut Simulation<D>, r: &mut Reader) -> Result<(), CheckpointError> {
     let world = &mut sim.ctx.world;
     let held: Vec<Entity> = world

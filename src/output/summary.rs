@@ -139,6 +139,9 @@ pub struct Ranks {
     /// nodes and of moving points, and the reductions), over the steps this invocation
     /// made (a resumed run's since its checkpoint).
     pub bytes_per_step: f64,
+    /// Each rank's peak resident memory (bytes), set-up included, where the system reports
+    /// it (0 where it does not).
+    pub peak_memory_bytes: Vec<u64>,
 }
 
 /// How a run ended, as `summary.json` writes it (snake case).
@@ -242,6 +245,7 @@ impl Summary {
         let mut largest = max_u.map_or([f64::NEG_INFINITY; 2], |u| [u.0, u.1]);
         comm.max(&mut largest);
         let max_u = (largest[0] >= 0.0).then_some((largest[0], largest[1]));
+        let peaks = comm.gather_all(&[peak_memory_bytes().unwrap_or(0) as f64]);
         let ranks = (comm.size() > 1).then(|| {
             let mut migrations = [s.ranks.migrations as f64, comm.sent_bytes() as f64];
             comm.sum(&mut migrations);
@@ -252,6 +256,7 @@ impl Summary {
                 rebalances: s.ranks.rebalances,
                 bounds: sim.ctx.decomposition.bounds.clone(),
                 bytes_per_step: migrations[1] / (s.clock.step - s.ranks.first_step).max(1) as f64,
+                peak_memory_bytes: peaks.iter().map(|&p| p as u64).collect(),
             }
         });
         let rigid_bodies = body_results(sim);

@@ -39,7 +39,7 @@ use crate::error::{Ending, SceneError, StepError};
 use crate::infra::comm::Comm;
 use crate::interrupt::StopSignal;
 use crate::output::{Outcome, OutputDir, Progress, Recorder, Summary};
-use crate::scene::{build, LoadedScene};
+use crate::scene::{build, build_part, LoadedScene, RankPart};
 use crate::simulation::Simulation;
 use crate::state::SolverState;
 use crate::systems::convergence::ratio_text;
@@ -225,10 +225,11 @@ impl<'a> Run<'a> {
         let Run { start, watch } = self;
         match start {
             Start::Scene(loaded) => {
-                let (mut sim, _) = build(&loaded)?;
                 if watch.comm.size() > 1 {
-                    return with_simulation!(&mut sim, s => ranks::go(s, &loaded, watch, None));
+                    let (mut sim, derived) = build_part(&loaded, Some(watch.part()))?;
+                    return with_simulation!(&mut sim, s => ranks::go(s, &loaded, watch, derived.points, None));
                 }
+                let (mut sim, _) = build(&loaded)?;
                 let dir = watch.out.as_deref().map(claim).transpose()?;
                 if let Some(dir) = &dir {
                     // A checkpoint left by an earlier run belongs to that run: resuming it
@@ -257,13 +258,13 @@ impl<'a> Run<'a> {
                 let header = &manifest.header;
                 let loaded = LoadedScene::from_text(&header.scene_path, &header.scene_text, &[])?;
                 check_meshes(&loaded, header, &dir.join(checkpoint::FILE_NAME))?;
-                let (mut sim, _) = build(&loaded)?;
+                let (mut sim, derived) = build_part(&loaded, Some(watch.part()))?;
                 let resume = ranks::Resume {
                     manifest: &manifest,
                     part: &part,
                     file: &file,
                 };
-                with_simulation!(&mut sim, s => ranks::go(s, &loaded, watch, Some(resume)))
+                with_simulation!(&mut sim, s => ranks::go(s, &loaded, watch, derived.points, Some(resume)))
             }
             Start::Checkpoint(dir) => {
                 let file = dir.join(checkpoint::FILE_NAME);
@@ -287,6 +288,14 @@ impl<'a> Run<'a> {
 }
 
 impl Watch<'_> {
+    /// This process's part of a run over the ranks of its communicator.
+    fn part(&self) -> RankPart {
+        RankPart {
+            ranks: self.comm.size(),
+            rank: self.comm.rank(),
+        }
+    }
+
     /// Steps `sim` to its end with the hooks, writing into `dir` when there is one. `header`
     /// carries the scene and, for a resumed run, the wall time before and the history's
     /// mark (`history`).

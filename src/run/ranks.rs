@@ -20,17 +20,18 @@ pub(super) struct Resume<'a> {
     pub file: &'a std::path::Path,
 }
 
-/// Steps this rank's part of `sim` (built from the scene, or from the checkpoint's scene
-/// when `resume` is given); rank 0 through the runner's hooks and outputs.
+/// Steps this rank's part `sim` of a scene of `total` points (built from the scene for this
+/// rank, or from the checkpoint's scene when `resume` is given); rank 0 through the runner's
+/// hooks and outputs.
 pub(super) fn go<D: Dim>(
     sim: &mut Simulation<D>,
     loaded: &LoadedScene,
     watch: Watch<'_>,
+    total: usize,
     resume: Option<Resume<'_>>,
 ) -> Result<RunReport, RunError> {
     let comm = watch.comm.clone();
-    let total = sim.point_count();
-    super::distribute::decompose(sim, comm.clone());
+    super::distribute::join(sim, comm.clone());
     if let Some(r) = &resume {
         // This rank's points, state and split as saved; a rank that cannot stops all.
         let restored = checkpoint::restore_part(sim, r.part, r.file, total);

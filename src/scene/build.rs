@@ -10,7 +10,7 @@ use crate::context::Context;
 use crate::dim::{Dim, Dim2, Dim3, DimAxi, Vector};
 use crate::error::SceneError;
 use crate::grid::Grid;
-use crate::infra::columns::{col, fill, points_with};
+use crate::infra::columns::fill;
 use crate::infra::decomposition::Decomposition;
 use crate::materials::{MaterialModel, MaterialState, StateVisitor};
 use crate::model::{Control, Gravity, LoadStage, Model, MotionSpec};
@@ -26,18 +26,40 @@ use hecs::{ColumnBatchBuilder, ColumnBatchType, Entity, World};
 /// Validates the scene and builds its simulation with its schedule (the default one for its
 /// settings unless `solver.schedule` names the systems).
 pub fn build(loaded: &LoadedScene) -> Result<(AnySimulation, Derived), SceneError> {
+    build_part(loaded, None)
+}
+
+/// One MPI rank's part of a scene: which rank of how many.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RankPart {
+    /// The run's rank count (≥ 1).
+    pub ranks: usize,
+    /// This rank (< `ranks`).
+    pub rank: usize,
+}
+
+/// [`build`], spawning only the points of `part`'s cell layers when a part is given: the
+/// split ([`Decomposition::balanced`]) comes from the layer counts of every body's points,
+/// found from the bodies' regions without spawning them, so a rank holds its own points
+/// only, from set-up on. Everything global (ids, the nodes the points touch, the points a
+/// traction loads, traced points, the initial energy) is found over every point, so each
+/// rank's part is the one-rank build's cut to its layers.
+pub fn build_part(
+    loaded: &LoadedScene,
+    part: Option<RankPart>,
+) -> Result<(AnySimulation, Derived), SceneError> {
     let checked = validate::check(loaded)?;
     Ok(match loaded.scene.dimension {
         Dimension::Two => {
-            let (sim, d) = build_dim::<Dim2>(loaded, checked)?;
+            let (sim, d) = build_dim::<Dim2>(loaded, checked, part)?;
             (AnySimulation::Two(sim), d)
         }
         Dimension::Axisymmetric => {
-            let (sim, d) = build_dim::<DimAxi>(loaded, checked)?;
+            let (sim, d) = build_dim::<DimAxi>(loaded, checked, part)?;
             (AnySimulation::Axi(sim), d)
         }
         Dimension::Three => {
-            let (sim, d) = build_dim::<Dim3>(loaded, checked)?;
+            let (sim, d) = build_dim::<Dim3>(loaded, checked, part)?;
             (AnySimulation::Three(sim), d)
         }
     })
@@ -254,7 +276,11 @@ fn numerics(solver: &SolverSpec, dt: f64, full_node_mass: f64, initial_energy: f
     }
 }
 
-fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulation<D>, Derived), SceneError> {
+fn build_dim<D: Dim>(
+    loaded: &LoadedScene,
+    checked: Checked,
+    part: Option<RankPart>,
+) -> Result<(Simulation<D>, Derived), SceneError> {
     let Checked {
         grid: checked_grid,
         materials: table,
@@ -271,6 +297,9 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
     let grid = new_grid::<D>(&checked_grid);
     let mut world = World::new();
     spawn_nodes(&mut world, &grid, &checked_grid.faces);
+    let decomposition = split(s, &grid, part);
+    let layers = decomposition.cells();
+    let keep = |x: [f64; 3]| layers.contains(&grid.clamped_cell_along(D::vec_from(x), grid.slab_axis));
     let Bodies {
         ids: body_ids,
         next_id,
@@ -282,16 +311,18 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         &table,
         &every_water(&water, &checked_stages),
         &mut world,
+        &keep,
     )?;
-    let touched = touched_nodes(&world, &grid, s.shape);
+    let every = || every_point(s, &grid, &body_ids);
+    let touched = touched_nodes(&grid, s.shape, every().map(|p| p.x));
     validate::check_motion_boxes(loaded, &grid, &touched)?;
-    let (load_ids, _) = spawn_point_loads(loaded, &grid, &mut world, &touched, next_id)?;
-    let placed = super::tractions::place::<D>(&mut world, loaded, &body_ids)?;
+    let (load_ids, point_count) = spawn_point_loads(loaded, &grid, &mut world, &touched, next_id, &keep)?;
+    let placed = super::tractions::place::<D, _>(&mut world, loaded, every)?;
 
     // Bodies are filled row of points by row of points; cell order keeps the points that
     // share nodes together in memory from the first step.
     sort_points(&world, &grid).expect("set-up spawns only kdmpm components");
-    let traced = find_traced::<D>(loaded, &world)?;
+    let traced = find_traced::<D, _>(loaded, &world, every)?;
 
     let numerics = numerics(&s.solver, dt, full_node_mass, initial_energy);
     let model = Model {
@@ -325,9 +356,7 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
         p_wave_speed: c_p,
         critical_time_step: dt_crit,
         time_step: dt,
-        points: points_with::<Position<D::Vec>>(&world)
-            .map(|a| a.len() as usize)
-            .sum(),
+        points: point_count as usize,
         active_nodes: touched.iter().filter(|&&t| t).count(),
         grid_nodes: grid.node_count(),
         systems: schedule.names(),
@@ -338,7 +367,6 @@ fn build_dim<D: Dim>(loaded: &LoadedScene, checked: Checked) -> Result<(Simulati
     };
     let state = initial_state(s);
     let materials = table.into_iter().map(|(_, m)| m).collect();
-    let decomposition = Decomposition::whole(grid.axes[grid.slab_axis].cells, s.shape.support());
     let ctx = Context {
         world,
         grid,
@@ -494,6 +522,52 @@ fn spawn_nodes<D: Dim>(world: &mut World, grid: &Grid<D>, faces: &[FaceHold]) {
     }));
 }
 
+/// The split of the scene's cell layers over `part`'s ranks (every layer on one rank without
+/// a part), balanced on the points every body and point load puts in each layer: the counts
+/// the spawned points would give, found from the regions alone.
+fn split<D: Dim>(s: &Scene, grid: &Grid<D>, part: Option<RankPart>) -> Decomposition {
+    let (axis, support) = (grid.slab_axis, s.shape.support());
+    let layers = grid.axes[axis].cells;
+    let Some(RankPart { ranks, rank }) = part.filter(|p| p.ranks > 1) else {
+        return Decomposition::whole(layers, support);
+    };
+    let mut counts = vec![0u64; layers];
+    let mut count = |x: [f64; 3]| counts[grid.clamped_cell_along(D::vec_from(x), axis)] += 1;
+    for body in &s.bodies {
+        fill_points(grid, &body.region, &body.points_per_cell, &s.rigid_bodies).for_each(&mut count);
+    }
+    s.point_loads.iter().for_each(|l| count(pad3(&l.position)));
+    Decomposition::balanced(&counts, ranks, rank, support)
+}
+
+/// A body's point at set-up, whichever rank holds it.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct BodyPoint {
+    /// Its body (index into `bodies`).
+    pub body: usize,
+    /// Its id.
+    pub id: u32,
+    /// Its place at set-up (m, x y z).
+    pub x: [f64; 3],
+}
+
+/// Every body's points in id order, regenerated from the regions (`ids`: each body's).
+fn every_point<'a, D: Dim>(
+    s: &'a Scene,
+    grid: &'a Grid<D>,
+    ids: &'a [std::ops::Range<u32>],
+) -> impl Iterator<Item = BodyPoint> + 'a {
+    s.bodies
+        .iter()
+        .zip(ids)
+        .enumerate()
+        .flat_map(move |(body, (b, ids))| {
+            fill_points(grid, &b.region, &b.points_per_cell, &s.rigid_bodies)
+                .zip(ids.clone())
+                .map(move |(x, id)| BodyPoint { body, id, x })
+        })
+}
+
 /// The ids of each body's points, the next free id and the mass ρ·h^D of a node inside the
 /// lightest body, after spawning every body's points.
 struct Bodies {
@@ -505,13 +579,15 @@ struct Bodies {
 }
 
 /// Fills every body with points (refusing one outside the grid, one that overlaps an
-/// earlier body and one with no point) and spawns them.
+/// earlier body and one with no point) and spawns those at places `keep` takes (a rank's
+/// layers); ids and the figures of [`Bodies`] count every point.
 fn spawn_bodies<D: Dim>(
     loaded: &LoadedScene,
     grid: &Grid<D>,
     table: &[(String, MaterialModel)],
     waters: &[(String, &crate::water::Water)],
     world: &mut World,
+    keep: &dyn Fn([f64; 3]) -> bool,
 ) -> Result<Bodies, SceneError> {
     let s = &loaded.scene;
     let n = D::N;
@@ -564,7 +640,7 @@ fn spawn_bodies<D: Dim>(
                 "the body holds no material point (is it smaller than a sub-cell?)",
             ));
         }
-        let spawned = spawn_body::<D>(loaded, b, table, waters, world, xs, next_id)?;
+        let spawned = spawn_body::<D>(loaded, b, table, waters, world, xs, next_id, keep)?;
         full_node_mass = full_node_mass.min(spawned.full_node_mass);
         initial_energy += spawned.initial_energy;
         body_ids.push(next_id..spawned.next_id);
@@ -587,17 +663,24 @@ struct Spawned {
     initial_energy: f64,
 }
 
-/// Spawns body `b`'s points `xs` (positions and ids from `first`, as many as `xs.left`) as
-/// one column batch of its material's columns.
+/// Spawns those of body `b`'s points `all` (positions and ids from `first`, as many as
+/// `all.left`) at places `keep` takes, as one column batch of its material's columns.
+#[allow(clippy::too_many_arguments)]
 fn spawn_body<D: Dim>(
     loaded: &LoadedScene,
     b: usize,
     table: &[(String, MaterialModel)],
     waters: &[(String, &crate::water::Water)],
     world: &mut World,
-    xs: Counted<impl Iterator<Item = ([f64; 3], u32)> + Clone>,
+    all: Counted<impl Iterator<Item = ([f64; 3], u32)> + Clone>,
     first: u32,
+    keep: &dyn Fn([f64; 3]) -> bool,
 ) -> Result<Spawned, SceneError> {
+    let kept = all.clone().filter(|(x, _)| keep(*x));
+    let xs = Counted {
+        left: kept.clone().count(),
+        inner: kept,
+    };
     let count = xs.left;
     let s = &loaded.scene;
     let body = &s.bodies[b];
@@ -620,7 +703,7 @@ fn spawn_body<D: Dim>(
         waters,
         mat as u16,
         &body.material,
-        xs.clone().map(|(x, _)| (x, vol_at(x))),
+        all.clone().map(|(x, _)| (x, vol_at(x))),
     )?;
     let mass_at = |x: [f64; 3]| {
         let (v, rho) = (vol_at(x), model.density());
@@ -629,7 +712,7 @@ fn spawn_body<D: Dim>(
             None => rho * v,
         }
     };
-    let next_id = u32::try_from(count)
+    let next_id = u32::try_from(all.left)
         .ok()
         .and_then(|c| first.checked_add(c))
         .ok_or_else(|| {
@@ -666,7 +749,7 @@ fn spawn_body<D: Dim>(
     // 3p²/(2M) bounds it from the P-wave modulus M.
     let initial_energy = if body.initial_pressure > 0.0 {
         1.5 * body.initial_pressure.powi(2) / model.p_wave_modulus()
-            * xs.clone().map(|(x, _)| vol_at(x)).sum::<f64>()
+            * all.map(|(x, _)| vol_at(x)).sum::<f64>()
     } else {
         0.0
     };
@@ -700,26 +783,25 @@ fn spawn_body<D: Dim>(
     })
 }
 
-/// Which nodes the points touch at the start.
-fn touched_nodes<D: Dim>(world: &World, grid: &Grid<D>, shape: ShapeKind) -> Vec<bool> {
+/// Which nodes the points at places `xs` touch at the start.
+fn touched_nodes<D: Dim>(grid: &Grid<D>, shape: ShapeKind, xs: impl Iterator<Item = [f64; 3]>) -> Vec<bool> {
     let mut touched = vec![false; grid.node_count()];
-    for arch in points_with::<Position<D::Vec>>(world) {
-        for x in col::<Position<D::Vec>>(arch).iter() {
-            visit_support(grid, shape, x.0, |i, w| touched[i] |= w > 0.0);
-        }
+    for x in xs {
+        visit_support(grid, shape, D::vec_from(x), |i, w| touched[i] |= w > 0.0);
     }
-
     touched
 }
 
 /// Spawns the point loads' carriers, massless points that move with the body, from id
-/// `next_id` on; returns each load's name and id, and the next free id.
+/// `next_id` on, those at places `keep` takes; returns each load's name and id, and the
+/// next free id.
 fn spawn_point_loads<D: Dim>(
     loaded: &LoadedScene,
     grid: &Grid<D>,
     world: &mut World,
     touched: &[bool],
     mut next_id: u32,
+    keep: &dyn Fn([f64; 3]) -> bool,
 ) -> Result<(Vec<(String, u32)>, u32), SceneError> {
     let s = &loaded.scene;
     let z = D::Vec::ZERO;
@@ -744,20 +826,24 @@ fn spawn_point_loads<D: Dim>(
             ));
         }
         load_ids.push((l.name.clone(), next_id));
-        let carrier = world.spawn((
-            PointId(next_id),
-            Position(x),
-            Velocity(z),
-            Mass(0.0),
-            VelocityGradient(D::MAT_ZERO),
-            PointLoad(D::vec_from(pad3(&l.force))),
-        ));
+        let id = next_id;
         next_id = next_id.checked_add(1).ok_or_else(|| {
             loaded.invalid(
                 &format!("point_loads[{i}]"),
                 "more than 4 294 967 295 points in all",
             )
         })?;
+        if !keep(pad3(&l.position)) {
+            continue;
+        }
+        let carrier = world.spawn((
+            PointId(id),
+            Position(x),
+            Velocity(z),
+            Mass(0.0),
+            VelocityGradient(D::MAT_ZERO),
+            PointLoad(D::vec_from(pad3(&l.force))),
+        ));
         if s.output.displacements {
             world.insert_one(carrier, Displacement(z)).expect("just spawned");
         }
@@ -767,24 +853,26 @@ fn spawn_point_loads<D: Dim>(
 }
 
 /// The traced points: the nearest point within one cell of each position asked for.
-fn find_traced<D: Dim>(loaded: &LoadedScene, world: &World) -> Result<Vec<TracedPoint>, SceneError> {
+fn find_traced<D: Dim, I: Iterator<Item = BodyPoint>>(
+    loaded: &LoadedScene,
+    world: &World,
+    every: impl Fn() -> I,
+) -> Result<Vec<TracedPoint>, SceneError> {
     let s = &loaded.scene;
     let n = D::N;
     let mut traced = Vec::new();
     for (i, t) in s.traced.iter().enumerate() {
         let want = pad3(&t.position);
         let dist = |x: &[f64; 3]| (0..3).map(|a| (x[a] - want[a]).powi(2)).sum::<f64>().sqrt();
-        let mut query = world.query::<(Entity, &Position<D::Vec>, &PointId)>();
-        let best = query
-            .iter()
-            .map(|(e, x, id)| (D::vec_to3(x.0), e, *id))
-            .min_by(|a, b| dist(&a.0).total_cmp(&dist(&b.0)));
+        // The nearest of every body's points, the first made on a tie: the same on every
+        // rank, held by one of them.
+        let best = every().min_by(|a, b| dist(&a.x).total_cmp(&dist(&b.x)));
         match best {
-            Some((x, entity, id)) if dist(&x) <= s.grid.cell_size => traced.push(TracedPoint {
+            Some(p) if dist(&p.x) <= s.grid.cell_size => traced.push(TracedPoint {
                 name: t.name.clone(),
-                id,
-                entity,
-                initial_position: x,
+                id: PointId(p.id),
+                entity: crate::simulation::find_point(world, PointId(p.id)).unwrap_or(Entity::DANGLING),
+                initial_position: p.x,
             }),
             _ => {
                 return Err(loaded.invalid(

@@ -17,7 +17,7 @@ mod tractions;
 mod validate;
 
 pub use crate::materials::MaterialSpec;
-pub use build::build;
+pub use build::{build, build_part, RankPart};
 pub use loaded::LoadedScene;
 pub use spec::{
     BodySpec, BoundarySpec, CheckpointEvery, Condition, Dimension, GravitySpec, GridSpec, OutputSpec,

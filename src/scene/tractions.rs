@@ -1,5 +1,6 @@
 //! Tractions: a distributed load on a body's surface, carried by the outermost points.
 
+use super::build::BodyPoint;
 use super::loaded::LoadedScene;
 use crate::components::*;
 use crate::dim::Dim;
@@ -14,46 +15,53 @@ use std::collections::BTreeMap;
 /// surface, (h/n) per axis across the normal for n points a cell. A `pressure` gives them
 /// the traction −p n and their neighbours along the surface (the next columns' points), from
 /// which `point_loads` turns the load with the surface ([`crate::surface_pressure`]).
-/// `body_ids` holds the point ids of each body.
-pub(super) fn place<D: Dim>(
+/// `every` gives every body's points at set-up, whichever rank holds them: the columns and
+/// their outermost points are the whole scene's, and the loads go to those `world` holds.
+pub(super) fn place<D: Dim, I: Iterator<Item = BodyPoint>>(
     world: &mut World,
     loaded: &LoadedScene,
-    body_ids: &[std::ops::Range<u32>],
+    every: impl Fn() -> I,
 ) -> Result<Placed, SceneError> {
     let s = &loaded.scene;
     let n = D::N;
     let mut placed = Placed::default();
+    // Each traction's columns, then the entities of the loaded points this rank holds.
+    let columns = (0..s.tractions.len())
+        .map(|i| outermost::<D>(every(), loaded, i))
+        .collect::<Result<Vec<_>, _>>()?;
+    let wanted: std::collections::BTreeSet<u32> =
+        columns.iter().flat_map(|c| c.values().map(|v| v.1.id)).collect();
+    let held: BTreeMap<u32, Entity> = world
+        .query::<(Entity, &PointId)>()
+        .iter()
+        .filter(|(_, id)| wanted.contains(&id.0))
+        .map(|(e, id)| (id.0, e))
+        .collect();
     // Every loaded point, by id: the traction that loaded it and whether it is a pressure.
     let mut loaded_by: BTreeMap<u32, (usize, bool)> = BTreeMap::new();
     // The points under a pressure and their places in its surface.
     let mut followers: Vec<(u32, SurfacePoint)> = Vec::new();
-    for (i, t) in s.tractions.iter().enumerate() {
+    for ((i, t), outermost) in s.tractions.iter().enumerate().zip(&columns) {
         let (normal, upper) = t.surface.axis_side();
-        let outermost = outermost::<D>(world, loaded, body_ids, i)?;
         let pressed = t.pressure.is_some();
         let across: Vec<usize> = (0..n).filter(|&a| a != normal).collect();
-        let ids: BTreeMap<&Vec<i64>, u32> = outermost
-            .iter()
-            .map(|(k, v)| (k, world.get::<&PointId>(v.1).expect("a live point").0))
-            .collect();
+        let ids: BTreeMap<&Vec<i64>, u32> = outermost.iter().map(|(k, v)| (k, v.1.id)).collect();
         let (mut points, mut shares) = (Vec::new(), Vec::new());
-        for (key, &(_, e, share, subs)) in &outermost {
-            let id = ids[key];
-            let at = || {
-                let x = D::vec_to3(world.get::<&Position<D::Vec>>(e).expect("a live point").0);
-                x[..n].to_vec()
-            };
+        for (key, &(_, p, share, subs)) in outermost {
+            let id = p.id;
             if let Some(&(j, earlier_pressed)) = loaded_by.get(&id) {
                 if pressed || earlier_pressed {
-                    return Err(shared_point(loaded, i, j, at()));
+                    return Err(shared_point(loaded, i, j, p.x[..n].to_vec()));
                 }
             }
             loaded_by.entry(id).or_insert((i, pressed));
             let f = D::vec_from(t.vector()) * share;
-            let earlier = world.get::<&PointLoad<D::Vec>>(e).map(|p| p.0).ok();
-            world
-                .insert_one(e, PointLoad(earlier.map_or(f, |g| g + f)))
-                .expect("a live point");
+            if let Some(&e) = held.get(&id) {
+                let earlier = world.get::<&PointLoad<D::Vec>>(e).map(|p| p.0).ok();
+                world
+                    .insert_one(e, PointLoad(earlier.map_or(f, |g| g + f)))
+                    .expect("a live point");
+            }
             points.push((id, D::vec_to3(f)));
             shares.push((id, share));
             if pressed {
@@ -90,13 +98,12 @@ pub(super) fn place<D: Dim>(
 /// sub-cell coordinates across the normal; key order keeps set-up deterministic) → (how
 /// far out along the normal, the point, the column's share of the surface, the sub-cell's
 /// edges in m). Refused when the box holds no point or its face lies on the axis.
-type Columns = BTreeMap<Vec<i64>, (f64, Entity, f64, [f64; 3])>;
+type Columns = BTreeMap<Vec<i64>, (f64, BodyPoint, f64, [f64; 3])>;
 
-/// The outermost point of each column of traction `i` ([`Columns`]).
+/// The outermost of the body points `every` in each column of traction `i` ([`Columns`]).
 fn outermost<D: Dim>(
-    world: &World,
+    every: impl Iterator<Item = BodyPoint>,
     loaded: &LoadedScene,
-    body_ids: &[std::ops::Range<u32>],
     i: usize,
 ) -> Result<Columns, SceneError> {
     let s = &loaded.scene;
@@ -104,19 +111,12 @@ fn outermost<D: Dim>(
     let t = &s.tractions[i];
     let (normal, upper) = t.surface.axis_side();
     let mut outermost = Columns::new();
-    for (e, x, id) in world.query::<(Entity, &Position<D::Vec>, &PointId)>().iter() {
-        if world.get::<&Stress<D::Stress>>(e).is_err() {
-            continue; // a load carrier
-        }
-        let x = D::vec_to3(x.0);
+    for p in every {
+        let x = p.x;
         if !(0..n).all(|a| x[a] >= t.min[a] && x[a] <= t.max[a]) {
             continue;
         }
-        let body = body_ids
-            .iter()
-            .position(|r| r.contains(&id.0))
-            .expect("every point has a body");
-        let ppc = &s.bodies[body].points_per_cell;
+        let ppc = &s.bodies[p.body].points_per_cell;
         let sub = |a: usize| s.grid.cell_size / ppc[a] as f64;
         let key: Vec<i64> = (0..n)
             .filter(|&a| a != normal)
@@ -145,9 +145,9 @@ fn outermost<D: Dim>(
         let share: f64 = (0..n).filter(|&a| a != normal).map(sub).product::<f64>() * radius;
         let out = if upper { x[normal] } else { -x[normal] };
         let subs = std::array::from_fn(|a| if a < n { sub(a) } else { 0.0 });
-        let entry = outermost.entry(key).or_insert((out, e, share, subs));
+        let entry = outermost.entry(key).or_insert((out, p, share, subs));
         if entry.0 < out {
-            *entry = (out, e, share, subs);
+            *entry = (out, p, share, subs);
         }
     }
     if outermost.is_empty() {

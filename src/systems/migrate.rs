@@ -1,6 +1,6 @@
 //! Points that left this rank's cell layers move to the neighbouring rank (runs over MPI).
 //!
-//! [`Migrate`] ends every step of a run over several ranks (`distributed::decompose` adds
+//! [`Migrate`] ends every step of a run over several ranks (`distribute::join` adds
 //! it): a point moves less than a cell a step, so at the next mapping every point lies in
 //! its rank's layers and maps only into that rank's nodes and the bands it shares. A point goes
 //! with every column it has (the list of `point_components!`,

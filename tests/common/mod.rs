@@ -278,6 +278,7 @@ pub fn summary_numbers(dir: &Path) -> serde_json::Value {
     }
     if let Some(ranks) = v.get_mut("ranks").and_then(|r| r.as_object_mut()) {
         ranks.remove("bytes_per_step");
+        ranks.remove("peak_memory_bytes");
     }
     v
 }

@@ -20,6 +20,7 @@ mod fuzz_scenes;
 mod pay_for_what_you_use;
 mod plane_strain;
 mod prescribed_motion;
+mod rank_parts;
 mod refine;
 mod rigid_bodies;
 mod robustness;
