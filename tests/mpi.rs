@@ -719,3 +719,100 @@ fn a_point_leaving_the_grid_on_one_rank_stops_every_rank_with_its_error() {
         assert!(s["error"].as_str().expect("the error").starts_with(&last), "{s}");
     }
 }
+
+/// `kdmpm study --launcher "mpirun … -n 2"` starts each of its runs over 2 ranks and
+/// tabulates what one-process runs give, to 1e-10 (the ranks sum in another order); under
+/// mpirun itself the study is refused, naming the launcher.
+#[test]
+fn a_study_launching_its_runs_on_2_ranks_tabulates_one_ranks_answers() {
+    if child() {
+        return;
+    }
+    let dir = common::scratch("mpi", "study");
+    let study = dir.join("slope.ron");
+    let scene = common::scene("slope_fast.ron");
+    std::fs::write(
+        &study,
+        format!(
+            "Study(scene: {:?}, axes: [Set(path: \"solver.time_step\", values: [\"Courant(0.4)\", \
+             \"Courant(0.5)\"])], quantities: [(name: \"angle\", of: SurfaceAngle, compare: \
+             Analytic(30.0)), (name: \"crest\", of: Displacement(point: \"crest\", component: 0), \
+             compare: Analytic(-1.0))])",
+            scene.to_str().expect("UTF-8")
+        ),
+    )
+    .unwrap();
+    let conduct = |name: &str, launcher: Option<&str>| {
+        let out = dir.join(name);
+        let mut cmd = Command::new(env!("CARGO_BIN_EXE_kdmpm"));
+        cmd.arg("study")
+            .arg(&study)
+            .arg("--out")
+            .arg(&out)
+            .args(["--quiet", "--threads", "1"]);
+        if let Some(l) = launcher {
+            cmd.args(["--launcher", l]);
+        }
+        let o = cmd.output().expect("kdmpm starts");
+        assert!(
+            o.status.success(),
+            "{name}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        out
+    };
+    let one = conduct("one", None);
+    let two = conduct("two", Some("mpirun --allow-run-as-root --oversubscribe -n 2"));
+    let table = |out: &Path| -> Vec<Vec<String>> {
+        let text = std::fs::read_to_string(out.join("study.csv")).expect("study.csv");
+        text.lines()
+            .map(|l| l.split(',').map(String::from).collect())
+            .collect()
+    };
+    let (a, b) = (table(&one), table(&two));
+    assert_eq!(a.len(), 3, "{a:?}");
+    assert_eq!(a[0], b[0], "the same columns");
+    for (ra, rb) in a[1..].iter().zip(&b[1..]) {
+        for ((head, x), y) in a[0].iter().zip(ra).zip(rb) {
+            // Machine figures, and the front they decide.
+            if [
+                "wall_seconds",
+                "particle_steps_per_second",
+                "peak_memory_bytes",
+                "pareto",
+            ]
+            .contains(&head.as_str())
+            {
+                continue;
+            }
+            match (x.parse::<f64>(), y.parse::<f64>()) {
+                (Ok(p), Ok(q)) => assert!(
+                    p == q || (p - q).abs() <= 1e-10 * p.abs().max(q.abs()),
+                    "{head}: {p} on one rank, {q} on 2"
+                ),
+                _ => assert_eq!(x, y, "{head}"),
+            }
+        }
+    }
+    // Each run of the second study went over 2 ranks, to one rank's answer at full precision.
+    for run in ["run-001", "run-002"] {
+        let read = |d: &Path| -> Value {
+            serde_json::from_str(&std::fs::read_to_string(d.join(run).join("summary.json")).unwrap()).unwrap()
+        };
+        let (a, b) = (read(&one), read(&two));
+        assert_eq!(b["ranks"]["count"], 2, "{run}");
+        assert!(a["ranks"].is_null(), "{run}");
+        assert_eq!(a["steps"], b["steps"], "{run}");
+        let angle = |s: &Value| s["surface_angle"]["degrees"].clone();
+        assert!(
+            rel(&angle(&a), &angle(&b)) <= 1e-10,
+            "{run}: {} {}",
+            angle(&a),
+            angle(&b)
+        );
+    }
+    let o = kdmpm_on(2, &["study", study.to_str().expect("UTF-8")]);
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{e}");
+    assert!(e.contains("--launcher"), "{e}");
+}

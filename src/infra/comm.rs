@@ -59,6 +59,22 @@ impl Comm {
         }
     }
 
+    /// How many processes the launcher started when more than one: what `mpirun` (Open MPI)
+    /// or `srun` (PMI) tell each process, read without starting MPI.
+    pub fn launched() -> Option<usize> {
+        ["OMPI_COMM_WORLD_SIZE", "PMI_SIZE"]
+            .iter()
+            .filter_map(|v| std::env::var(v).ok())
+            .find_map(|n| n.parse::<usize>().ok().filter(|&n| n > 1))
+    }
+
+    /// This process's rank among those the launcher started, read as [`Comm::launched`].
+    pub fn launched_rank() -> Option<usize> {
+        ["OMPI_COMM_WORLD_RANK", "PMI_RANK"]
+            .iter()
+            .find_map(|v| std::env::var(v).ok()?.parse().ok())
+    }
+
     /// The processes `mpirun` started; one process when started without it, or when the
     /// build has no `mpi` feature. Call once, before any thread pool is built.
     pub fn world() -> Result<Comm, String> {
@@ -88,13 +104,9 @@ impl Comm {
         }
         #[cfg(not(feature = "mpi"))]
         {
-            // Started by mpirun or srun (Open MPI and PMI set these in each process) but
-            // built without MPI: every process would run the whole scene on its own.
-            let launched = ["OMPI_COMM_WORLD_SIZE", "PMI_SIZE"]
-                .iter()
-                .filter_map(|v| std::env::var(v).ok())
-                .find_map(|n| n.parse::<usize>().ok().filter(|&n| n > 1));
-            if let Some(n) = launched {
+            // Started by mpirun or srun but built without MPI: every process would run the
+            // whole scene on its own.
+            if let Some(n) = Comm::launched() {
                 return Err(format!(
                     "started as one of {n} MPI processes, but this kdmpm was built without \
                      MPI: build it with `cargo build --release --features mpi`"

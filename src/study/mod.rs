@@ -34,6 +34,9 @@ pub struct Launch {
     pub exe: PathBuf,
     /// `--threads` for each run.
     pub threads: Option<usize>,
+    /// The command that starts each run over MPI ranks (`["mpirun", "-n", "4"]`), the
+    /// executable and its arguments after it; empty: each run is one process.
+    pub launcher: Vec<String>,
 }
 
 /// Why a study could not go on (its runs' own failures are rows, not errors).
@@ -146,7 +149,14 @@ pub fn run_one(
             }
         }
     }
-    let mut cmd = Command::new(&launch.exe);
+    let mut cmd = match launch.launcher.split_first() {
+        Some((first, rest)) => {
+            let mut c = Command::new(first);
+            c.args(rest).arg(&launch.exe);
+            c
+        }
+        None => Command::new(&launch.exe),
+    };
     cmd.arg(study.command())
         .arg(&study.scene)
         .arg("--out")
@@ -165,9 +175,13 @@ pub fn run_one(
         .map_err(|e| StudyError::Output(format!("cannot write {}: {e}", out.join("stderr.txt").display())))?;
     cmd.stdout(Stdio::null()).stderr(stderr);
     let start = Instant::now();
-    let mut child = cmd
-        .spawn()
-        .map_err(|e| StudyError::Output(format!("cannot start {}: {e}", launch.exe.display())))?;
+    let mut child = cmd.spawn().map_err(|e| {
+        let what = launch
+            .launcher
+            .first()
+            .map_or(launch.exe.display().to_string(), String::clone);
+        StudyError::Output(format!("cannot start {what}: {e}"))
+    })?;
     let limit = study.spec.run_limit.map(Duration::from_secs_f64);
     let status = loop {
         match child.try_wait() {

@@ -90,6 +90,11 @@ pub enum Command {
         /// Output directory (default: out/study-<study file stem>).
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Start each run over MPI ranks with this launcher command, split at spaces (e.g.
+        /// "mpirun -n 4" or, in a Slurm job, "srun -n 4"): the study stays one process and
+        /// each of its runs spans the ranks.
+        #[arg(long, value_name = "COMMAND")]
+        launcher: Option<String>,
         #[command(flatten)]
         workers: Workers,
     },

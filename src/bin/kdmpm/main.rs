@@ -35,8 +35,25 @@ fn main() -> ExitCode {
     }
     let cli = Cli::parse();
     // MPI starts before any thread pool; without `mpirun` (or the `mpi` feature) this is
-    // one rank.
-    let comm = match Comm::world() {
+    // one rank. A study starts no MPI of its own: its runs are processes it launches (over
+    // ranks through `--launcher`), and a child of an MPI process would inherit its MPI.
+    let comm = match &cli.command {
+        Command::Study { .. } => match Comm::launched() {
+            // Every process is refused alike; the first says why.
+            Some(_) if Comm::launched_rank() != Some(0) => return ExitCode::from(Ending::BadInput.code()),
+            Some(n) => {
+                return Fault::bad(format!(
+                    "kdmpm study was started as one of {n} MPI processes: start it without \
+                     mpirun and it launches each run over the ranks, `kdmpm study STUDY \
+                     --launcher \"mpirun -n {n}\"` (in a Slurm job, \"srun -n {n}\")"
+                ))
+                .report()
+            }
+            None => Ok(Comm::single()),
+        },
+        _ => Comm::world(),
+    };
+    let comm = match comm {
         Ok(c) => Arc::new(c),
         Err(e) => return Fault::bad(e).report(),
     };
@@ -116,7 +133,12 @@ fn command(command: Command, comm: &Arc<Comm>) -> Result<ExitCode, Fault> {
             written.iter().for_each(|w| println!("{}", dir.join(w).display()));
             skipped.iter().for_each(|s| eprintln!("  not drawn: {s}"));
         }
-        Command::Study { study, out, workers } => run_study(&study, out, workers)?,
+        Command::Study {
+            study,
+            out,
+            launcher,
+            workers,
+        } => run_study(&study, out, launcher, workers)?,
         Command::Fos {
             scene,
             out,
@@ -294,7 +316,12 @@ fn run_fos(
 }
 
 /// `kdmpm study`: plans and checks every run, then has the library conduct the study.
-fn run_study(path: &Path, out: Option<PathBuf>, workers: Workers) -> Result<(), Fault> {
+fn run_study(
+    path: &Path,
+    out: Option<PathBuf>,
+    launcher: Option<String>,
+    workers: Workers,
+) -> Result<(), Fault> {
     use kdmpm::study::{conduct, Launch, Study};
     let study = Study::from_file(path).map_err(Fault::bad)?;
     let out = out.unwrap_or_else(|| default_out(path, "study-", "study"));
@@ -306,8 +333,18 @@ fn run_study(path: &Path, out: Option<PathBuf>, workers: Workers) -> Result<(), 
         )
     })?;
     let threads = workers.threads.map(|n| n.get());
-    let results = conduct(&study, &dir, &Launch { exe, threads }, workers.quiet)
-        .map_err(|e| Fault(e.to_string(), e.ending()))?;
+    let launcher: Vec<String> = launcher
+        .iter()
+        .flat_map(|l| l.split_whitespace())
+        .map(String::from)
+        .collect();
+    let launch = Launch {
+        exe,
+        threads,
+        launcher,
+    };
+    let results =
+        conduct(&study, &dir, &launch, workers.quiet).map_err(|e| Fault(e.to_string(), e.ending()))?;
     if !workers.quiet {
         println!("{}→ {}", results.describe(&study), dir.path().display());
     }
