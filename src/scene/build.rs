@@ -2,7 +2,7 @@
 //! and the schedule. Only what the scene uses is created.
 
 use super::loaded::LoadedScene;
-use super::region::{cell_span, region_bounds, region_contains};
+use super::region::{cell_span, region_bounds, region_contains, BodyPoint};
 use super::spec::{pad3, Dimension, Region, Scene, SolverSpec};
 use super::validate::{self, carried_state, Checked, CheckedGrid, CheckedStage, Derived, FaceHold};
 use crate::components::*;
@@ -538,17 +538,6 @@ fn split<D: Dim>(s: &Scene, grid: &Grid<D>, part: Option<RankPart>) -> Decomposi
     }
     s.point_loads.iter().for_each(|l| count(pad3(&l.position)));
     Decomposition::balanced(&counts, ranks, rank, support)
-}
-
-/// A body's point at set-up, whichever rank holds it.
-#[derive(Clone, Copy, Debug)]
-pub(super) struct BodyPoint {
-    /// Its body (index into `bodies`).
-    pub body: usize,
-    /// Its id.
-    pub id: u32,
-    /// Its place at set-up (m, x y z).
-    pub x: [f64; 3],
 }
 
 /// Every body's points in id order, regenerated from the regions (`ids`: each body's).

@@ -4,6 +4,17 @@
 
 use super::spec::{pad3, Region};
 
+/// A point filling a body's region at set-up, whichever rank holds it.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct BodyPoint {
+    /// Its body (index into `bodies`).
+    pub body: usize,
+    /// Its id.
+    pub id: u32,
+    /// Its place at set-up (m, x y z).
+    pub x: [f64; 3],
+}
+
 /// Bounding box of a region (m, x y z; z is 0..0 in 2D).
 pub(crate) fn region_bounds(region: &Region, n: usize) -> ([f64; 3], [f64; 3]) {
     match region {

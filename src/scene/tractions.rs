@@ -1,7 +1,7 @@
 //! Tractions: a distributed load on a body's surface, carried by the outermost points.
 
-use super::build::BodyPoint;
 use super::loaded::LoadedScene;
+use super::region::BodyPoint;
 use crate::components::*;
 use crate::dim::Dim;
 use crate::error::SceneError;
