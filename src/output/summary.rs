@@ -245,10 +245,13 @@ impl Summary {
         let mut largest = max_u.map_or([f64::NEG_INFINITY; 2], |u| [u.0, u.1]);
         comm.max(&mut largest);
         let max_u = (largest[0] >= 0.0).then_some((largest[0], largest[1]));
-        let peaks = comm.gather_all(&[peak_memory_bytes().unwrap_or(0) as f64]);
+        // This process's peak, read once: the summary's own and, over ranks, its entry in
+        // every rank's list.
+        let peak = peak_memory_bytes();
         let ranks = (comm.size() > 1).then(|| {
             let mut migrations = [s.ranks.migrations as f64, comm.sent_bytes() as f64];
             comm.sum(&mut migrations);
+            let peaks = comm.gather_all(&[peak.unwrap_or(0) as f64]);
             Ranks {
                 count: comm.size(),
                 points: points.iter().map(|&p| p as u64).collect(),
@@ -321,7 +324,7 @@ impl Summary {
             } else {
                 None
             },
-            peak_memory_bytes: peak_memory_bytes(),
+            peak_memory_bytes: peak,
             traced: sim.traced_results(),
             systems: sim.schedule.timings(),
             snapshots: None,

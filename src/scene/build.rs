@@ -322,7 +322,7 @@ fn build_dim<D: Dim>(
     // Bodies are filled row of points by row of points; cell order keeps the points that
     // share nodes together in memory from the first step.
     sort_points(&world, &grid).expect("set-up spawns only kdmpm components");
-    let traced = find_traced::<D, _>(loaded, &world, every)?;
+    let traced = find_traced::<D>(loaded, &world, every())?;
 
     let numerics = numerics(&s.solver, dt, full_node_mass, initial_energy);
     let model = Model {
@@ -842,22 +842,30 @@ fn spawn_point_loads<D: Dim>(
 }
 
 /// The traced points: the nearest point within one cell of each position asked for.
-fn find_traced<D: Dim, I: Iterator<Item = BodyPoint>>(
+fn find_traced<D: Dim>(
     loaded: &LoadedScene,
     world: &World,
-    every: impl Fn() -> I,
+    every: impl Iterator<Item = BodyPoint>,
 ) -> Result<Vec<TracedPoint>, SceneError> {
     let s = &loaded.scene;
     let n = D::N;
+    let wanted: Vec<[f64; 3]> = s.traced.iter().map(|t| pad3(&t.position)).collect();
+    let dist = |x: &[f64; 3], want: &[f64; 3]| (0..3).map(|a| (x[a] - want[a]).powi(2)).sum::<f64>().sqrt();
+    // The nearest of every body's points to each place, the first made on a tie (the same on
+    // every rank, held by one of them), in one pass over the points.
+    let mut best: Vec<Option<(f64, BodyPoint)>> = vec![None; wanted.len()];
+    for p in every {
+        for (b, want) in best.iter_mut().zip(&wanted) {
+            let d = dist(&p.x, want);
+            if b.is_none_or(|(e, _)| d.total_cmp(&e).is_lt()) {
+                *b = Some((d, p));
+            }
+        }
+    }
     let mut traced = Vec::new();
-    for (i, t) in s.traced.iter().enumerate() {
-        let want = pad3(&t.position);
-        let dist = |x: &[f64; 3]| (0..3).map(|a| (x[a] - want[a]).powi(2)).sum::<f64>().sqrt();
-        // The nearest of every body's points, the first made on a tie: the same on every
-        // rank, held by one of them.
-        let best = every().min_by(|a, b| dist(&a.x).total_cmp(&dist(&b.x)));
-        match best {
-            Some(p) if dist(&p.x) <= s.grid.cell_size => traced.push(TracedPoint {
+    for (i, (t, b)) in s.traced.iter().zip(best).enumerate() {
+        match b {
+            Some((d, p)) if d <= s.grid.cell_size => traced.push(TracedPoint {
                 name: t.name.clone(),
                 id: PointId(p.id),
                 entity: crate::simulation::find_point(world, PointId(p.id)).unwrap_or(Entity::DANGLING),
@@ -869,7 +877,7 @@ fn find_traced<D: Dim, I: Iterator<Item = BodyPoint>>(
                     format!(
                         "no material point within one cell ({} m) of {:?}",
                         s.grid.cell_size,
-                        &want[..n]
+                        &wanted[i][..n]
                     ),
                 ))
             }
