@@ -37,6 +37,7 @@ mod simulation;
 pub mod checkpoint;
 mod context;
 mod dim;
+pub mod element_test;
 mod error;
 pub mod fos;
 mod grid;

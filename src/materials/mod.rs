@@ -13,10 +13,14 @@
 //! fixed frame.
 
 mod linear_elastic;
+mod modified_cam_clay;
 mod mohr_coulomb;
 mod mohr_coulomb_softening;
 
 pub use linear_elastic::{LinearElastic, LinearElasticSpec};
+pub use modified_cam_clay::{
+    CamClayState, ModifiedCamClay, ModifiedCamClaySpec, Preconsolidation, MIN_STIFFNESS_PRESSURE,
+};
 pub use mohr_coulomb::{MohrCoulomb, MohrCoulombSpec, PlasticStrain, Return};
 pub use mohr_coulomb_softening::{MohrCoulombSoftening, MohrCoulombSofteningSpec, SofteningStrain};
 
@@ -39,6 +43,7 @@ macro_rules! materials {
             LinearElastic($crate::materials::LinearElasticSpec),
             MohrCoulomb($crate::materials::MohrCoulombSpec),
             MohrCoulombSoftening($crate::materials::MohrCoulombSofteningSpec),
+            ModifiedCamClay($crate::materials::ModifiedCamClaySpec),
         }
     };
 }
@@ -51,6 +56,11 @@ pub trait MaterialState: bytemuck::Pod + Default + PartialEq + Debug + Send + Sy
     fn plastic_strain(&self) -> f64;
     /// True when every value is finite.
     fn is_finite(&self) -> bool;
+    /// The state's other values by name (units in the model's docs), for element tests and
+    /// output: none by default.
+    fn fields(&self) -> Vec<(&'static str, f64)> {
+        Vec::new()
+    }
 }
 
 impl MaterialState for () {

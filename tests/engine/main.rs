@@ -7,8 +7,10 @@
 mod common;
 
 mod anti_locking;
+
 mod axisymmetric;
 mod bar;
+mod cam_clay;
 mod checkpoint_integrity;
 mod checkpoint_resume;
 mod custom_system;

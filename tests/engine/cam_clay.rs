@@ -1,0 +1,147 @@
+//! Modified Cam Clay against the closed forms of Wood (1990, *Soil Behaviour and Critical
+//! State Soil Mechanics*, Cambridge University Press, §6.4 and §7.3–7.4), by element tests
+//! (`kdmpm::element_test`), and the same clay in the engine: an oedometer.
+//!
+//! The clay is `scenes/clay_oedometer.ron`'s: λ = 0.25, κ = 0.05 (Λ = (λ − κ)/λ = 0.8),
+//! M = 0.9, ν = 0.25, N = 3.0 at 1 kPa, Γ = N − (λ − κ) ln 2.
+
+use crate::common::{rel, run, scene};
+use kdmpm::element_test::{oedometer, triaxial, Drainage, Row, Triaxial};
+use kdmpm::materials::{MaterialModel, MaterialSpec};
+use kdmpm::LoadedScene;
+
+const M: f64 = 0.9;
+const LAMBDA: f64 = 0.25;
+const KAPPA: f64 = 0.05;
+const N: f64 = 3.0;
+const P0: f64 = 100e3;
+
+/// The oedometer scene's clay with overconsolidation ratio `ratio`.
+fn clay(ratio: f64) -> MaterialModel {
+    let set = format!("materials.clay.preconsolidation=Ratio({ratio:?})");
+    let loaded = LoadedScene::from_file(&scene("clay_oedometer.ron"), &[set]).expect("scene loads");
+    let spec: &MaterialSpec = &loaded.scene.materials["clay"];
+    spec.model(&|f| f.to_string()).expect("a valid clay")
+}
+
+fn test(drainage: Drainage, axial_strain: f64, steps: usize) -> Triaxial {
+    Triaxial {
+        cell_pressure: P0,
+        drainage,
+        axial_strain,
+        steps,
+    }
+}
+
+fn field(row: &Row, name: &str) -> f64 {
+    row.state
+        .iter()
+        .find(|(n, _)| *n == name)
+        .expect("a state field")
+        .1
+}
+
+#[test]
+fn drained_compression_of_a_normally_consolidated_clay_ends_on_the_critical_state_line() {
+    // The drained path q = 3(p′ − p′₀) meets q = M p′ at p′_f = 3p′₀/(3 − M), there with
+    // v_f = Γ − λ ln p′_f (Wood 1990, §7.3).
+    let rows = triaxial(&clay(1.0), &test(Drainage::Drained, 1.0, 10_000)).unwrap();
+    let last = rows.last().unwrap();
+    let pf = 3.0 * P0 / (3.0 - M);
+    let gamma = N - (LAMBDA - KAPPA) * 2f64.ln();
+    let vf = gamma - LAMBDA * (pf / 1e3).ln();
+    assert!(
+        rel(last.mean_stress, pf).abs() < 0.002,
+        "p′ {} against {pf}",
+        last.mean_stress
+    );
+    assert!(
+        rel(last.deviator, M * pf).abs() < 0.005,
+        "q {} against {}",
+        last.deviator,
+        M * pf
+    );
+    assert!(rel(field(last, "specific_volume"), vf).abs() < 0.001);
+    // Every row keeps the radial stress at the cell pressure: q = 3(p′ − p′₀).
+    for r in &rows {
+        assert!(
+            (r.deviator - 3.0 * (r.mean_stress - P0)).abs() < 1e-6 * P0,
+            "{r:?}"
+        );
+    }
+}
+
+#[test]
+fn undrained_compression_of_a_normally_consolidated_clay_follows_the_closed_form_path() {
+    // Constant volume: p′/p′₀ = (M²/(M² + η²))^Λ (Wood 1990, §7.4), η = q/p′.
+    let rows = triaxial(&clay(1.0), &test(Drainage::Undrained, 0.5, 5_000)).unwrap();
+    let big_lambda = (LAMBDA - KAPPA) / LAMBDA;
+    let mut checked = 0;
+    for r in rows.iter().skip(1) {
+        let eta = r.deviator / r.mean_stress;
+        let exact = P0 * (M * M / (M * M + eta * eta)).powf(big_lambda);
+        assert!(
+            rel(r.mean_stress, exact).abs() < 0.01,
+            "η {eta}: p′ {} against {exact}",
+            r.mean_stress
+        );
+        assert!(r.volumetric_strain.abs() < 1e-12);
+        checked += 1;
+    }
+    assert_eq!(checked, 5_000);
+}
+
+#[test]
+fn undrained_strength_follows_the_overconsolidation_ratio() {
+    // s_u/p′₀ = (M/2)(R₀/2)^Λ (Wood 1990, eq. 7.37 with isotropic R₀ = p′_c/p′₀).
+    let big_lambda = (LAMBDA - KAPPA) / LAMBDA;
+    for r0 in [1.0, 2.0, 4.0, 8.0] {
+        let rows = triaxial(&clay(r0), &test(Drainage::Undrained, 0.5, 5_000)).unwrap();
+        let last = rows.last().unwrap();
+        let su = last.deviator / 2.0;
+        let exact = P0 * M / 2.0 * (r0 / 2.0f64).powf(big_lambda);
+        assert!(rel(su, exact).abs() < 0.002, "R₀ {r0}: s_u {su} against {exact}");
+        // The excess pore pressure: the total stress path's p minus p′.
+        let u = P0 + last.deviator / 3.0 - last.mean_stress;
+        assert!((last.pore_pressure - u).abs() < 1e-6 * P0);
+    }
+}
+
+#[test]
+fn an_oedometer_of_normally_consolidated_clay_settles_as_its_element_test() {
+    // The scene: a 1 m square of clay at 100 kPa on its normal compression line, pressed to
+    // 800 kPa in 100 kPa increments. The element: the same clay strained one-dimensionally.
+    // At each static state the vertical strain from the start (from the loaded points'
+    // settlement) against the element's at the same vertical stress.
+    let s = run("clay_oedometer.ron", &[]);
+    assert!(s.converged, "{:?}", s.error);
+    let element = oedometer(&clay(1.0), P0, 0.6, 60_000).unwrap();
+    // The element's strain where its vertical stress σ′_v = p′ + 2q/3 reaches `sv` (Pa).
+    let vertical = |r: &Row| r.mean_stress + 2.0 * r.deviator / 3.0;
+    let strain_at = |sv: f64| {
+        let w = element.windows(2).find(|w| vertical(&w[1]) >= sv).unwrap();
+        let (a, b) = (&w[0], &w[1]);
+        a.axial_strain + (sv - vertical(a)) / (vertical(b) - vertical(a)) * (b.axial_strain - a.axial_strain)
+    };
+    // The loaded points stand 0.9375 m over the base at the start.
+    assert_eq!(s.curve.len(), 8);
+    for c in &s.curve {
+        let sv = c.pressure.unwrap();
+        let engine = (0.9375 / (0.9375 - c.displacement)).ln();
+        let exact = strain_at(sv);
+        eprintln!(
+            "{sv}: engine {engine:.5}, element {exact:.5}, {:+.2} %",
+            100.0 * rel(engine, exact)
+        );
+        if sv == 800e3 {
+            // The run's own figure (1 thread or 2: the same bits).
+            assert!((engine - 0.31514).abs() < 5e-6, "{engine}");
+        }
+        if sv >= 300e3 {
+            assert!(
+                rel(engine, exact).abs() < 0.02,
+                "{sv} Pa: {engine} against {exact}"
+            );
+        }
+    }
+}
