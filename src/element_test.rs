@@ -5,8 +5,10 @@
 //! isotropic effective stress p′₀ (the cell pressure, with no pore pressure), its axial
 //! strain is raised in equal increments, and the radial strain (x and z alike) is
 //!
-//! * drained: whatever keeps the radial effective stress at the cell pressure, found in each
-//!   increment by the secant method on the material's own update;
+//! * drained: whatever keeps the radial stress at the cell pressure, found in each increment
+//!   by the secant method on the material's own update (a material that holds its own
+//!   undrained water, `ModifiedCamClay` with `drainage: Undrained`, then gives an undrained
+//!   test with that water's stiffness: its excess pore pressure is the row's u);
 //! * undrained: minus half the axial one, so the volume does not change (water and grains
 //!   incompressible); the excess pore pressure is then what the radial total stress, held at
 //!   the cell pressure, leaves to the water: u = p′₀ − σ′_r.
@@ -52,7 +54,7 @@ pub struct Row {
     pub mean_stress: f64,
     /// q = σ′_a − σ′_r (Pa), the deviator stress.
     pub deviator: f64,
-    /// u (Pa): the excess pore pressure (0 when drained).
+    /// u (Pa): the excess pore pressure (the material's own when the test is drained).
     pub pore_pressure: f64,
     /// The material's state by name ([`MaterialState::fields`]).
     pub state: Vec<(&'static str, f64)>,
@@ -166,16 +168,18 @@ pub fn oedometer(
     Ok(r.2.expect("every model has a state type"))
 }
 
-/// The row of a sample at `stress` (tension positive) and strains `ea`, `ev`.
+/// The row of a sample at `stress` (tension positive; σ′ − u I for a material that holds
+/// undrained water) and strains `ea`, `ev`.
 fn row<S: MaterialState>(test: &Triaxial, stress: &Sym3, state: &S, ea: f64, ev: f64) -> Row {
-    let (sa, sr) = (-stress.yy, -stress.xx);
+    let u = state.excess_pore_pressure();
+    let (sa, sr) = (-stress.yy - u, -stress.xx - u);
     Row {
         axial_strain: ea,
         volumetric_strain: ev,
         mean_stress: (sa + 2.0 * sr) / 3.0,
         deviator: sa - sr,
         pore_pressure: match test.drainage {
-            Drainage::Drained => 0.0,
+            Drainage::Drained => u,
             Drainage::Undrained => test.cell_pressure - sr,
         },
         state: state.fields(),

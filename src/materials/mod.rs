@@ -19,7 +19,7 @@ mod mohr_coulomb_softening;
 
 pub use linear_elastic::{LinearElastic, LinearElasticSpec};
 pub use modified_cam_clay::{
-    CamClayState, ModifiedCamClay, ModifiedCamClaySpec, Preconsolidation, MIN_STIFFNESS_PRESSURE,
+    CamClayState, Drainage, ModifiedCamClay, ModifiedCamClaySpec, Preconsolidation, MIN_STIFFNESS_PRESSURE,
 };
 pub use mohr_coulomb::{MohrCoulomb, MohrCoulombSpec, PlasticStrain, Return};
 pub use mohr_coulomb_softening::{MohrCoulombSoftening, MohrCoulombSofteningSpec, SofteningStrain};
@@ -56,6 +56,11 @@ pub trait MaterialState: bytemuck::Pod + Default + PartialEq + Debug + Send + Sy
     fn plastic_strain(&self) -> f64;
     /// True when every value is finite.
     fn is_finite(&self) -> bool;
+    /// u (Pa, compression positive): the excess pore pressure a model with undrained water
+    /// holds in the point's stress column, which is then σ′ − u I; 0 by default.
+    fn excess_pore_pressure(&self) -> f64 {
+        0.0
+    }
     /// The state's other values by name (units in the model's docs), for element tests and
     /// output: none by default.
     fn fields(&self) -> Vec<(&'static str, f64)> {

@@ -21,6 +21,14 @@
 //! lies on the surface of its own p′_c (eqs. in [`return_map`]). A step whose Newton solve does
 //! not settle is cut in halves.
 //!
+//! Undrained (`drainage: Undrained(bulk_modulus)`), the pores' water takes the step's
+//! volumetric strain as an excess pressure, δu = K_f δε_v with K_f = K_w/n, and the point's
+//! stress column holds σ′ − u I (tension positive): the grid's forces see the water, the
+//! clay's law sees σ′ = σ + u I. u is part of the point's state. K_f adds to the P-wave
+//! modulus and so shortens the time step as 1/√(M′ + K_f): a K_f far below water's own
+//! (2.2 GPa/n) but far above the clay's K′ holds the volume nearly constant at a step that
+//! stays practical (docs/verification.md measures the trade).
+//!
 //! A point's state starts from the stress it carries the first time the model updates it
 //! (its p′_c is 0 until then), so a body given this clay after an elastic geostatic stage
 //! starts where that stage left it: p′_c from the overconsolidation ratio times the isotropic
@@ -52,8 +60,23 @@ pub enum Preconsolidation {
     Pressure(f64),
 }
 
+/// How the water in a clay's pores behaves.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub enum Drainage {
+    /// The water leaves as the clay deforms: no excess pressure.
+    #[default]
+    Drained,
+    /// The water stays: the clay's volume change compresses it.
+    Undrained {
+        /// K_f = K_w/n (Pa, > 0): the pore water's bulk modulus over the porosity, the
+        /// stiffness against volume change that the water lends the clay.
+        bulk_modulus: f64,
+    },
+}
+
 /// Scene entry `ModifiedCamClay(density, lambda, kappa, critical_state_ratio |
-/// critical_state_angle, poisson_ratio, ncl_volume, preconsolidation, max_mean_stress)`.
+/// critical_state_angle, poisson_ratio, ncl_volume, preconsolidation, max_mean_stress,
+/// drainage)`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, rename = "ModifiedCamClay")]
 pub struct ModifiedCamClaySpec {
@@ -80,6 +103,9 @@ pub struct ModifiedCamClaySpec {
     /// The largest mean effective stress (Pa, > 0) the run will reach: the stiffness
     /// there, N·p′/κ, sets the time step.
     pub max_mean_stress: f64,
+    /// `Drained` (the default) or `Undrained(bulk_modulus: K_f)`.
+    #[serde(default)]
+    pub drainage: Drainage,
 }
 
 impl ModifiedCamClaySpec {
@@ -168,7 +194,25 @@ impl SceneMaterial for ModifiedCamClaySpec {
                 format!("must be > 0 Pa, found {}", self.max_mean_stress),
             );
         }
+        let fluid_bulk = match self.drainage {
+            Drainage::Drained => 0.0,
+            Drainage::Undrained { bulk_modulus }
+                if positive(bulk_modulus) && bulk_modulus <= super::MAX_MODULUS =>
+            {
+                bulk_modulus
+            }
+            Drainage::Undrained { bulk_modulus } => {
+                return bad(
+                    "drainage",
+                    format!(
+                        "an Undrained bulk_modulus must be > 0 Pa and at most {:e} Pa, found {bulk_modulus}",
+                        super::MAX_MODULUS
+                    ),
+                );
+            }
+        };
         Ok(ModifiedCamClay {
+            fluid_bulk,
             density: self.density,
             lambda: self.lambda,
             kappa: self.kappa,
@@ -210,6 +254,9 @@ pub struct CamClayState {
     pub specific_volume: f64,
     /// Σ δε_q^p, the accumulated plastic shear strain (dimensionless).
     pub plastic_strain: f64,
+    /// u (Pa, compression positive): the excess pore pressure of an undrained clay (0
+    /// drained).
+    pub excess_pore_pressure: f64,
 }
 
 impl MaterialState for CamClayState {
@@ -220,6 +267,9 @@ impl MaterialState for CamClayState {
         self.preconsolidation.is_finite()
             && self.specific_volume.is_finite()
             && self.plastic_strain.is_finite()
+    }
+    fn excess_pore_pressure(&self) -> f64 {
+        self.excess_pore_pressure
     }
     fn fields(&self) -> Vec<(&'static str, f64)> {
         vec![
@@ -248,6 +298,8 @@ pub struct ModifiedCamClay {
     pub preconsolidation: Preconsolidation,
     /// The time step's mean effective stress (Pa).
     pub max_mean_stress: f64,
+    /// K_f (Pa): the pore water's stiffness when undrained, 0 when drained.
+    pub fluid_bulk: f64,
 }
 
 /// p′ (Pa, compression positive), the deviator s (Pa) and q = √(3/2 s:s) of a
@@ -286,6 +338,7 @@ impl ModifiedCamClay {
             specific_volume: self.ncl_volume - self.lambda * (pc / REFERENCE_PRESSURE).ln()
                 + self.kappa * (pc / p).ln(),
             plastic_strain: 0.0,
+            excess_pore_pressure: 0.0,
         }
     }
 
@@ -395,19 +448,25 @@ impl Material for ModifiedCamClay {
     /// gets in the run.
     fn p_wave_modulus(&self) -> f64 {
         let (k, g) = self.moduli(self.max_mean_stress, self.ncl_volume);
-        k + 4.0 / 3.0 * g
+        k + 4.0 / 3.0 * g + self.fluid_bulk
     }
+    /// σ′ = σ + u I through the clay's law; undrained, u grows by K_f times the step's
+    /// volume loss and the stress column takes σ′ − u I again.
     fn update(&self, stress: &mut Sym3, de: &Sym3, state: &mut CamClayState) {
+        let u = state.excess_pore_pressure;
+        let mut effective = *stress + Sym3::IDENTITY * u;
         if state.preconsolidation == 0.0 {
-            *state = self.initial_state(stress);
+            *state = self.initial_state(&effective);
         }
-        self.substep(stress, de, state, 0);
+        self.substep(&mut effective, de, state, 0);
+        state.excess_pore_pressure = u - self.fluid_bulk * de.trace();
+        *stress = effective - Sym3::IDENTITY * state.excess_pore_pressure;
     }
     fn admits(&self, stress: &Sym3, state: &CamClayState) -> bool {
         if state.preconsolidation == 0.0 {
             return true;
         }
-        let (p, _, q) = invariants(stress);
+        let (p, _, q) = invariants(&(*stress + Sym3::IDENTITY * state.excess_pore_pressure));
         let pc = state.preconsolidation;
         self.yield_value(p, q, pc) <= 1e-9 * pc * pc
     }
@@ -428,6 +487,7 @@ mod tests {
             ncl_volume: 3.0,
             preconsolidation: pre,
             max_mean_stress: 1e6,
+            drainage: Drainage::Drained,
         }
         .model(&|f| f.to_string())
         .unwrap()
@@ -480,6 +540,7 @@ mod tests {
             ncl_volume: 3.0,
             preconsolidation: Preconsolidation::Ratio(1.0),
             max_mean_stress: 1e6,
+            drainage: Drainage::Drained,
         };
         let e = spec.model(&|f| f.to_string()).unwrap_err();
         assert_eq!(e.field, "critical_state_ratio", "{e:?}");
