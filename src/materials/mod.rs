@@ -121,6 +121,11 @@ pub trait SceneMaterial: Clone + PartialEq + Debug + Serialize + DeserializeOwne
     fn dilatancy_angle(&self) -> f64 {
         0.0
     }
+    /// True when the model holds undrained pore water in its state (the point's stress
+    /// column then holds σ′ − u I). The cell means against locking are refused there.
+    fn holds_water(&self) -> bool {
+        false
+    }
 }
 
 /// The largest Young's modulus a scene may give (Pa): a thousand times diamond's
@@ -245,6 +250,13 @@ macro_rules! define_materials {
             pub fn dilatancy_angle(&self) -> f64 {
                 match self {
                     $(MaterialSpec::$variant(s) => s.dilatancy_angle(),)*
+                }
+            }
+
+            /// Whether it holds undrained water (see [`SceneMaterial::holds_water`]).
+            pub fn holds_water(&self) -> bool {
+                match self {
+                    $(MaterialSpec::$variant(s) => s.holds_water(),)*
                 }
             }
         }
@@ -446,6 +458,49 @@ pub fn extend_plastic_strain(arch: &Archetype, out: &mut Vec<f64>) {
     visit_states(&mut e);
     if !e.2 {
         out.resize(out.len() + arch.len() as usize, 0.0);
+    }
+}
+
+/// The names of the state fields ([`MaterialState::fields`]) of the points of `arch`, none
+/// when its points carry no state or a state without fields.
+pub fn state_field_names(arch: &Archetype) -> Vec<&'static str> {
+    struct Names<'a>(&'a Archetype, Vec<&'static str>);
+    impl StateVisitor for Names<'_> {
+        fn visit<S: MaterialState>(&mut self) {
+            if self.1.is_empty() && self.0.has::<S>() {
+                self.1 = S::default().fields().into_iter().map(|(n, _)| n).collect();
+            }
+        }
+    }
+    let mut n = Names(arch, Vec::new());
+    visit_states(&mut n);
+    n.1
+}
+
+/// Appends to `out[k]` the state field `names[k]` of each point of `arch`, in row order: 0
+/// where the point's state has no such field.
+pub fn extend_state_fields(arch: &Archetype, names: &[&'static str], out: &mut [Vec<f64>]) {
+    struct Extend<'a>(&'a Archetype, &'a [&'static str], &'a mut [Vec<f64>], bool);
+    impl StateVisitor for Extend<'_> {
+        fn visit<S: MaterialState>(&mut self) {
+            if let (false, Some(c)) = (self.3, self.0.get::<&S>()) {
+                for s in c.iter() {
+                    let f = s.fields();
+                    for (k, name) in self.1.iter().enumerate() {
+                        let v = f.iter().find(|(n, _)| n == name).map_or(0.0, |(_, v)| *v);
+                        self.2[k].push(v);
+                    }
+                }
+                self.3 = true;
+            }
+        }
+    }
+    let mut e = Extend(arch, names, out, false);
+    visit_states(&mut e);
+    if !e.3 {
+        for o in out.iter_mut() {
+            o.resize(o.len() + arch.len() as usize, 0.0);
+        }
     }
 }
 

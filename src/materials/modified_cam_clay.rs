@@ -228,6 +228,9 @@ impl SceneMaterial for ModifiedCamClaySpec {
     fn dilatancy_angle(&self) -> f64 {
         self.angle().unwrap_or(0.0)
     }
+    fn holds_water(&self) -> bool {
+        matches!(self.drainage, Drainage::Undrained { .. })
+    }
     /// tan φ_cs divided by `factor`, M following it.
     fn reduce_strength(&mut self, factor: f64) -> bool {
         let Some(phi) = self.angle() else {
@@ -275,6 +278,7 @@ impl MaterialState for CamClayState {
         vec![
             ("preconsolidation", self.preconsolidation),
             ("specific_volume", self.specific_volume),
+            ("excess_pore_pressure", self.excess_pore_pressure),
         ]
     }
 }

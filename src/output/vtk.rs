@@ -4,7 +4,7 @@
 use crate::components::*;
 use crate::dim::Dim;
 use crate::infra::columns::{col, points_with};
-use crate::materials::extend_plastic_strain;
+use crate::materials::{extend_plastic_strain, extend_state_fields, state_field_names};
 use crate::simulation::Simulation;
 use crate::tensor::StoredSym;
 use crate::water::Water;
@@ -30,6 +30,22 @@ enum Field {
     PorePressure,
     /// σ = σ′ − u I (Pa, tension positive: xx yy zz xy yz zx).
     TotalStress,
+    /// The material state's field of this index in [`Source::state_fields`] (0 for points
+    /// whose state has no such field).
+    State(usize),
+}
+
+/// The state field names of the points of `archs`, each once, in the order first met.
+fn state_names(archs: &[&Archetype]) -> Vec<&'static str> {
+    let mut names = Vec::new();
+    for a in archs {
+        for n in state_field_names(a) {
+            if !names.contains(&n) {
+                names.push(n);
+            }
+        }
+    }
+    names
 }
 
 /// The total stress of the effective stress `s` at `x` in `material`.
@@ -47,6 +63,8 @@ trait Source {
     fn has_displacement(&self) -> bool;
     /// The water table, when the scene has one (the stress is then effective).
     fn water(&self) -> Option<&Water>;
+    /// The names of the material states' fields the points carry (none for most models).
+    fn state_fields(&self) -> &[&'static str];
     /// Writes `field` of every point, in id order.
     fn write(&self, field: Field, out: &mut BufWriter<File>) -> std::io::Result<()>;
 }
@@ -137,6 +155,16 @@ fn arrays<S: Source>(src: &S) -> Vec<Array<'_>> {
             field(f),
         ));
     }
+    for (k, &name) in src.state_fields().iter().enumerate() {
+        arrays.push(Array::new(
+            Part::PointData,
+            name,
+            Kind::Float64,
+            1,
+            n,
+            field(Field::State(k)),
+        ));
+    }
     let mut offset = 0;
     for array in &mut arrays {
         array.offset = offset;
@@ -151,7 +179,10 @@ fn arrays<S: Source>(src: &S) -> Vec<Array<'_>> {
 /// when kept), velocity (m/s), stress (Pa, tension positive: xx yy zz xy yz zx), mean
 /// stress p and deviatoric stress q = √(3J₂) (Pa), volume (m³) and accumulated plastic
 /// strain (0 for bodies without plastic state). With water the stress is effective, and the
-/// pore pressure (Pa, compression positive) and the total stress σ′ − u I follow.
+/// pore pressure (Pa, compression positive) and the total stress σ′ − u I follow. A
+/// material state's fields follow last (`ModifiedCamClay`: `preconsolidation`,
+/// `specific_volume`, `excess_pore_pressure`; 0 on the points of other materials); an
+/// undrained clay's stress is σ′ − u I with its own excess pore pressure u.
 ///
 /// The arrays are raw little-endian binary in the file's appended section (VTK XML's
 /// `format="appended"`, `encoding="raw"`, 64-bit block headers), the form ParaView itself
@@ -226,6 +257,7 @@ struct Columns<'a, D: Dim> {
     n: usize,
     displacements: bool,
     water: Option<Water>,
+    states: Vec<&'static str>,
     _marker: std::marker::PhantomData<fn() -> D>,
 }
 
@@ -244,6 +276,7 @@ impl<'a, D: Dim> Columns<'a, D> {
         // Displacements only when the scene keeps them (`output.displacements`).
         let displacements = n > 0 && archs.iter().all(|a| a.has::<Displacement<D::Vec>>());
         Columns {
+            states: state_names(&archs),
             archs,
             order: Order(at),
             n,
@@ -263,6 +296,9 @@ impl<D: Dim> Source for Columns<'_, D> {
     }
     fn water(&self) -> Option<&Water> {
         self.water.as_ref()
+    }
+    fn state_fields(&self) -> &[&'static str] {
+        &self.states
     }
     fn write(&self, field: Field, out: &mut BufWriter<File>) -> std::io::Result<()> {
         let (archs, order) = (&self.archs[..], &self.order);
@@ -317,6 +353,21 @@ impl<D: Dim> Source for Columns<'_, D> {
                     .points()
                     .try_for_each(|(_, a, r)| f64s(out, &[plastic[a][r]]))
             }
+            Field::State(k) => {
+                let name = [self.states[k]];
+                let values: Vec<Vec<f64>> = archs
+                    .iter()
+                    .map(|a| {
+                        let mut v = [Vec::new()];
+                        extend_state_fields(a, &name, &mut v);
+                        let [v] = v;
+                        v
+                    })
+                    .collect();
+                order
+                    .points()
+                    .try_for_each(|(_, a, r)| f64s(out, &[values[a][r]]))
+            }
         }
     }
 }
@@ -344,6 +395,10 @@ pub struct Frame {
     pub volume: Vec<f64>,
     /// Accumulated plastic strain (0 without plastic state).
     pub plastic_strain: Vec<f64>,
+    /// The names of the material states' fields the points carry.
+    pub state_names: Vec<&'static str>,
+    /// Each of those fields, a value a point (0 where a point's state has no such field).
+    pub state: Vec<Vec<f64>>,
     /// The water table, when the scene has one (the stress is then effective).
     pub water: Option<Water>,
     /// The rigid bodies where they are (none without).
@@ -377,6 +432,9 @@ impl Frame {
         self.stress.clear();
         self.volume.clear();
         self.plastic_strain.clear();
+        self.state_names = state_names(&archs);
+        self.state.resize_with(self.state_names.len(), Vec::new);
+        self.state.iter_mut().for_each(Vec::clear);
         for arch in archs {
             copy::<PointId, _>(arch, &mut self.id, |i| i.0);
             copy::<MaterialId, _>(arch, &mut self.material, |m| m.0);
@@ -388,6 +446,7 @@ impl Frame {
             copy::<Stress<D::Stress>, _>(arch, &mut self.stress, voigt::<D>);
             copy::<Volume, _>(arch, &mut self.volume, |v| v.0);
             extend_plastic_strain(arch, &mut self.plastic_strain);
+            extend_state_fields(arch, &self.state_names, &mut self.state);
         }
         self.displacement = displacements.then_some(u);
     }
@@ -421,6 +480,11 @@ impl Frame {
         permute(&self.stress, &order, &mut sorted.stress);
         permute(&self.volume, &order, &mut sorted.volume);
         permute(&self.plastic_strain, &order, &mut sorted.plastic_strain);
+        sorted.state_names.clone_from(&self.state_names);
+        sorted.state.resize_with(self.state.len(), Vec::new);
+        for (from, to) in self.state.iter().zip(&mut sorted.state) {
+            permute(from, &order, to);
+        }
         for r in order.iter_mut() {
             *r = self.id[*r as usize];
         }
@@ -448,6 +512,9 @@ impl Source for Frame {
     }
     fn water(&self) -> Option<&Water> {
         self.water.as_ref()
+    }
+    fn state_fields(&self) -> &[&'static str] {
+        &self.state_names
     }
     fn write(&self, field: Field, out: &mut BufWriter<File>) -> std::io::Result<()> {
         // Whole columns at a time: a frame is written on the writer thread, which shares
@@ -479,6 +546,7 @@ impl Source for Frame {
             ),
             Field::Volume => f64_block(out, &self.volume),
             Field::PlasticStrain => f64_block(out, &self.plastic_strain),
+            Field::State(k) => f64_block(out, &self.state[k]),
             Field::PorePressure => {
                 let w = self.water.as_ref().expect("written only with water");
                 f64_block(

@@ -218,3 +218,64 @@ fn an_undrained_oedometer_settles_as_its_element_test() {
         }
     }
 }
+
+#[test]
+fn the_clays_state_is_written_with_its_points() {
+    // points.vtu carries p′_c, v and u; after the undrained oedometer every point holds
+    // water pressure, its stress column is σ′ − u I, and σ′ lies inside its own surface.
+    // The pore pressure alternates layer by layer (the loaded row 80 kPa, the row under
+    // it 988 kPa, the rest 586–721 kPa: nearly incompressible points each keep their own
+    // volume, docs/verification.md); the grid's forces see the mean.
+    let out = crate::common::scratch("cam_clay", "vtu");
+    let run = crate::common::run_into(
+        &scene("clay_oedometer.ron"),
+        &out,
+        &["materials.clay.drainage=Undrained(bulk_modulus: 1.0e8)"],
+    );
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let vtu = crate::common::read_vtu(&out.join("points.vtu"));
+    let (_, pc) = &vtu["preconsolidation"];
+    let (_, v) = &vtu["specific_volume"];
+    let (_, u) = &vtu["excess_pore_pressure"];
+    let (_, stress) = &vtu["stress"];
+    assert_eq!(pc.len(), 64);
+    for k in 0..64 {
+        let p = -(stress[6 * k] + stress[6 * k + 1] + stress[6 * k + 2]) / 3.0 - u[k];
+        assert!(u[k] > 0.0, "point {k}: u {}", u[k]);
+        assert!(
+            p > 0.0 && p <= pc[k] * (1.0 + 1e-9),
+            "point {k}: p′ {p}, p′_c {}",
+            pc[k]
+        );
+        assert!(v[k] > 1.8 && v[k] < 1.85, "point {k}: v {}", v[k]);
+    }
+    // The run's own figures: the base row and the loaded row.
+    assert!((u[0] - 675.0e3).abs() < 1e3, "{}", u[0]);
+    assert!((u[60] - 80.0e3).abs() < 1e3, "{}", u[60]);
+    // The drained clay's points hold no water.
+    let out = crate::common::scratch("cam_clay", "vtu-drained");
+    assert!(crate::common::run_into(&scene("clay_oedometer.ron"), &out, &[])
+        .status
+        .success());
+    let vtu = crate::common::read_vtu(&out.join("points.vtu"));
+    assert!(vtu["excess_pore_pressure"].1.iter().all(|&u| u == 0.0));
+}
+
+#[test]
+fn the_cell_means_are_refused_on_an_undrained_clay() {
+    let out = crate::common::scratch("cam_clay", "cell-means");
+    let run = crate::common::run_into(
+        &scene("clay_oedometer.ron"),
+        &out,
+        &[
+            "materials.clay.drainage=Undrained(bulk_modulus: 1.0e8)",
+            "solver.anti_locking=CellMean",
+        ],
+    );
+    assert_eq!(run.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&run.stderr);
+    assert!(
+        err.contains("solver.anti_locking") && err.contains("undrained"),
+        "{err}"
+    );
+}

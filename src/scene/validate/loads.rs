@@ -1,7 +1,7 @@
 //! The loads: gravity, point loads, tractions (and their increments), traced points, and
 //! the rule that a scene loads something.
 
-use super::materials::{check_mass_finite, check_smoothing};
+use super::materials::{check_cell_means, check_mass_finite, check_smoothing};
 use super::rules::*;
 use crate::error::SceneError;
 use crate::materials::MaterialModel;
@@ -13,8 +13,10 @@ pub(super) fn check_loads(r: &Rules, table: &[(String, MaterialModel)]) -> Resul
         check_gravity(r, "gravity", g)?;
     }
     check_mass_finite(loaded, table, n)?;
-    if s.solver.anti_locking == crate::state::AntiLocking::StrainSmoothing {
-        check_smoothing(loaded)?;
+    match s.solver.anti_locking {
+        crate::state::AntiLocking::StrainSmoothing => check_smoothing(loaded)?,
+        crate::state::AntiLocking::CellMean => check_cell_means(loaded)?,
+        crate::state::AntiLocking::Off => {}
     }
     for (i, l) in s.point_loads.iter().enumerate() {
         r.len(&format!("point_loads[{i}].position"), l.position.len())?;

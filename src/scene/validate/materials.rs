@@ -49,6 +49,24 @@ pub(super) fn check_mass_finite(
     Ok(())
 }
 
+/// The cell means move each point's stress column to its cell's mean stress; an undrained
+/// clay keeps its excess pore pressure in its state and reads σ′ = σ + u I from the column,
+/// so the two would part (the oedometer of `clay_oedometer.ron` settled 8 times as far).
+pub(super) fn check_cell_means(loaded: &LoadedScene) -> Result<(), SceneError> {
+    for (name, m) in loaded.scene.every_material() {
+        if m.holds_water() {
+            return Err(loaded.invalid(
+                "solver.anti_locking",
+                format!(
+                    "material \"{name}\" holds undrained water: the cell means would move its \
+                     stress away from its pore pressure; use anti_locking Off"
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// Volumetric smoothing is for isochoric plastic flow (ψ = 0): it is refused on a material
 /// that dilates, in the scene or in a stage. The smoothed strain rate is not work-conjugate
 /// to the nodal forces, and on dilatant flow the mismatch feeds the kinetic energy: a
