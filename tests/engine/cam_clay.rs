@@ -279,3 +279,75 @@ fn the_cell_means_are_refused_on_an_undrained_clay() {
         "{err}"
     );
 }
+
+/// A 4 m layer of clay under its own weight, first elastic (ν = 0.3: K0 = ν/(1 − ν) = 0.43)
+/// to its geostatic state, then the overconsolidated clay.
+const LAYER: &str = r#"Scene(
+    dimension: 2,
+    grid: (origin: [0.0, 0.0], cell_size: 0.5, cells: [2, 9]),
+    shape: QuadraticBSpline,
+    materials: { "clay": LinearElastic(density: 1800.0, youngs_modulus: 1.0e7, poisson_ratio: 0.3) },
+    stages: [
+        (name: "geostatic"),
+        (
+            name: "clay",
+            materials: {
+                "clay": ModifiedCamClay(
+                    density: 1800.0, lambda: 0.25, kappa: 0.05, critical_state_ratio: Some(0.9),
+                    poisson_ratio: 0.3, ncl_volume: 3.0, preconsolidation: Ratio(2.0),
+                    max_mean_stress: 1.0e5,
+                ),
+            },
+        ),
+    ],
+    bodies: [(material: "clay", region: Box(min: [0.0, 0.0], max: [1.0, 4.0]), points_per_cell: [2, 2])],
+    boundaries: [(face: YMin, condition: Fixed), (face: XMin, condition: Roller), (face: XMax, condition: Roller)],
+    gravity: (acceleration: [0.0, -9.81]),
+    solver: (damping: Kinetic, time_step: Courant(0.5), tolerance: 1e-4, max_time: 50.0),
+)"#;
+
+#[test]
+fn a_clay_given_after_a_geostatic_stage_starts_from_its_k0_state() {
+    // Each point's p′_c is R times the isotropic pressure of the surface through the K0
+    // stress it was handed (R = 2: inside the surface, so the clay stage moves nothing).
+    let out = crate::common::scratch("cam_clay", "layer");
+    std::fs::write(out.join("layer.ron"), LAYER).unwrap();
+    let run = crate::common::run_into(&out.join("layer.ron"), &out.join("run"), &[]);
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    // The clay stage is static at once: its static state comes a step after the geostatic one.
+    let stages = std::fs::read_to_string(out.join("run/stages.csv")).unwrap();
+    let steps: Vec<u64> = stages
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').nth(1).unwrap().parse().unwrap())
+        .collect();
+    assert_eq!(steps.len(), 2);
+    assert!(steps[1] - steps[0] <= 2, "{stages}");
+    let vtu = crate::common::read_vtu(&out.join("run/points.vtu"));
+    let (_, pc) = &vtu["preconsolidation"];
+    let (_, stress) = &vtu["stress"];
+    let (_, y) = &vtu["Points"];
+    assert_eq!(pc.len(), 64);
+    for k in 0..64 {
+        let s = &stress[6 * k..6 * k + 6];
+        let (sv, sh) = (-s[1], -s[0]);
+        let depth = 4.0 - y[3 * k + 1];
+        // The geostatic state: σ_v = ρ g z, σ_h = K0 σ_v (to the static tolerance).
+        assert!(
+            (sv - 1800.0 * 9.81 * depth).abs() < 0.02 * 1800.0 * 9.81 * 4.0,
+            "point {k}: σ_v {sv} at {depth} m"
+        );
+        if depth > 1.0 {
+            assert!(rel(sh / sv, 0.3 / 0.7).abs() < 0.03, "point {k}: K0 {}", sh / sv);
+        }
+        let p = (sv + 2.0 * sh) / 3.0;
+        let q = sv - sh;
+        let through = p.max(kdmpm::materials::MIN_STIFFNESS_PRESSURE) + q * q / (M * M * p.max(1e3));
+        assert!(
+            rel(pc[k], 2.0 * through).abs() < 0.01,
+            "point {k}: p′_c {} against {}",
+            pc[k],
+            2.0 * through
+        );
+    }
+}
