@@ -121,6 +121,11 @@ pub trait SceneMaterial: Clone + PartialEq + Debug + Serialize + DeserializeOwne
     fn dilatancy_angle(&self) -> f64 {
         0.0
     }
+    /// The field whose value sets the model's P-wave speed, named when that speed is
+    /// refused (too fast for a stage, not finite): Young's modulus by default.
+    fn stiffness_field(&self) -> &'static str {
+        "youngs_modulus"
+    }
     /// True when the model holds undrained pore water in its state (the point's stress
     /// column then holds σ′ − u I). The cell means against locking are refused there.
     fn holds_water(&self) -> bool {
@@ -227,7 +232,7 @@ macro_rules! define_materials {
                 let speed = (model.p_wave_modulus() / model.density()).sqrt();
                 if !(speed > 0.0 && speed.is_finite()) {
                     return Err(Refusal::new(
-                        at("youngs_modulus"),
+                        at(self.stiffness_field()),
                         format!(
                             "M = {} Pa with ρ = {} kg/m³ gives a P-wave speed of {speed} m/s, not \
                              a finite number > 0",
@@ -250,6 +255,13 @@ macro_rules! define_materials {
             pub fn dilatancy_angle(&self) -> f64 {
                 match self {
                     $(MaterialSpec::$variant(s) => s.dilatancy_angle(),)*
+                }
+            }
+
+            /// The field that sets its P-wave speed (see [`SceneMaterial::stiffness_field`]).
+            pub fn stiffness_field(&self) -> &'static str {
+                match self {
+                    $(MaterialSpec::$variant(s) => s.stiffness_field(),)*
                 }
             }
 

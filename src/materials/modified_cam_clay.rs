@@ -228,6 +228,9 @@ impl SceneMaterial for ModifiedCamClaySpec {
     fn dilatancy_angle(&self) -> f64 {
         self.angle().unwrap_or(0.0)
     }
+    fn stiffness_field(&self) -> &'static str {
+        "max_mean_stress"
+    }
     fn holds_water(&self) -> bool {
         matches!(self.drainage, Drainage::Undrained { .. })
     }

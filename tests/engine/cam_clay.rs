@@ -351,3 +351,11 @@ fn a_clay_given_after_a_geostatic_stage_starts_from_its_k0_state() {
         );
     }
 }
+
+#[test]
+fn a_stage_clay_too_stiff_for_the_time_step_is_refused_at_its_stiffness_field() {
+    let soft = LAYER.replace("youngs_modulus: 1.0e7", "youngs_modulus: 5.0e6");
+    let err = crate::common::refusal(&soft);
+    assert!(err.contains("stages[1].materials.clay.max_mean_stress"), "{err}");
+    assert!(err.contains("P-wave speed"), "{err}");
+}

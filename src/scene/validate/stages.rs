@@ -98,7 +98,7 @@ fn stage_materials(
         let speed = (model.p_wave_modulus() / model.density()).sqrt();
         if speed > c_p * (1.0 + 1e-12) {
             return r.bad(
-                &at("youngs_modulus"),
+                &at(spec.stiffness_field()),
                 format!(
                     "a P-wave speed of {speed:.6} m/s, above the {c_p:.6} m/s that set the time \
                      step: the explicit scheme would be unstable in this stage; give the \
