@@ -114,24 +114,17 @@ impl Triaxial {
 /// Runs `test` on `model`: the start and a row after every increment.
 pub fn triaxial(model: &MaterialModel, test: &Triaxial) -> Result<Vec<Row>, ElementError> {
     test.check()?;
-    struct Run<'a>(
-        &'a MaterialModel,
-        &'a Triaxial,
-        Option<Result<Vec<Row>, ElementError>>,
-    );
-    impl StateVisitor for Run<'_> {
-        fn visit<S: MaterialState>(&mut self) {
-            self.2 = Some(run::<S>(self.0, self.1));
-        }
-    }
-    let mut r = Run(model, test, None);
-    model.visit_state(&mut r);
-    r.2.expect("every model has a state type")
+    let radial = match test.drainage {
+        Drainage::Drained => Radial::Balanced,
+        Drainage::Undrained => Radial::Isochoric,
+    };
+    with_state(model, test, radial)
 }
 
 /// One-dimensional compression (an oedometer): the sample starts under an isotropic
 /// effective stress `p0` (Pa) and its axial (y) strain is raised to `axial_strain` in `steps`
-/// equal increments with no radial strain; rows as [`triaxial`]'s (u = 0, ε_v = ε_a).
+/// equal increments with no radial strain; rows as [`triaxial`]'s (u the material's own,
+/// ε_v = ε_a).
 pub fn oedometer(
     model: &MaterialModel,
     p0: f64,
@@ -145,27 +138,36 @@ pub fn oedometer(
         steps,
     };
     test.check()?;
-    struct Run<'a>(&'a MaterialModel, &'a Triaxial, Option<Vec<Row>>);
+    with_state(model, &test, Radial::Fixed)
+}
+
+/// What each increment's radial strain is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Radial {
+    /// Whatever holds the radial stress at the cell pressure.
+    Balanced,
+    /// Minus half the axial strain: no volume change.
+    Isochoric,
+    /// None.
+    Fixed,
+}
+
+/// [`run`] with the state type of `model`.
+fn with_state(model: &MaterialModel, test: &Triaxial, radial: Radial) -> Result<Vec<Row>, ElementError> {
+    struct Run<'a>(
+        &'a MaterialModel,
+        &'a Triaxial,
+        Radial,
+        Option<Result<Vec<Row>, ElementError>>,
+    );
     impl StateVisitor for Run<'_> {
         fn visit<S: MaterialState>(&mut self) {
-            let (model, test) = (self.0, self.1);
-            let p0 = test.cell_pressure;
-            let mut stress = Sym3::diagonal(-p0, -p0, -p0);
-            let mut state = S::default();
-            model.update(&mut stress, &Sym3::ZERO, &mut state);
-            let de = test.axial_strain / test.steps as f64;
-            let mut rows = vec![row(test, &stress, &state, 0.0, 0.0)];
-            for step in 1..=test.steps {
-                model.update(&mut stress, &Sym3::diagonal(0.0, -de, 0.0), &mut state);
-                let e = de * step as f64;
-                rows.push(row(test, &stress, &state, e, e));
-            }
-            self.2 = Some(rows);
+            self.3 = Some(run::<S>(self.0, self.1, self.2));
         }
     }
-    let mut r = Run(model, &test, None);
+    let mut r = Run(model, test, radial, None);
     model.visit_state(&mut r);
-    Ok(r.2.expect("every model has a state type"))
+    r.3.expect("every model has a state type")
 }
 
 /// The row of a sample at `stress` (tension positive; σ′ − u I for a material that holds
@@ -186,7 +188,11 @@ fn row<S: MaterialState>(test: &Triaxial, stress: &Sym3, state: &S, ea: f64, ev:
     }
 }
 
-fn run<S: MaterialState>(model: &MaterialModel, test: &Triaxial) -> Result<Vec<Row>, ElementError> {
+fn run<S: MaterialState>(
+    model: &MaterialModel,
+    test: &Triaxial,
+    radial: Radial,
+) -> Result<Vec<Row>, ElementError> {
     let p0 = test.cell_pressure;
     let mut stress = Sym3::diagonal(-p0, -p0, -p0);
     let mut state = S::default();
@@ -199,9 +205,10 @@ fn run<S: MaterialState>(model: &MaterialModel, test: &Triaxial) -> Result<Vec<R
     // the next.
     let mut ratio = 0.3;
     for step in 1..=test.steps {
-        let de_r = match test.drainage {
-            Drainage::Undrained => 0.5 * de_a,
-            Drainage::Drained => {
+        let de_r = match radial {
+            Radial::Fixed => 0.0,
+            Radial::Isochoric => 0.5 * de_a,
+            Radial::Balanced => {
                 let radial = |de_r: f64| {
                     let (mut s, mut st) = (stress, state);
                     model.update(&mut s, &Sym3::diagonal(de_r, -de_a, de_r), &mut st);

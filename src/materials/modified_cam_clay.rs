@@ -326,6 +326,14 @@ impl ModifiedCamClay {
         (k, 3.0 * k * (1.0 - 2.0 * nu) / (2.0 * (1.0 + nu)))
     }
 
+    /// The elastic trial of `de` from `stress` at specific volume `v`, with the bulk and
+    /// shear moduli (Pa) of the stress it starts from.
+    fn trial(&self, stress: &Sym3, de: &Sym3, v: f64) -> (Sym3, f64, f64) {
+        let (k, g) = self.moduli(invariants(stress).0, v);
+        let trial = *stress + Sym3::IDENTITY * ((k - 2.0 / 3.0 * g) * de.trace()) + *de * (2.0 * g);
+        (trial, k, g)
+    }
+
     /// f (Pa²) at p′, q and p′_c.
     fn yield_value(&self, p: f64, q: f64, pc: f64) -> f64 {
         q * q / (self.m * self.m) + p * (p - pc)
@@ -352,10 +360,8 @@ impl ModifiedCamClay {
     /// One step of `de` from `stress` and `state`; false (nothing changed) when the return's
     /// Newton solve does not settle.
     fn step(&self, stress: &mut Sym3, de: &Sym3, state: &mut CamClayState) -> bool {
-        let (p0, _, _) = invariants(stress);
         let v = state.specific_volume;
-        let (k, g) = self.moduli(p0, v);
-        let trial = *stress + Sym3::IDENTITY * ((k - 2.0 / 3.0 * g) * de.trace()) + *de * (2.0 * g);
+        let (trial, k, g) = self.trial(stress, de, v);
         let (pt, st, qt) = invariants(&trial);
         let pcn = state.preconsolidation;
         if self.yield_value(pt, qt, pcn) <= 1e-12 * pcn * pcn {
@@ -430,8 +436,7 @@ impl ModifiedCamClay {
         }
         if depth >= 12 {
             // The last resort: the trial's shear scaled back onto the surface at its p′.
-            let (k, g) = self.moduli(invariants(stress).0, state.specific_volume);
-            let trial = *stress + Sym3::IDENTITY * ((k - 2.0 / 3.0 * g) * de.trace()) + *de * (2.0 * g);
+            let (trial, _, _) = self.trial(stress, de, state.specific_volume);
             let (p, s, q) = invariants(&trial);
             let pc = state.preconsolidation;
             let p = p.clamp(0.0, pc);

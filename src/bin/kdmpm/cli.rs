@@ -127,31 +127,7 @@ pub enum Command {
     /// increments, drained (radial effective stress held) or undrained (no volume change);
     /// writes triaxial.csv (compression positive: ε_a, ε_v, p′, q, excess pore pressure and
     /// the material's state) and prints the last row.
-    Triaxial {
-        /// Scene file (RON) whose `materials` holds the material.
-        scene: PathBuf,
-        /// The material's name in the scene.
-        #[arg(long)]
-        material: String,
-        /// The isotropic effective stress the sample starts at (Pa).
-        #[arg(long, value_name = "PA")]
-        cell_pressure: f64,
-        /// No water leaves the sample: its volume stays as it was.
-        #[arg(long)]
-        undrained: bool,
-        /// The last axial strain (compression positive).
-        #[arg(long, default_value_t = 0.3)]
-        axial_strain: f64,
-        /// Equal axial increments.
-        #[arg(long, default_value_t = 3000)]
-        steps: usize,
-        /// Output directory (default: out/triaxial-<material>).
-        #[arg(long)]
-        out: Option<PathBuf>,
-        /// Override a scene field (repeatable).
-        #[arg(long = "set", value_name = "PATH=VALUE")]
-        overrides: Vec<String>,
-    },
+    Triaxial(TriaxialArgs),
     /// Parse and validate a scene without running it; print the derived figures.
     Check {
         /// Scene file (RON).
@@ -160,4 +136,32 @@ pub enum Command {
         #[arg(long = "set", value_name = "PATH=VALUE")]
         overrides: Vec<String>,
     },
+}
+
+/// The element test of `kdmpm triaxial`.
+#[derive(clap::Args)]
+pub struct TriaxialArgs {
+    /// Scene file (RON) whose `materials` holds the material.
+    pub scene: PathBuf,
+    /// The material's name in the scene.
+    #[arg(long)]
+    pub material: String,
+    /// The isotropic effective stress the sample starts at (Pa).
+    #[arg(long, value_name = "PA")]
+    pub cell_pressure: f64,
+    /// No water leaves the sample: its volume stays as it was.
+    #[arg(long)]
+    pub undrained: bool,
+    /// The last axial strain (compression positive).
+    #[arg(long, default_value_t = 0.3)]
+    pub axial_strain: f64,
+    /// Equal axial increments.
+    #[arg(long, default_value_t = 3000)]
+    pub steps: usize,
+    /// Output directory (default: out/triaxial-<material>).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Override a scene field (repeatable).
+    #[arg(long = "set", value_name = "PATH=VALUE")]
+    pub overrides: Vec<String>,
 }

@@ -65,6 +65,66 @@ fn main() -> ExitCode {
     }
 }
 
+/// `kdmpm triaxial`: the element test of a scene's material, written to triaxial.csv.
+fn triaxial(args: cli::TriaxialArgs) -> Result<(), Fault> {
+    let cli::TriaxialArgs {
+        scene,
+        material,
+        cell_pressure,
+        undrained,
+        axial_strain,
+        steps,
+        out,
+        overrides,
+    } = args;
+    let loaded = LoadedScene::from_file(&scene, &overrides).map_err(Fault::bad)?;
+    let Some(spec) = loaded.scene.materials.get(&material) else {
+        let names: Vec<&String> = loaded.scene.materials.keys().collect();
+        return Err(Fault::bad(format!(
+            "{}: no material \"{material}\" (the scene has {names:?})",
+            scene.display()
+        )));
+    };
+    let at = |f: &str| format!("materials.{material}.{f}");
+    let model = spec
+        .model(&at)
+        .map_err(|r| Fault::bad(loaded.invalid(&r.field, r.rule)))?;
+    let drainage = if undrained {
+        kdmpm::element_test::Drainage::Undrained
+    } else {
+        kdmpm::element_test::Drainage::Drained
+    };
+    let test = kdmpm::element_test::Triaxial {
+        cell_pressure,
+        drainage,
+        axial_strain,
+        steps,
+    };
+    let rows = kdmpm::element_test::triaxial(&model, &test).map_err(|e| match e {
+        kdmpm::element_test::ElementError::Input(..) => Fault::bad(e),
+        _ => Fault(e.to_string(), Ending::Failed),
+    })?;
+    let out = out.unwrap_or_else(|| PathBuf::from("out").join(format!("triaxial-{material}")));
+    let path = out.join("triaxial.csv");
+    std::fs::create_dir_all(&out)
+        .and_then(|_| kdmpm::element_test::write_csv(&rows, &path))
+        .map_err(|e| Fault(format!("cannot write {}: {e}", path.display()), Ending::Failed))?;
+    let last = rows.last().expect("the start is a row");
+    println!(
+        "{}: ε_a {:.4}, ε_v {:.4}, p′ {:.1} kPa, q {:.1} kPa, u {:.1} kPa",
+        path.display(),
+        last.axial_strain,
+        last.volumetric_strain,
+        last.mean_stress / 1e3,
+        last.deviator / 1e3,
+        last.pore_pressure / 1e3
+    );
+    for (name, v) in &last.state {
+        println!("  {name} {v:.6e}");
+    }
+    Ok(())
+}
+
 /// An error message and how the command ends with it.
 struct Fault(String, Ending);
 
@@ -127,62 +187,7 @@ fn command(command: Command, comm: &Arc<Comm>) -> Result<ExitCode, Fault> {
                 .map_err(Fault::bad)?;
             print!("{}: valid\n{derived}", scene.display());
         }
-        Command::Triaxial {
-            scene,
-            material,
-            cell_pressure,
-            undrained,
-            axial_strain,
-            steps,
-            out,
-            overrides,
-        } => {
-            let loaded = LoadedScene::from_file(&scene, &overrides).map_err(Fault::bad)?;
-            let Some(spec) = loaded.scene.materials.get(&material) else {
-                let names: Vec<&String> = loaded.scene.materials.keys().collect();
-                return Err(Fault::bad(format!(
-                    "{}: no material \"{material}\" (the scene has {names:?})",
-                    scene.display()
-                )));
-            };
-            let at = |f: &str| format!("materials.{material}.{f}");
-            let model = spec
-                .model(&at)
-                .map_err(|r| Fault::bad(loaded.invalid(&r.field, r.rule)))?;
-            let drainage = if undrained {
-                kdmpm::element_test::Drainage::Undrained
-            } else {
-                kdmpm::element_test::Drainage::Drained
-            };
-            let test = kdmpm::element_test::Triaxial {
-                cell_pressure,
-                drainage,
-                axial_strain,
-                steps,
-            };
-            let rows = kdmpm::element_test::triaxial(&model, &test).map_err(|e| match e {
-                kdmpm::element_test::ElementError::Input(..) => Fault::bad(e),
-                _ => Fault(e.to_string(), Ending::Failed),
-            })?;
-            let out = out.unwrap_or_else(|| PathBuf::from("out").join(format!("triaxial-{material}")));
-            let path = out.join("triaxial.csv");
-            std::fs::create_dir_all(&out)
-                .and_then(|_| kdmpm::element_test::write_csv(&rows, &path))
-                .map_err(|e| Fault(format!("cannot write {}: {e}", path.display()), Ending::Failed))?;
-            let last = rows.last().expect("the start is a row");
-            println!(
-                "{}: ε_a {:.4}, ε_v {:.4}, p′ {:.1} kPa, q {:.1} kPa, u {:.1} kPa",
-                path.display(),
-                last.axial_strain,
-                last.volumetric_strain,
-                last.mean_stress / 1e3,
-                last.deviator / 1e3,
-                last.pore_pressure / 1e3
-            );
-            for (name, v) in &last.state {
-                println!("  {name} {v:.6e}");
-            }
-        }
+        Command::Triaxial(args) => triaxial(args)?,
         Command::Plot { dir } => {
             let (written, skipped) = kdmpm::output::plots::draw(&dir)
                 .map_err(|e| Fault::bad(format!("cannot plot {}: {e}", dir.display())))?;
