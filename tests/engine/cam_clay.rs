@@ -16,12 +16,47 @@ const KAPPA: f64 = 0.05;
 const N: f64 = 3.0;
 const P0: f64 = 100e3;
 
-/// The oedometer scene's clay with overconsolidation ratio `ratio`.
-fn clay(ratio: f64) -> MaterialModel {
-    let set = format!("materials.clay.preconsolidation=Ratio({ratio:?})");
-    let loaded = LoadedScene::from_file(&scene("clay_oedometer.ron"), &[set]).expect("scene loads");
+/// The oedometer scene's clay with overconsolidation ratio `ratio`, and the overrides
+/// `sets` of its other fields.
+fn clay_with(ratio: f64, sets: &[&str]) -> MaterialModel {
+    let mut overrides = vec![format!("materials.clay.preconsolidation=Ratio({ratio:?})")];
+    overrides.extend(sets.iter().map(|s| s.to_string()));
+    let loaded = LoadedScene::from_file(&scene("clay_oedometer.ron"), &overrides).expect("scene loads");
     let spec: &MaterialSpec = &loaded.scene.materials["clay"];
     spec.model(&|f| f.to_string()).expect("a valid clay")
+}
+
+/// The oedometer scene's clay with overconsolidation ratio `ratio`.
+fn clay(ratio: f64) -> MaterialModel {
+    clay_with(ratio, &[])
+}
+
+/// The same clay holding undrained water of stiffness `bulk_modulus` (Pa).
+fn undrained_clay(ratio: f64, bulk_modulus: f64) -> MaterialModel {
+    clay_with(
+        ratio,
+        &[&format!(
+            "materials.clay.drainage=Undrained(bulk_modulus: {bulk_modulus:?})"
+        )],
+    )
+}
+
+/// The axial strain of an oedometer element's rows where its total vertical stress
+/// σ′_v + u = p′ + 2q/3 + u reaches `sv` (Pa), by linear interpolation.
+fn element_strain_at(element: &[Row], sv: f64) -> f64 {
+    let total = |r: &Row| r.mean_stress + 2.0 * r.deviator / 3.0 + r.pore_pressure;
+    let w = element
+        .windows(2)
+        .find(|w| total(&w[1]) >= sv)
+        .expect("the element reaches it");
+    let (a, b) = (&w[0], &w[1]);
+    a.axial_strain + (sv - total(a)) / (total(b) - total(a)) * (b.axial_strain - a.axial_strain)
+}
+
+/// The vertical strain of the oedometer scene from its loaded points' settlement `d` (m):
+/// they stand 0.9375 m over the base at the start.
+fn engine_strain(d: f64) -> f64 {
+    (0.9375 / (0.9375 - d)).ln()
 }
 
 fn test(drainage: Drainage, axial_strain: f64, steps: usize) -> Triaxial {
@@ -116,19 +151,11 @@ fn an_oedometer_of_normally_consolidated_clay_settles_as_its_element_test() {
     let s = run("clay_oedometer.ron", &[]);
     assert!(s.converged, "{:?}", s.error);
     let element = oedometer(&clay(1.0), P0, 0.6, 60_000).unwrap();
-    // The element's strain where its vertical stress σ′_v = p′ + 2q/3 reaches `sv` (Pa).
-    let vertical = |r: &Row| r.mean_stress + 2.0 * r.deviator / 3.0;
-    let strain_at = |sv: f64| {
-        let w = element.windows(2).find(|w| vertical(&w[1]) >= sv).unwrap();
-        let (a, b) = (&w[0], &w[1]);
-        a.axial_strain + (sv - vertical(a)) / (vertical(b) - vertical(a)) * (b.axial_strain - a.axial_strain)
-    };
-    // The loaded points stand 0.9375 m over the base at the start.
     assert_eq!(s.curve.len(), 8);
     for c in &s.curve {
         let sv = c.pressure.unwrap();
-        let engine = (0.9375 / (0.9375 - c.displacement)).ln();
-        let exact = strain_at(sv);
+        let engine = engine_strain(c.displacement);
+        let exact = element_strain_at(&element, sv);
         eprintln!(
             "{sv}: engine {engine:.5}, element {exact:.5}, {:+.2} %",
             100.0 * rel(engine, exact)
@@ -144,17 +171,6 @@ fn an_oedometer_of_normally_consolidated_clay_settles_as_its_element_test() {
             );
         }
     }
-}
-
-/// The oedometer scene's clay with undrained water of stiffness `bulk_modulus` (Pa).
-fn undrained_clay(ratio: f64, bulk_modulus: f64) -> MaterialModel {
-    let sets = [
-        format!("materials.clay.preconsolidation=Ratio({ratio:?})"),
-        format!("materials.clay.drainage=Undrained(bulk_modulus: {bulk_modulus:?})"),
-    ];
-    let loaded = LoadedScene::from_file(&scene("clay_oedometer.ron"), &sets).expect("scene loads");
-    let spec: &MaterialSpec = &loaded.scene.materials["clay"];
-    spec.model(&|f| f.to_string()).expect("a valid clay")
 }
 
 #[test]
@@ -192,17 +208,11 @@ fn an_undrained_oedometer_settles_as_its_element_test() {
     );
     assert!(s.converged, "{:?}", s.error);
     let element = oedometer(&undrained_clay(1.0, 1e8), P0, 0.05, 50_000).unwrap();
-    let total = |r: &Row| r.mean_stress + 2.0 * r.deviator / 3.0 + r.pore_pressure;
-    let strain_at = |sv: f64| {
-        let w = element.windows(2).find(|w| total(&w[1]) >= sv).unwrap();
-        let (a, b) = (&w[0], &w[1]);
-        a.axial_strain + (sv - total(a)) / (total(b) - total(a)) * (b.axial_strain - a.axial_strain)
-    };
     assert_eq!(s.curve.len(), 8);
     for c in &s.curve {
         let sv = c.pressure.unwrap();
-        let engine = (0.9375 / (0.9375 - c.displacement)).ln();
-        let exact = strain_at(sv);
+        let engine = engine_strain(c.displacement);
+        let exact = element_strain_at(&element, sv);
         eprintln!(
             "{sv}: engine {engine:.6}, element {exact:.6}, {:+.2} %",
             100.0 * rel(engine, exact)
