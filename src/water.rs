@@ -257,6 +257,12 @@ impl Water {
         self.heads[self.of_material[material as usize] as usize].at(s)
     }
 
+    /// The height (m, up gravity's axis) of `material`'s piezometric surface above the place
+    /// across gravity of `x`.
+    pub fn table_height(&self, material: u16, x: [f64; 3]) -> f64 {
+        self.head(material, x).0
+    }
+
     /// Pore pressure at `x` in `material` (Pa, compression positive): γ_w times the depth
     /// below its piezometric surface, 0 above it.
     #[inline(always)]

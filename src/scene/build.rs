@@ -1,6 +1,7 @@
 //! Building a simulation from a valid scene: grid nodes, material points, loads, tracing
 //! and the schedule. Only what the scene uses is created.
 
+use super::initial_stress::{Ground, Layer};
 use super::loaded::LoadedScene;
 use super::region::{cell_span, region_bounds, region_contains, BodyPoint};
 use super::spec::{pad3, Dimension, Region, Scene, SolverSpec};
@@ -587,6 +588,7 @@ fn spawn_bodies<D: Dim>(
     let mut next_id = 0u32;
     // The ids of each body's points (spawn order).
     let mut body_ids: Vec<std::ops::Range<u32>> = Vec::new();
+    let ground = ground(loaded, table, waters);
     for (b, body) in s.bodies.iter().enumerate() {
         let (lo, hi) = region_bounds(&body.region, n);
         if (0..n).any(|a| lo[a] < gmin[a] - 1e-9 || hi[a] > gmax[a] + 1e-9) {
@@ -629,7 +631,7 @@ fn spawn_bodies<D: Dim>(
                 "the body holds no material point (is it smaller than a sub-cell?)",
             ));
         }
-        let spawned = spawn_body::<D>(loaded, b, table, waters, world, xs, next_id, keep)?;
+        let spawned = spawn_body::<D>(loaded, b, table, waters, &ground, world, xs, next_id, keep)?;
         full_node_mass = full_node_mass.min(spawned.full_node_mass);
         initial_energy += spawned.initial_energy;
         body_ids.push(next_id..spawned.next_id);
@@ -642,6 +644,39 @@ fn spawn_bodies<D: Dim>(
         full_node_mass,
         initial_energy,
     })
+}
+
+/// The ground a geostatic start is worked out from: every body, the scene's gravity (down
+/// one axis, as the check requires of a geostatic start; axis 1 and no weight without
+/// gravity) and its water.
+fn ground<'a>(
+    loaded: &'a LoadedScene,
+    table: &[(String, MaterialModel)],
+    waters: &[(String, &'a crate::water::Water)],
+) -> Ground<'a> {
+    let s = &loaded.scene;
+    let id = |name: &str| table.iter().position(|(n, _)| n == name).expect("validated");
+    let layers = s
+        .bodies
+        .iter()
+        .map(|body| {
+            let m = id(&body.material);
+            Layer {
+                region: &body.region,
+                material: m as u16,
+                density: table[m].1.density(),
+            }
+        })
+        .collect();
+    let g = s.gravity.as_ref().map_or(&[][..], |g| g.acceleration.as_slice());
+    let axis = (0..g.len()).find(|&a| g[a] != 0.0).unwrap_or(1);
+    Ground {
+        layers,
+        axis,
+        gravity: g.get(axis).map_or(0.0, |v| v.abs()),
+        water: waters.first().map(|(_, w)| *w),
+        n: s.grid.cells.len(),
+    }
 }
 
 /// What [`spawn_body`] spawned: the next free point id and the mass ρ·h^D of a node inside
@@ -660,6 +695,7 @@ fn spawn_body<D: Dim>(
     b: usize,
     table: &[(String, MaterialModel)],
     waters: &[(String, &crate::water::Water)],
+    ground: &Ground,
     world: &mut World,
     all: Counted<impl Iterator<Item = ([f64; 3], u32)> + Clone>,
     first: u32,
@@ -736,27 +772,28 @@ fn spawn_body<D: Dim>(
     fill(&batch, std::iter::repeat_n(Velocity(z), count));
     // The strain energy of σ = −p I is p²/(2K) a unit volume; K ≥ M/3 for ν ≥ 0, so
     // 3p²/(2M) bounds it from the P-wave modulus M.
-    let initial_energy = if body.initial_pressure > 0.0 {
-        1.5 * body.initial_pressure.powi(2) / model.p_wave_modulus()
-            * all.map(|(x, _)| vol_at(x)).sum::<f64>()
+    let start = |x: [f64; 3]| match &body.initial_stress {
+        Some(spec) => ground.stress(spec, mat as u16, x),
+        None => crate::tensor::Sym3::ZERO,
+    };
+    // The strain energy of a start stress, p²/(2K) + q²/(6G) a unit volume, bounded by
+    // 3(p² + q²)/(2M) from the P-wave modulus M: K ≥ M/3 for ν ≥ 0, and 6G ≥ 2M/3 for
+    // ν ≤ 0.42. The energy guard allows for it.
+    let initial_energy = if body.initial_stress.is_some() {
+        let m = model.p_wave_modulus();
+        all.map(|(x, _)| {
+            let (p, s) = start(x).mean_and_deviatoric_norm();
+            1.5 * (p * p + 1.5 * s * s) / m * vol_at(x)
+        })
+        .sum::<f64>()
     } else {
         0.0
     };
     fill(&batch, xs.clone().map(|(x, _)| Mass(mass_at(x))));
-    fill(&batch, xs.map(|(x, _)| Volume(vol_at(x))));
-    let p = -body.initial_pressure;
-    let start = crate::tensor::Sym3 {
-        xx: p,
-        yy: p,
-        zz: p,
-        ..crate::tensor::Sym3::ZERO
-    };
+    fill(&batch, xs.clone().map(|(x, _)| Volume(vol_at(x))));
     fill(
         &batch,
-        std::iter::repeat_n(
-            Stress(<D::Stress as crate::tensor::StoredSym>::from_sym3(&start)),
-            count,
-        ),
+        xs.map(|(x, _)| Stress(<D::Stress as crate::tensor::StoredSym>::from_sym3(&start(x)))),
     );
     fill(&batch, std::iter::repeat_n(VelocityGradient(D::MAT_ZERO), count));
     fill(&batch, std::iter::repeat_n(MaterialId(mat as u16), count));

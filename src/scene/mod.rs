@@ -9,6 +9,7 @@
 //! simulation made from a valid scene; this file only names what the others offer.
 
 mod build;
+mod initial_stress;
 mod loaded;
 pub mod locate;
 mod region;
@@ -20,8 +21,8 @@ pub use crate::materials::MaterialSpec;
 pub use build::{build, build_part, RankPart};
 pub use loaded::LoadedScene;
 pub use spec::{
-    BodySpec, BoundarySpec, CheckpointEvery, Condition, Dimension, GravitySpec, GridSpec, OutputSpec,
-    PointLoadSpec, Region, Scene, SolverSpec, StageSpec, StrengthReductionSpec, TimeStep, TracedSpec,
-    TractionSpec,
+    BodySpec, BoundarySpec, CheckpointEvery, Condition, Dimension, GravitySpec, GridSpec, InitialStress,
+    OutputSpec, PointLoadSpec, Region, Scene, SolverSpec, StageSpec, StrengthReductionSpec, TimeStep,
+    TracedSpec, TractionSpec,
 };
 pub use validate::{check, Checked, CheckedGrid, CheckedStage, Derived, Estimate, FaceHold};

@@ -1,6 +1,7 @@
 //! The scene's schema: every part of a scene as serde reads it from RON, with the defaults
 //! of its fields. The rules each field holds are checked in `validate`.
 
+pub use super::initial_stress::InitialStress;
 use crate::grid::Face;
 use crate::materials::MaterialSpec;
 use crate::model::MotionSpec;
@@ -154,10 +155,10 @@ pub struct BodySpec {
     pub region: Region,
     /// Points per cell along each axis, ≥ 1 (placed at the centres of equal sub-cells).
     pub points_per_cell: Vec<usize>,
-    /// Isotropic stress the points start at (Pa, compression positive: σ = −p I), for a
-    /// weightless soil under a confining pressure; balance it with a traction on free faces.
+    /// The stress the points start at: `Isotropic(p)` or `Geostatic(k0: …)`
+    /// ([`InitialStress`]). Default: none.
     #[serde(default)]
-    pub initial_pressure: f64,
+    pub initial_stress: Option<InitialStress>,
 }
 
 /// The shape of a body.

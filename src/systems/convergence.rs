@@ -241,10 +241,15 @@ impl<D: Dim> System<D> for Convergence {
         if norms.external[0] > 0.0 {
             s.convergence.force_reference = Some(norms.external);
         }
+        // K_E = E_k / W_ext. Where the loads have done no work yet (a start in balance, such
+        // as a geostatic state, whose W_ext is round-off about 0) the energy the start's
+        // stress holds, E_0, is the scale the kinetic energy is judged against.
         s.convergence.energy_ratio = if s.convergence.external_work > 0.0 {
             s.energy.current() / s.convergence.external_work
         } else if quiet {
             0.0
+        } else if ctx.numerics.initial_energy > 0.0 {
+            s.energy.current() / ctx.numerics.initial_energy
         } else {
             UNDEFINED
         };

@@ -371,7 +371,7 @@ fn a_cone_in_sand_bears_in_proportion_to_its_confining_stress() {
         &[
             travel,
             "materials.sand.youngs_modulus=30.02e6",
-            "bodies[0].initial_pressure=200.0e3",
+            "bodies[0].initial_stress=Isotropic(200.0e3)",
             "tractions[0].pressure=200.0e3",
         ],
         200.0e3,

@@ -19,6 +19,7 @@ mod extremes;
 mod fos;
 mod friction;
 mod fuzz_scenes;
+mod geostatic;
 mod pay_for_what_you_use;
 mod plane_strain;
 mod prescribed_motion;

@@ -247,12 +247,13 @@ fn an_axisymmetric_body_driven_across_the_axis_is_refused() {
 }
 
 #[test]
-fn a_negative_initial_pressure_is_refused() {
+fn a_negative_initial_pressure_is_refused_at_its_field() {
     let e = refused(
         "points_per_cell: [2, 2])",
-        "points_per_cell: [2, 2], initial_pressure: -1.0)",
+        "points_per_cell: [2, 2], initial_stress: Isotropic(-1.0))",
     );
-    assert!(e.contains("bodies[0].initial_pressure"), "{e}");
+    assert!(e.contains("bodies[0].initial_stress"), "{e}");
+    assert!(e.contains("finite pressure ≥ 0 Pa, found -1"), "{e}");
 }
 
 /// `scenes/tbar.ron` with 2 × 2 points a cell (the scene has 3 × 3) over 0.15 D, with

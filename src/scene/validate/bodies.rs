@@ -30,14 +30,15 @@ pub(super) fn check_bodies(r: &Rules) -> Result<(), SceneError> {
             &format!("bodies[{b}].points_per_cell"),
             body.points_per_cell.len(),
         )?;
-        if !(body.initial_pressure.is_finite() && body.initial_pressure >= 0.0) {
-            return r.bad(
-                &format!("bodies[{b}].initial_pressure"),
-                format!(
-                    "must be a finite pressure ≥ 0 Pa, found {}",
-                    body.initial_pressure
-                ),
-            );
+        if let Some(start) = &body.initial_stress {
+            let field = format!("bodies[{b}].initial_stress");
+            if let Err(e) = start.check() {
+                let e = e.under(&field);
+                return r.bad(&e.field, e.rule);
+            }
+            if matches!(start, crate::scene::InitialStress::Geostatic { .. }) {
+                geostatic_gravity(r, &field)?;
+            }
         }
         if body.points_per_cell.contains(&0) {
             return r.bad(
@@ -94,6 +95,40 @@ pub(super) fn check_bodies(r: &Rules) -> Result<(), SceneError> {
                 }
             }
         }
+    }
+    Ok(())
+}
+
+/// A geostatic start balances full gravity, down one axis, from the first step.
+fn geostatic_gravity(r: &Rules, field: &str) -> Result<(), SceneError> {
+    let Some(g) = &r.loaded.scene.gravity else {
+        return r.bad(
+            field,
+            "a Geostatic start is the ground's own weight: the scene needs gravity".into(),
+        );
+    };
+    let along: Vec<usize> = (0..g.acceleration.len())
+        .filter(|&a| g.acceleration[a] != 0.0)
+        .collect();
+    if !matches!(along[..], [a] if g.acceleration[a] < 0.0) {
+        return r.bad(
+            "gravity.acceleration",
+            format!(
+                "{:?} under a Geostatic start: gravity points down one axis (a negative entry, \
+                 the others 0), the vertical the ground's weight is summed along",
+                g.acceleration
+            ),
+        );
+    }
+    if g.ramp_time != 0.0 {
+        return r.bad(
+            "gravity.ramp_time",
+            format!(
+                "{} s under a Geostatic start: the start balances full gravity, so gravity acts \
+                 in full from the first step (ramp_time 0)",
+                g.ramp_time
+            ),
+        );
     }
     Ok(())
 }
