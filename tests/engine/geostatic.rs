@@ -72,7 +72,8 @@ fn a_geostatic_start_carries_the_ground_above_and_takes_its_water_off() {
 fn level_ground_started_at_its_geostatic_state_is_static_at_the_first_step() {
     // In Mohr–Coulomb at the elastic K0, and in a normally consolidated Cam Clay (on its
     // yield surface from the start) drained and undrained, the start balances gravity and
-    // the water: the first step's K_F is round-off and nothing moves. Started from no
+    // the water, below the ground and standing on it: the first step's K_F is round-off
+    // and nothing moves. Started from no
     // stress, the same sand settles 38.3 mm at mid-height over 199 steps.
     let clay = COLUMN
         .replace(
@@ -96,6 +97,15 @@ fn level_ground_started_at_its_geostatic_state_is_static_at_the_first_step() {
         let u = s.traced[0].displacement;
         assert!(u[0].abs() < 1e-15 && u[1].abs() < 1e-15, "{name}: {u:?}");
     }
+    // Under 2 m of open water (table at 12 m, the grid 14 m tall) the sand carries its
+    // buoyant weight only: σ′_yy at mid-height (4.875 m) is (ρ_sat g − γ_w)(10 − 4.875).
+    let open = COLUMN
+        .replace("Level(6.0)", "Level(12.0)")
+        .replace("cells: [4, 24]", "cells: [4, 28]");
+    let s = run_text("open water", &open);
+    assert_eq!(s.steps, 1);
+    let buoyant = (2000.0 * 9.81 - 9810.0) * (10.0 - 4.875);
+    assert!((s.traced[0].stress.yy + buoyant).abs() < 1e-9 * buoyant);
     let settled = run_text(
         "from rest",
         &COLUMN.replace(
