@@ -106,6 +106,44 @@ fn level_ground_started_at_its_geostatic_state_is_static_at_the_first_step() {
     assert_eq!(s.steps, 1);
     let buoyant = (2000.0 * 9.81 - 9810.0) * (10.0 - 4.875);
     assert!((s.traced[0].stress.yy + buoyant).abs() < 1e-9 * buoyant);
+    // Two layers (clay under the sand, each its own saturated density), the column turned
+    // about its axis, and the column in 3D with gravity along z: static at the first step.
+    let two = COLUMN
+        .replace(
+            "Box(min: [0.0, 0.0], max: [2.0, 10.0]), points_per_cell: [2, 2],",
+            "Box(min: [0.0, 4.0], max: [2.0, 10.0]), points_per_cell: [2, 2],",
+        )
+        .replace(
+            "    ],\n    boundaries",
+            "        (material: \"clay\", region: Box(min: [0.0, 0.0], max: [2.0, 4.0]), points_per_cell: [2, 2],\n         \
+             initial_stress: Geostatic(k0: 0.5)),\n    ],\n    boundaries",
+        )
+        .replace(
+            "    },\n    bodies",
+            "        \"clay\": MohrCoulomb(density: 1600.0, youngs_modulus: 5.0e6, poisson_ratio: 0.3, \
+             cohesion: 20.0e3, friction_angle: 0.0),\n    },\n    bodies",
+        )
+        .replace("{\"soil\": 2000.0}", "{\"soil\": 2000.0, \"clay\": 1900.0}");
+    assert!(two.matches("Geostatic").count() == 2 && two.contains("\"clay\": 1900.0"));
+    let turned = COLUMN.replace("dimension: 2,", "dimension: Axisymmetric,");
+    let solid = COLUMN
+        .replace("dimension: 2,", "dimension: 3,")
+        .replace("origin: [0.0, 0.0], cell_size: 0.5, cells: [4, 24]", "origin: [0.0, 0.0, 0.0], cell_size: 0.5, cells: [4, 4, 24]")
+        .replace(
+            "Box(min: [0.0, 0.0], max: [2.0, 10.0]), points_per_cell: [2, 2]",
+            "Box(min: [0.0, 0.0, 0.0], max: [2.0, 2.0, 10.0]), points_per_cell: [2, 2, 2]",
+        )
+        .replace("[0.0, -9.81]", "[0.0, 0.0, -9.81]")
+        .replace(
+            "(face: YMin, condition: Fixed)",
+            "(face: ZMin, condition: Fixed), (face: YMin, condition: Roller), (face: YMax, condition: Roller)",
+        )
+        .replace("position: [0.875, 4.875]", "position: [0.875, 0.875, 4.875]");
+    for (name, text) in [("layers", two), ("axisymmetric", turned), ("3D", solid)] {
+        assert_ne!(text, COLUMN, "{name}");
+        let s = run_text(name, &text);
+        assert_eq!((s.outcome, s.steps), (Outcome::Converged, 1), "{name}");
+    }
     let settled = run_text(
         "from rest",
         &COLUMN.replace(
