@@ -456,6 +456,17 @@ fn head(surface: &Surface, n: usize, lo: [f64; 2], hi: [f64; 2]) -> Result<Head,
     }
 }
 
+/// The axis gravity `g` (m/s², one entry an axis) points down, when it points down exactly
+/// one (a negative entry, the others 0): the vertical that heights, and the weight of the
+/// ground above a point, are measured along.
+pub fn down_axis(g: &[f64]) -> Option<usize> {
+    let mut along = (0..g.len()).filter(|&a| g[a] != 0.0);
+    match (along.next(), along.next()) {
+        (Some(a), None) if g[a] < 0.0 => Some(a),
+        _ => None,
+    }
+}
+
 /// What checking the water needs to know of the scene.
 pub struct Frame<'a> {
     /// The scene's gravity (one entry an axis), if any.
@@ -479,16 +490,14 @@ impl Frame<'_> {
                 "pore pressure is hydrostatic: the scene needs gravity".into(),
             ));
         };
-        let along: Vec<usize> = (0..g.len()).filter(|&a| g[a] != 0.0).collect();
-        match along[..] {
-            [axis] if g[axis] < 0.0 => Ok(axis),
-            _ => Err(Refusal::new(
+        down_axis(g).ok_or_else(|| {
+            Refusal::new(
                 "gravity.acceleration",
                 "with water, gravity points down one axis (a negative entry, the others 0): \
                  heights are measured up that axis"
                     .into(),
-            )),
-        }
+            )
+        })
     }
 
     /// The surfaces `table` and `material_tables` checked against the grid and the

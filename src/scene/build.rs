@@ -647,7 +647,7 @@ fn spawn_bodies<D: Dim>(
 }
 
 /// The ground a geostatic start is worked out from: every body, the scene's gravity (down
-/// one axis, as the check requires of a geostatic start; axis 1 and no weight without
+/// one axis, as the check requires of a geostatic start; axis 1 and no weight without such
 /// gravity) and its water.
 fn ground<'a>(
     loaded: &'a LoadedScene,
@@ -669,11 +669,11 @@ fn ground<'a>(
         })
         .collect();
     let g = s.gravity.as_ref().map_or(&[][..], |g| g.acceleration.as_slice());
-    let axis = (0..g.len()).find(|&a| g[a] != 0.0).unwrap_or(1);
+    let axis = crate::water::down_axis(g);
     Ground {
         layers,
-        axis,
-        gravity: g.get(axis).map_or(0.0, |v| v.abs()),
+        axis: axis.unwrap_or(1),
+        gravity: axis.map_or(0.0, |a| g[a].abs()),
         water: waters.first().map(|(_, w)| *w),
         n: s.grid.cells.len(),
     }
@@ -770,8 +770,6 @@ fn spawn_body<D: Dim>(
     fill(&batch, xs.clone().map(|(_, id)| PointId(id)));
     fill(&batch, xs.clone().map(|(x, _)| Position(D::vec_from(x))));
     fill(&batch, std::iter::repeat_n(Velocity(z), count));
-    // The strain energy of σ = −p I is p²/(2K) a unit volume; K ≥ M/3 for ν ≥ 0, so
-    // 3p²/(2M) bounds it from the P-wave modulus M.
     let start = |x: [f64; 3]| match &body.initial_stress {
         Some(spec) => ground.stress(spec, mat as u16, x),
         None => crate::tensor::Sym3::ZERO,

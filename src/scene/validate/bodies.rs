@@ -107,10 +107,7 @@ fn geostatic_gravity(r: &Rules, field: &str) -> Result<(), SceneError> {
             "a Geostatic start is the ground's own weight: the scene needs gravity".into(),
         );
     };
-    let along: Vec<usize> = (0..g.acceleration.len())
-        .filter(|&a| g.acceleration[a] != 0.0)
-        .collect();
-    if !matches!(along[..], [a] if g.acceleration[a] < 0.0) {
+    if crate::water::down_axis(&g.acceleration).is_none() {
         return r.bad(
             "gravity.acceleration",
             format!(
