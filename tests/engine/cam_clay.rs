@@ -229,6 +229,15 @@ fn an_undrained_oedometer_settles_as_its_element_test() {
     }
 }
 
+/// The points.vtu of `scenes/clay_oedometer.ron` run with `sets` into the scratch folder
+/// `name`.
+fn oedometer_points(name: &str, sets: &[&str]) -> std::collections::BTreeMap<String, (usize, Vec<f64>)> {
+    let out = crate::common::scratch("cam_clay", name);
+    let run = crate::common::run_into(&scene("clay_oedometer.ron"), &out, sets);
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    crate::common::read_vtu(&out.join("points.vtu"))
+}
+
 #[test]
 fn the_clays_state_is_written_with_its_points() {
     // points.vtu carries p′_c, v and u; after the undrained oedometer every point holds
@@ -236,14 +245,7 @@ fn the_clays_state_is_written_with_its_points() {
     // The pore pressure alternates layer by layer (the loaded row 80 kPa, the row under
     // it 988 kPa, the rest 586–721 kPa: nearly incompressible points each keep their own
     // volume, docs/verification.md); the grid's forces see the mean.
-    let out = crate::common::scratch("cam_clay", "vtu");
-    let run = crate::common::run_into(
-        &scene("clay_oedometer.ron"),
-        &out,
-        &["materials.clay.drainage=Undrained(bulk_modulus: 1.0e8)"],
-    );
-    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
-    let vtu = crate::common::read_vtu(&out.join("points.vtu"));
+    let vtu = oedometer_points("vtu", &["materials.clay.drainage=Undrained(bulk_modulus: 1.0e8)"]);
     let (_, pc) = &vtu["preconsolidation"];
     let (_, v) = &vtu["specific_volume"];
     let (_, u) = &vtu["excess_pore_pressure"];
@@ -263,11 +265,7 @@ fn the_clays_state_is_written_with_its_points() {
     assert!((u[0] - 675.0e3).abs() < 1e3, "{}", u[0]);
     assert!((u[60] - 80.0e3).abs() < 1e3, "{}", u[60]);
     // The drained clay's points hold no water.
-    let out = crate::common::scratch("cam_clay", "vtu-drained");
-    assert!(crate::common::run_into(&scene("clay_oedometer.ron"), &out, &[])
-        .status
-        .success());
-    let vtu = crate::common::read_vtu(&out.join("points.vtu"));
+    let vtu = oedometer_points("vtu-drained", &[]);
     assert!(vtu["excess_pore_pressure"].1.iter().all(|&u| u == 0.0));
 }
 
