@@ -26,6 +26,13 @@ pub fn run_text(name: &str, text: &str) -> Summary {
     run_loaded(loaded)
 }
 
+/// `scenes/slope_fast.ron` run to its stop once for the whole test binary: two tests compare
+/// against it (the fast preset against slope.ron, the staged slope against one stage).
+pub fn slope_fast() -> &'static Summary {
+    static RUN: std::sync::OnceLock<Summary> = std::sync::OnceLock::new();
+    RUN.get_or_init(|| run("slope_fast.ron", &[]))
+}
+
 /// Each static state's mean pressure over `c_u` (a penetrometer's or a footing's factor
 /// N), in curve order.
 pub fn factors(s: &Summary, c_u: f64) -> Vec<f64> {

@@ -30,23 +30,23 @@ fn a_second_stage_that_doubles_the_bars_load_doubles_its_displacement() {
 #[test]
 fn the_slope_failed_from_its_geostatic_state_rests_at_the_one_stage_angle() {
     let staged = run("slope_staged.ron", &[]);
-    let one = run("slope_fast.ron", &[]);
+    let one = common::slope_fast();
     assert!(staged.converged && one.converged);
     assert_eq!(staged.stages.len(), 2, "geostatic, then strength");
     let angle = |s: &kdmpm::output::Summary| s.surface_angle.as_ref().unwrap().degrees;
     assert!(
-        (angle(&staged) - angle(&one)).abs() < 0.25,
+        (angle(&staged) - angle(one)).abs() < 0.25,
         "{} against {}",
         angle(&staged),
-        angle(&one)
+        angle(one)
     );
     // The crest's run-out counted from the geostatic state, against from the start.
     let ux = |s: &kdmpm::output::Summary| s.traced[0].displacement[0];
     assert!(
-        rel(ux(&staged), ux(&one)).abs() < 0.03,
+        rel(ux(&staged), ux(one)).abs() < 0.03,
         "{} against {}",
         ux(&staged),
-        ux(&one)
+        ux(one)
     );
 }
 
