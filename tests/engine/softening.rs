@@ -39,27 +39,38 @@ fn a_softening_soil_whose_residual_is_its_peak_runs_as_mohr_coulomb_bit_for_bit(
 }
 
 /// Softening lowers the factor of safety of the Griffiths–Lane slope below the one of its
-/// peak strength (1.383, pinned in tests/engine/fos.rs), and not as far as the one of its residual
-/// strength alone: failure progresses from the points that yield first, while the others
-/// keep their peak.
+/// peak strength, and not as far as the one of its residual strength alone: failure
+/// progresses from the points that yield first, while the others keep their peak. On 1 m
+/// cells, where tests/engine/refine.rs pins the peak's factor (1.414): `kdmpm fos
+/// scenes/slope_fos.ron --set grid.cell_size=1.0 --set "grid.cells=[55, 12]" --set
+/// "strength_reduction.bracket=[0.5, 2.0]" --set materials.soil=…` gives 0.764 for the
+/// residual strength alone and 1.314 for softening from peak to residual at κ = 0.01 (on the
+/// shipped 0.5 m cells: 1.383 for the peak).
 #[test]
 fn softening_puts_the_factor_of_safety_between_the_residual_and_the_peak() {
-    let wide = "strength_reduction.bracket=[0.5, 2.0]".to_string();
-    let fos = |name: &str, overrides: Vec<String>| {
+    let coarse = [
+        "grid.cell_size=1.0",
+        "grid.cells=[55, 12]",
+        "strength_reduction.bracket=[0.5, 2.0]",
+    ];
+    let fos = |name: &str, material: String| {
         let out = common::scratch("softening", name);
+        let mut overrides: Vec<String> = coarse.iter().map(|s| s.to_string()).collect();
+        overrides.push(material);
         strength_reduction(&slope(&overrides), &out, |_| {})
             .expect("the bracket holds the factor")
             .factor_of_safety
     };
-    // The peak strength's factor is the scene's own, pinned in tests/engine/fos.rs (1.383;
-    // 1.385 with this wider bracket: `kdmpm fos scenes/slope_fos.ron --set
-    // "strength_reduction.bracket=[0.5, 2.0]"`), not run again here.
-    let peak = 1.383;
+    // The peak strength's factor on these cells, pinned in tests/engine/refine.rs, not run
+    // again here.
+    let peak = 1.4140625;
     let residual_only = "materials.soil=MohrCoulomb(density: 2038.74, youngs_modulus: 100.0e6, \
                          poisson_ratio: 0.3, cohesion: 2.0e3, friction_angle: 16.0)"
         .to_string();
-    let residual = fos("residual", vec![wide.clone(), residual_only]);
-    let soft = fos("soft", vec![wide, softening(2.0e3, 16.0, 0.01)]);
+    let residual = fos("fos-residual", residual_only);
+    let soft = fos("fos-soft", softening(2.0e3, 16.0, 0.01));
+    // Pinned: each is the middle of its last bracket (0.7578–0.7695, 1.3086–1.3203).
+    assert_eq!([residual, soft], [0.763671875, 1.314453125]);
     assert!(
         residual + 0.1 < soft && soft < peak - 0.05,
         "residual {residual}, softening {soft}, peak {peak}"
