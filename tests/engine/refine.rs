@@ -159,54 +159,54 @@ fn a_mean_pressure_of_a_row_without_an_area_or_without_refine_is_refused() {
     assert!(!out.join("summary.json").exists(), "nothing is run");
 }
 
-/// `slope_fos.ron` from h = 1 m with two cell sizes: 1.4141 at h = 1 m, 1.3828 at 0.5 m;
-/// order 1 assumed, extrapolated 2·1.3828 − 1.4141 = 1.3516 (Bishop 1.378), so the answer
-/// at h = 1 m is 0.0625 above it.
+/// `slope_fos.ron` from h = 2.5 m with two cell sizes: 1.4453 at h = 2.5 m, 1.4141 at 1.25 m;
+/// order 1 assumed, extrapolated 2·1.4141 − 1.4453 = 1.3828 (Bishop 1.378), so the answer
+/// at h = 2.5 m is 0.0625 above it. (From the shipped h = 0.5 m: 1.3828 at 0.5 m, 1.3516
+/// extrapolated from h = 1 m and 0.5 m, docs/verification.md.)
 #[test]
 fn two_cell_sizes_of_the_slope_extrapolate_at_first_order() {
     let out = common::scratch("refine", "slope");
-    let l = loaded("slope_fos.ron", &["grid.cell_size=1.0", "grid.cells=[55, 12]"]);
+    let l = loaded("slope_fos.ron", &COARSE_SLOPE);
     let (report, r) = factor_of_safety(&l, &out, 2, |_, _| {}).expect("two analyses");
     assert_eq!(r.levels[0].value, report.factor_of_safety);
-    assert_eq!(r.levels[0].value, 1.4140625);
-    assert_eq!(r.levels[1].value, 1.3828125);
+    assert_eq!(r.levels[0].value, 1.4453125);
+    assert_eq!(r.levels[1].value, 1.4140625);
     assert_eq!(r.order_used, Some(1.0));
-    assert!((r.extrapolated.unwrap() - 1.3515625).abs() < 1e-12);
+    assert!((r.extrapolated.unwrap() - 1.3828125).abs() < 1e-12);
     assert!((r.error.unwrap() - 0.0625).abs() < 1e-12);
-    assert!((summary_refinement(&out)["extrapolated"].as_f64().unwrap() - 1.3515625).abs() < 1e-12);
+    assert!((summary_refinement(&out)["extrapolated"].as_f64().unwrap() - 1.3828125).abs() < 1e-12);
 }
 
-/// The same slope at a tolerance too coarse to tell h from h/2 (0.1: both brackets end
-/// at 1.375–1.4375, the two answers 1.40625): `--refine` bisects each on, a trial at a
-/// time, until they are resolved, here at 1/64 wide, and gives the estimate the scene's
-/// tolerance gives (1.4140625, 1.3828125 as above). Once it said only that the answers
-/// differ by less than they resolve.
+/// `slope_fos.ron` on 2.5 m cells, whose grid ends at the body's back at x = 55 m as the
+/// shipped one does (h and h/2 of the refinement tests of the factor of safety).
+const COARSE_SLOPE: [&str; 2] = ["grid.cell_size=2.5", "grid.cells=[22, 5]"];
+
+/// The same slope at a tolerance too coarse to tell h from h/2 (0.1: the two answers are
+/// 1.46875 and 1.40625, a bracket's width apart): `--refine` bisects each on, a trial at a
+/// time, until they are resolved, and gives the estimate the scene's tolerance gives
+/// (1.4453125, 1.4140625 as above). Once it said only that the answers differ by less than
+/// they resolve.
 #[test]
 fn answers_closer_than_their_brackets_are_bisected_on_until_resolved() {
     let out = common::scratch("refine", "narrowed");
-    let l = loaded(
-        "slope_fos.ron",
-        &[
-            "grid.cell_size=1.0",
-            "grid.cells=[55, 12]",
-            "strength_reduction.tolerance=0.1",
-        ],
-    );
+    let mut sets = COARSE_SLOPE.to_vec();
+    sets.push("strength_reduction.tolerance=0.1");
+    let l = loaded("slope_fos.ron", &sets);
     let (report, r) = factor_of_safety(&l, &out, 2, |_, _| {}).expect("two analyses");
-    assert_eq!(r.levels[0].value, 1.4140625);
-    assert_eq!(r.levels[1].value, 1.3828125);
+    assert_eq!(r.levels[0].value, 1.4453125);
+    assert_eq!(r.levels[1].value, 1.4140625);
     assert_eq!(r.levels[0].resolution, 1.0 / 128.0);
-    assert_eq!(report.factor_of_safety, 1.4140625);
+    assert_eq!(report.factor_of_safety, 1.4453125);
     assert_eq!(report.tolerance, 0.025);
-    assert!((r.extrapolated.unwrap() - 1.3515625).abs() < 1e-12, "{}", r.note);
+    assert!((r.extrapolated.unwrap() - 1.3828125).abs() < 1e-12, "{}", r.note);
     // The narrowing trials are the analysis's own: in its table and its folders.
     let table = std::fs::read_to_string(out.join("fos.csv")).unwrap();
     assert_eq!(table.lines().count(), 1 + report.trials.len());
-    assert!(out.join("trials/F1.421875").is_dir());
+    assert!(out.join("trials/F1.453125").is_dir());
     let fine: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("refine/h0.5/summary.json")).unwrap())
+        serde_json::from_str(&std::fs::read_to_string(out.join("refine/h1.25/summary.json")).unwrap())
             .unwrap();
-    assert_eq!(fine["factor_of_safety"], 1.3828125);
+    assert_eq!(fine["factor_of_safety"], 1.4140625);
 }
 
 #[test]
@@ -240,7 +240,7 @@ fn a_refinement_without_a_limit_pressure_or_with_four_levels_is_bad_input() {
 
 /// `kdmpm study` with a `Refine` axis runs the scenes `--refine` runs (one list of what a
 /// refinement changes), and a `FactorOfSafety` quantity makes each run a `kdmpm fos`: the
-/// slope from h = 1 m gives 1.4141 and 1.3828, as `two_cell_sizes_of_the_slope_…` pins.
+/// slope from h = 2.5 m gives 1.4453 and 1.4141, as `two_cell_sizes_of_the_slope_…` pins.
 #[test]
 fn a_study_of_the_factor_of_safety_refines_as_refine_does() {
     let dir = common::scratch("refine", "study-fos");
@@ -249,7 +249,7 @@ fn a_study_of_the_factor_of_safety_refines_as_refine_does() {
     let text = format!(
         r#"Study(
     scene: "{}/slope_fos.ron",
-    set: ["grid.cell_size=1.0", "grid.cells=[55, 12]"],
+    set: ["grid.cell_size=2.5", "grid.cells=[22, 5]"],
     axes: [Refine([1, 2])],
     quantities: [(name: "F", of: FactorOfSafety, compare: Analytic(1.378))],
 )"#,
@@ -263,7 +263,7 @@ fn a_study_of_the_factor_of_safety_refines_as_refine_does() {
     let header: Vec<&str> = table.lines().next().unwrap().split(',').collect();
     let at = |name: &str| header.iter().position(|h| *h == name).unwrap();
     let rows: Vec<Vec<&str>> = table.lines().skip(1).map(|l| l.split(',').collect()).collect();
-    for (row, pinned) in rows.iter().zip([1.4140625, 1.3828125]) {
+    for (row, pinned) in rows.iter().zip([1.4453125, 1.4140625]) {
         assert_eq!(row[at("outcome")], "bracketed", "{table}");
         assert!(
             common::rel(row[at("F")].parse().unwrap(), pinned).abs() < 1e-6,

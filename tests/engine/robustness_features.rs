@@ -220,10 +220,15 @@ fn a_load_in_billions_of_increments_stops_at_max_steps() {
 
 // ---- Factor of safety ---------------------------------------------------------------
 
-/// slope_fos.ron with an elastic soil whose strength comes from a stage (a geostatic
-/// elastic stage, then Mohr-Coulomb with the displacements zeroed).
+/// slope_fos.ron on 1 m cells with an elastic soil whose strength comes from a stage (a
+/// geostatic elastic stage, then Mohr-Coulomb with the displacements zeroed).
 fn slope_with_strength_in_a_stage() -> PathBuf {
-    let text = std::fs::read_to_string(common::scene("slope_fos.ron")).unwrap();
+    let shipped = std::fs::read_to_string(common::scene("slope_fos.ron")).unwrap();
+    let text = shipped.replace(
+        "cell_size: 0.5, cells: [110, 24]",
+        "cell_size: 1.0, cells: [55, 12]",
+    );
+    assert_ne!(text, shipped, "the grid line of slope_fos.ron");
     let soil = "MohrCoulomb(density: 2038.74, youngs_modulus: 100.0e6, poisson_ratio: 0.3, \
                 cohesion: 10.0e3, friction_angle: 20.0, dilatancy_angle: 0.0)";
     let start = text.find("\"soil\": MohrCoulomb(").unwrap() + "\"soil\": ".len();
@@ -245,8 +250,9 @@ fn slope_with_strength_in_a_stage() -> PathBuf {
 }
 
 /// Strength reduction divides the strength a stage gives, as it does the scene's: the
-/// factor is Griffiths & Lane's slope's, the bracket of the one-stage scene (1.375–1.391,
-/// README). Once the stage's strength was left whole ("above 2"), and an elastic scene
+/// factor is Griffiths & Lane's slope's, the bracket of the one-stage scene on the same
+/// 1 m cells (1.40625–1.421875: `kdmpm fos scenes/slope_fos.ron --set grid.cell_size=1.0
+/// --set "grid.cells=[55, 12]"`). Once the stage's strength was left whole ("above 2"), and an elastic scene
 /// with a Mohr-Coulomb stage was refused.
 #[test]
 fn fos_reduces_the_strength_that_a_stage_gives() {
@@ -255,12 +261,12 @@ fn fos_reduces_the_strength_that_a_stage_gives() {
     let o = fos_within(&scene, &out, Duration::from_secs(300));
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let s = summary(&out);
-    assert_eq!(s["bracket"], serde_json::json!([1.375, 1.390625]));
+    assert_eq!(s["bracket"], serde_json::json!([1.40625, 1.421875]));
     // The mechanism is the smallest failing trial's folder.
     let trials = s["trials"].as_array().unwrap();
     let mechanism = trials.iter().find(|t| t["dir"] == s["mechanism"]).unwrap();
     assert_eq!(mechanism["failed"], true);
-    assert_eq!(mechanism["factor"], 1.390625);
+    assert_eq!(mechanism["factor"], 1.421875);
     let _ = std::fs::remove_dir_all(scene.parent().unwrap());
 }
 

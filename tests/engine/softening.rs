@@ -41,9 +41,10 @@ fn a_softening_soil_whose_residual_is_its_peak_runs_as_mohr_coulomb_bit_for_bit(
 /// Softening lowers the factor of safety of the Griffiths–Lane slope below the one of its
 /// peak strength, and not as far as the one of its residual strength alone: failure
 /// progresses from the points that yield first, while the others keep their peak. On 1 m
-/// cells, where tests/engine/refine.rs pins the peak's factor (1.414): `kdmpm fos
-/// scenes/slope_fos.ron --set grid.cell_size=1.0 --set "grid.cells=[55, 12]" --set
-/// "strength_reduction.bracket=[0.5, 2.0]" --set materials.soil=…` gives 0.764 for the
+/// cells: `kdmpm fos scenes/slope_fos.ron --set grid.cell_size=1.0 --set "grid.cells=[55,
+/// 12]"` gives 1.414 for the peak strength (1.40625–1.421875, the bracket
+/// tests/engine/robustness_features.rs pins for the same strength given by a stage); with
+/// `--set "strength_reduction.bracket=[0.5, 2.0]" --set materials.soil=…` 0.764 for the
 /// residual strength alone and 1.314 for softening from peak to residual at κ = 0.01 (on the
 /// shipped 0.5 m cells: 1.383 for the peak).
 #[test]
@@ -61,8 +62,7 @@ fn softening_puts_the_factor_of_safety_between_the_residual_and_the_peak() {
             .expect("the bracket holds the factor")
             .factor_of_safety
     };
-    // The peak strength's factor on these cells, pinned in tests/engine/refine.rs, not run
-    // again here.
+    // The peak strength's factor on these cells (above), not run again here.
     let peak = 1.4140625;
     let residual_only = "materials.soil=MohrCoulomb(density: 2038.74, youngs_modulus: 100.0e6, \
                          poisson_ratio: 0.3, cohesion: 2.0e3, friction_angle: 16.0)"
