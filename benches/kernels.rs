@@ -22,7 +22,8 @@ fn slope() -> Simulation<Dim2> {
 }
 
 fn after_200_steps(scene: &str) -> Simulation<Dim2> {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(scene);
+    // This package is benches/ in the kdmpm checkout: scenes are one level up.
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join(scene);
     let loaded = LoadedScene::from_file(&path, &[]).unwrap();
     let AnySimulation::Two(mut sim) = build(&loaded).unwrap().0 else {
         unreachable!()

@@ -4,7 +4,7 @@
 //! 100k and 1M points on 1 and 2 threads, and the 2D slope. Prints a table and the
 //! per-system split. Each rate is the best of three rounds, the thread counts (and the
 //! variants of the 100k block) alternating.
-//! `cargo bench --bench throughput` (add `-- 10k` to run one size).
+//! `cargo bench -p kdmpm-bench --bench throughput` (add `-- 10k` to run one size).
 //!
 //! The 100k block is also run in a grid with ten times as many nodes (50 × 50 × 54 cells
 //! instead of 23 × 23 × 25): only the nodes the points reach should cost time, so the
@@ -96,8 +96,9 @@ fn prepare(variant: &Variant, threads: usize) -> (rayon::ThreadPool, kdmpm::AnyS
         .num_threads(threads)
         .build()
         .unwrap();
+    // This package is benches/ in the kdmpm checkout: scenes are one level up.
     let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("scenes")
+        .join("../scenes")
         .join(variant.file);
     let mut o = vec!["solver.max_steps=1000000000".to_string()];
     o.extend(variant.overrides.iter().map(|s| s.to_string()));

@@ -7,7 +7,7 @@
 //!
 //! Set-up sorts too: bodies are filled row of points by row of points, so the points of one
 //! cell start far apart in memory, and cell order is worth about a third of the block's
-//! throughput (`cargo bench --bench throughput`).
+//! throughput (`cargo bench -p kdmpm-bench --bench throughput`).
 
 use crate::components::*;
 use crate::context::Context;
