@@ -282,18 +282,12 @@ fn an_axisymmetric_footing_resumed_in_an_increment_writes_the_same_curve() {
     resume_from_last_checkpoint("footing_circular.ron", 5_000, &[]);
 }
 
-/// The paper's slope on 2 m cells, 4×4 points a cell (a quarter of the shipped points).
-const COARSE_SLOPE: [&str; 3] = [
-    "grid.cell_size=2",
-    "grid.cells=[90, 23]",
-    "bodies[0].points_per_cell=[4, 4]",
-];
-
 /// The paper's slope (the fast preset, whose static check window the run ends in),
-/// checkpointed in the middle of its run (step 1 500 of 2 500 on the coarse grid).
+/// on `common::COARSE_SLOPE`'s grid, checkpointed in the middle of its run (step 1 500 of
+/// 2 500).
 #[test]
 fn the_slope_resumed_from_the_middle_of_its_run_writes_the_same_files() {
-    resume_from_last_checkpoint("slope_fast.ron", 1_500, &COARSE_SLOPE);
+    resume_from_last_checkpoint("slope_fast.ron", 1_500, &common::COARSE_SLOPE);
 }
 
 #[test]
@@ -303,7 +297,7 @@ fn ctrl_c_checkpoints_and_a_resumed_run_writes_the_files_of_one_never_interrupte
     let scene = path.to_str().unwrap();
     let (whole, cut) = (dir.join("whole"), dir.join("cut"));
     let mut sets = vec!["--set", "solver.max_steps=3000"];
-    for s in &COARSE_SLOPE {
+    for s in &common::COARSE_SLOPE {
         sets.extend(["--set", s]);
     }
     let mut args = vec!["run", scene, "--quiet", "--out", whole.to_str().unwrap()];

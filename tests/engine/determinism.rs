@@ -2,6 +2,7 @@
 //! spatial sorts included (every 50 steps here, eight in the run), and the same bits whether
 //! the scatters share their grouping of points or group them anew.
 
+use crate::common;
 use kdmpm::components::{Position, Stress, Velocity};
 use kdmpm::infra::columns::{col, points_with};
 use kdmpm::materials::PlasticStrain;
@@ -97,7 +98,7 @@ fn the_slope_with_cell_means_is_bitwise_identical_on_one_and_two_threads() {
 fn scatters_sharing_their_slabs_give_the_bits_of_slabs_built_for_every_scatter() {
     // MUSL (remap reuses p2g's slabs) with volumetric smoothing (p2g reuses the smoothing's)
     // or cell means (the stress's reuses the strain's), and USF (the force pass reuses the
-    // momentum pass's); sorts every 25 steps. On 2 m cells with 4×4 points a cell (10 343
+    // momentum pass's); sorts every 25 steps. On `common::COARSE_SLOPE`'s grid (10 343
     // points, 90 × 23 cells): which slabs a scatter uses does not depend on the cell size.
     for (scheme, locking) in [
         ("Musl", "StrainSmoothing"),
@@ -105,15 +106,17 @@ fn scatters_sharing_their_slabs_give_the_bits_of_slabs_built_for_every_scatter()
         ("Musl", "CellMean"),
         ("Usf", "CellMean"),
     ] {
-        let overrides = [
-            "grid.cell_size=2",
-            "grid.cells=[90, 23]",
-            "bodies[0].points_per_cell=[4, 4]",
+        let (locking_set, scheme_set) = (
+            format!("solver.anti_locking={locking}"),
+            format!("solver.scheme={scheme}"),
+        );
+        let mut overrides = common::COARSE_SLOPE.to_vec();
+        overrides.extend([
             "solver.max_steps=300",
             "solver.sort_every=25",
-            &format!("solver.anti_locking={locking}"),
-            &format!("solver.scheme={scheme}"),
-        ];
+            &locking_set,
+            &scheme_set,
+        ]);
         let shared = run(2, &overrides, false);
         let anew = run(2, &overrides, true);
         let differing = shared.iter().zip(&anew).filter(|(a, b)| a != b).count();

@@ -252,8 +252,8 @@ fn slope_with_strength_in_a_stage() -> PathBuf {
 /// Strength reduction divides the strength a stage gives, as it does the scene's: the
 /// factor is Griffiths & Lane's slope's, the bracket of the one-stage scene on the same
 /// 1 m cells (1.40625–1.421875: `kdmpm fos scenes/slope_fos.ron --set grid.cell_size=1.0
-/// --set "grid.cells=[55, 12]"`). Once the stage's strength was left whole ("above 2"), and an elastic scene
-/// with a Mohr-Coulomb stage was refused.
+/// --set "grid.cells=[55, 12]"`). Once the stage's strength was left whole ("above 2"),
+/// and an elastic scene with a Mohr-Coulomb stage was refused.
 #[test]
 fn fos_reduces_the_strength_that_a_stage_gives() {
     let scene = slope_with_strength_in_a_stage();

@@ -112,7 +112,7 @@ fn run_and_continue<D: Dim>(sim: &mut Simulation<D>) -> Rest {
 #[test]
 fn failing_slope_comes_to_rest_at_its_repose_angle() {
     common::on_own_thread(|| {
-        let mut sim = scene("slope.ron", COARSE);
+        let mut sim = scene("slope.ron", &common::COARSE_SLOPE);
         let r = with_simulation!(&mut sim, s => run_and_continue(s));
         pinned("steps", r.steps as f64, 18308.0, 0.01);
         pinned("stop time (s)", r.time, 50.027, 0.01);
@@ -124,20 +124,14 @@ fn failing_slope_comes_to_rest_at_its_repose_angle() {
     })
 }
 
-/// 2 m cells with 4×4 points a cell (the crest point stays at (29.75, 39.75)).
-const COARSE: &[&str] = &[
-    "grid.cell_size=2",
-    "grid.cells=[90, 23]",
-    "bodies[0].points_per_cell=[4, 4]",
-];
-
-/// φ = 35° under a 30° face: it stands, settling 0.17 m at most (on the coarse grid above:
+/// φ = 35° under a 30° face: it stands, settling 0.17 m at most (on the coarse grid above,
+/// `common::COARSE_SLOPE`:
 /// `kdmpm run scenes/slope_stable.ron --set …` 4 330 steps, angle 29.7720°, crest u_x
 /// 0.05530 m; the shipped 1 m cells: 8 937 steps, 29.7668°, 0.05444 m).
 #[test]
 fn slope_steeper_friction_than_its_face_stands() {
     common::on_own_thread(|| {
-        let mut sim = scene("slope_stable.ron", COARSE);
+        let mut sim = scene("slope_stable.ron", &common::COARSE_SLOPE);
         let r = with_simulation!(&mut sim, s => run_and_continue(s));
         pinned("steps", r.steps as f64, 4330.0, 0.01);
         pinned("angle (°)", r.angle, 29.77204, 0.005 / 30.0);
@@ -185,8 +179,8 @@ fn the_fast_preset_still_refuses_the_creeping_slope() {
         // Under the preset itself the creep keeps K_F above the tolerance to the 26 s limit;
         // under MUSL at Courant 1 K_F and K_E are met and a 2 s window closes with centimetres
         // of movement (2.41 cm at 26 s; none has closed at 22 s): either way the run must not
-        // stop. (The paper's slope
-        // with its 10 s window refuses the same creep, 30 s of simulation: docs/verification.md.)
+        // stop. (The paper's slope with its 10 s window refuses the same creep, 30 s of
+        // simulation: docs/verification.md.)
         for extra in [
             &[][..],
             &["solver.scheme=Musl", "solver.time_step=Courant(1.0)"][..],
