@@ -61,6 +61,10 @@ pub trait MaterialState: bytemuck::Pod + Default + PartialEq + Debug + Send + Sy
     fn excess_pore_pressure(&self) -> f64 {
         0.0
     }
+    /// Sets u (Pa) in a state that holds undrained water; the caller moves the point's
+    /// stress column with it (`systems/pore_pressure_field.rs`). Nothing for a state
+    /// without water, which is never asked.
+    fn set_excess_pore_pressure(&mut self, _u: f64) {}
     /// The state's other values by name (units in the model's docs), for element tests and
     /// output: none by default.
     fn fields(&self) -> Vec<(&'static str, f64)> {
@@ -101,6 +105,12 @@ pub trait Material: Send + Sync {
     /// locking ask it after they move a point's mean stress (`systems/cell_mean.rs`).
     fn admits(&self, _stress: &Sym3, _state: &Self::State) -> bool {
         true
+    }
+    /// True when the model holds undrained pore water in its state (its points' stress
+    /// columns hold σ′ − u I): their pore pressure is then a cell field
+    /// (`systems/pore_pressure_field.rs`).
+    fn holds_water(&self) -> bool {
+        false
     }
 }
 
@@ -299,6 +309,13 @@ macro_rules! define_materials {
             pub fn visit_state(&self, v: &mut impl StateVisitor) {
                 match self {
                     $(MaterialModel::$variant(_) => v.visit::<<<$spec as SceneMaterial>::Model as Material>::State>(),)*
+                }
+            }
+
+            /// Whether it holds undrained water in its state (see [`Material::holds_water`]).
+            pub fn holds_water(&self) -> bool {
+                match self {
+                    $(MaterialModel::$variant(m) => m.holds_water(),)*
                 }
             }
 

@@ -25,7 +25,9 @@
 //! volumetric strain as an excess pressure, δu = K_f δε_v with K_f = K_w/n, and the point's
 //! stress column holds σ′ − u I (tension positive): the grid's forces see the water, the
 //! clay's law sees σ′ = σ + u I. u is part of the point's state. K_f adds to the P-wave
-//! modulus and so shortens the time step as 1/√(M′ + K_f): a K_f far below water's own
+//! modulus and so shortens the time step as 1/√(M′ + K_f). In a run the points of a
+//! cell share their mean u after every update (`systems/pore_pressure_field.rs`). A K_f
+//! far below water's own
 //! (2.2 GPa/n) but far above the clay's K′ holds the volume nearly constant at a step that
 //! stays practical (docs/verification.md measures the trade).
 //!
@@ -261,7 +263,7 @@ pub struct CamClayState {
     /// Σ δε_q^p, the accumulated plastic shear strain (dimensionless).
     pub plastic_strain: f64,
     /// u (Pa, compression positive): the excess pore pressure of an undrained clay (0
-    /// drained).
+    /// drained), in a run its cell's (`systems/pore_pressure_field.rs`).
     pub excess_pore_pressure: f64,
 }
 
@@ -273,9 +275,13 @@ impl MaterialState for CamClayState {
         self.preconsolidation.is_finite()
             && self.specific_volume.is_finite()
             && self.plastic_strain.is_finite()
+            && self.excess_pore_pressure.is_finite()
     }
     fn excess_pore_pressure(&self) -> f64 {
         self.excess_pore_pressure
+    }
+    fn set_excess_pore_pressure(&mut self, u: f64) {
+        self.excess_pore_pressure = u;
     }
     fn fields(&self) -> Vec<(&'static str, f64)> {
         vec![
@@ -481,6 +487,9 @@ impl Material for ModifiedCamClay {
         let (p, _, q) = invariants(&(*stress + Sym3::IDENTITY * state.excess_pore_pressure));
         let pc = state.preconsolidation;
         self.yield_value(p, q, pc) <= 1e-9 * pc * pc
+    }
+    fn holds_water(&self) -> bool {
+        self.fluid_bulk > 0.0
     }
 }
 

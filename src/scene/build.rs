@@ -419,6 +419,7 @@ fn schedule_of<D: Dim>(
     let s = &loaded.scene;
     let needs = Needs {
         point_loads: !s.point_loads.is_empty() || !s.tractions.is_empty(),
+        undrained: s.every_material().any(|(_, m)| m.holds_water()),
     };
     let names: Vec<String> = match &s.solver.schedule {
         Some(names) => {

@@ -33,6 +33,7 @@ pub mod p2g;
 pub mod peak_watch;
 pub mod point_forces;
 pub mod point_loads;
+pub mod pore_pressure_field;
 pub mod prescribed_motion;
 pub mod remap;
 pub mod rigid_contact;
@@ -58,6 +59,7 @@ pub use nodal_velocity::NodalVelocity;
 pub use p2g::{P2g, P2gPart};
 pub use peak_watch::PeakWatch;
 pub use point_loads::PointLoads;
+pub use pore_pressure_field::PorePressureField;
 pub use prescribed_motion::PrescribedMotion;
 pub use remap::Remap;
 pub use rigid_contact::RigidContact;
@@ -79,6 +81,8 @@ use crate::state::{AntiLocking, Damping, Numerics, Scheme};
 pub struct Needs {
     /// The scene has point loads.
     pub point_loads: bool,
+    /// A material of the scene or of a stage holds undrained pore water.
+    pub undrained: bool,
 }
 
 /// The place of a system in a step. A scheme runs its stages in the order
@@ -367,6 +371,17 @@ fn straining<D: Dim, S: Shape>() -> Vec<Entry<D>> {
             |_, _| Box::new(CellMean::<D, S>::new(CellMeanPart::Stress)),
         ),
         e(
+            "pore_pressure_field",
+            St::Project,
+            Needed(|_, _, n| n.undrained, "a material holds undrained water"),
+            &[
+                ("stress_update", "it projects the updated pore pressures"),
+                ("cell_mean_stress", "it projects the projected stress's water"),
+            ],
+            "cell mean of the undrained points' excess pore pressure",
+            |_, _| Box::new(PorePressureField::<D, S>::default()),
+        ),
+        e(
             "volume_update",
             St::Volume,
             Always,
@@ -381,6 +396,7 @@ fn straining<D: Dim, S: Shape>() -> Vec<Entry<D>> {
             &[
                 ("stress_update", "p2g_force maps the updated stress"),
                 ("cell_mean_stress", "p2g_force maps the projected stress"),
+                ("pore_pressure_field", "p2g_force maps the water's cell pressure"),
             ],
             "USF: internal force of the updated stress (and each point's other forces)",
             |_, _| Box::new(P2g::<D, S>::new(P2gPart::InternalForce)),
@@ -809,7 +825,10 @@ mod tests {
                 for gravity in [false, true] {
                     for loads in [false, true] {
                         let st = settings(scheme, damping, gravity);
-                        let needs = Needs { point_loads: loads };
+                        let needs = Needs {
+                            point_loads: loads,
+                            undrained: false,
+                        };
                         let n = names(&default_names(&st.0, &st.1, needs));
                         assert_eq!(check_names(&n, &st.0, &st.1, needs), Ok(()), "{n:?}");
                     }
@@ -822,7 +841,10 @@ mod tests {
     fn default_schedules_run_the_stages_of_each_scheme_in_order() {
         let mut st = settings(Scheme::Musl, Damping::Kinetic, true);
         st.0.anti_locking = AntiLocking::StrainSmoothing;
-        let needs = Needs { point_loads: true };
+        let needs = Needs {
+            point_loads: true,
+            undrained: false,
+        };
         assert_eq!(
             default_names(&st.0, &st.1, needs),
             [

@@ -199,9 +199,10 @@ fn an_undrained_oedometer_settles_as_its_element_test() {
     // goes to the water, and the clay settles 2 % of what it settles drained. The engine's
     // strain at each applied (total) vertical stress against the element's where σ′_v + u
     // reaches it. The loaded points' settlement runs 4.0–4.6 % over the element's from
-    // 300 kPa (6 % at 200 kPa): the loaded row carries the pressure as point forces and
-    // its own stress stays near 180 kPa, and at strains of 0.1 % that row's share shows
-    // (drained, at strains of 10 %, it is within 1.6 %; docs/verification.md).
+    // 300 kPa: the loaded row carries the pressure as point forces and its own stress
+    // stays near 180 kPa, and at strains of 0.1 % that row's share shows (drained, at
+    // strains of 10 %, it is within 1.6 %; docs/verification.md). The same clay under a
+    // rigid plate: `an_undrained_oedometer_under_a_plate_holds_one_pore_pressure`.
     let s = run(
         "clay_oedometer.ron",
         &["materials.clay.drainage=Undrained(bulk_modulus: 1.0e8)"],
@@ -224,9 +225,75 @@ fn an_undrained_oedometer_settles_as_its_element_test() {
             );
         }
         if sv == 800e3 {
-            assert!((c.displacement - 6.661732e-3).abs() < 1e-8, "{}", c.displacement);
+            assert!((c.displacement - 6.669698e-3).abs() < 1e-8, "{}", c.displacement);
         }
     }
+}
+
+/// The oedometer's load as a rigid plate under load control instead of a traction.
+const PLATE: [&str; 2] = [
+    "tractions=[]",
+    r#"rigid_bodies=[(name: "plate", parts: [(name: "base", geometry: Polygon(vertices: [[-0.5, 1.0], [1.5, 1.0], [1.5, 1.25], [-0.5, 1.25]]))], interface: Smooth, load: (force: [0.0, -800.0e3], increments: 8), area: 1.0)]"#,
+];
+
+#[test]
+fn an_undrained_oedometer_under_a_plate_holds_one_pore_pressure() {
+    // A smooth rigid plate pressed onto the clay (load control, 100 kPa an increment):
+    // every point of the column carries the same pore pressure and total stress, as the
+    // element does, and the plate settles as the element strains. Each point's own
+    // pressure alternated by ±15 % from row to row before the water's pressure was a cell
+    // field (docs/verification.md).
+    let mut sets = vec!["materials.clay.drainage=Undrained(bulk_modulus: 1.0e8)"];
+    sets.extend(PLATE);
+    let out = crate::common::scratch("cam_clay", "plate");
+    let output = crate::common::run_into(&scene("clay_oedometer.ron"), &out, &sets);
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let vtu = crate::common::read_vtu(&out.join("points.vtu"));
+    let (_, u) = &vtu["excess_pore_pressure"];
+    let (_, stress) = &vtu["stress"];
+    let mean = u.iter().sum::<f64>() / u.len() as f64;
+    for k in 0..u.len() {
+        assert!(
+            rel(u[k], mean).abs() < 1e-3,
+            "point {k}: u {} against {mean}",
+            u[k]
+        );
+        assert!(
+            rel(stress[6 * k + 1], -800e3).abs() < 3e-3,
+            "point {k}: σ_yy {}",
+            stress[6 * k + 1]
+        );
+    }
+    assert!((mean - 686_351.3).abs() < 1.0, "{mean}");
+    let s = run("clay_oedometer.ron", &sets);
+    assert!(s.converged, "{:?}", s.error);
+    let element = oedometer(&undrained_clay(1.0, 1e8), P0, 0.05, 50_000).unwrap();
+    for c in &s.curve {
+        let sv = c.pressure.unwrap();
+        let engine = (1.0_f64 / (1.0 - c.displacement)).ln();
+        let exact = element_strain_at(&element, sv);
+        eprintln!(
+            "{sv}: engine {engine:.6}, element {exact:.6}, {:+.2} %",
+            100.0 * rel(engine, exact)
+        );
+        // The first increment only brings the plate to the clay's own 100 kPa.
+        if sv > 150e3 {
+            assert!(
+                (-0.025..-0.02).contains(&rel(engine, exact)),
+                "{sv} Pa: {engine} against {exact}"
+            );
+        }
+    }
+    let last = s.curve.last().unwrap();
+    assert!(
+        (last.displacement - 6.668691e-3).abs() < 1e-8,
+        "{}",
+        last.displacement
+    );
 }
 
 /// The points.vtu of `scenes/clay_oedometer.ron` run with `sets` into the scratch folder
@@ -242,9 +309,9 @@ fn oedometer_points(name: &str, sets: &[&str]) -> std::collections::BTreeMap<Str
 fn the_clays_state_is_written_with_its_points() {
     // points.vtu carries p′_c, v and u; after the undrained oedometer every point holds
     // water pressure, its stress column is σ′ − u I, and σ′ lies inside its own surface.
-    // The pore pressure alternates layer by layer (the loaded row 80 kPa, the row under
-    // it 988 kPa, the rest 586–721 kPa: nearly incompressible points each keep their own
-    // volume, docs/verification.md); the grid's forces see the mean.
+    // The points of a cell share one pore pressure (`systems/pore_pressure_field.rs`),
+    // but for the loaded row, which keeps its own (80 kPa; the row under it 1 004 kPa, the
+    // cells below 630–697 kPa: the loaded row passes its load as point forces).
     let vtu = oedometer_points("vtu", &["materials.clay.drainage=Undrained(bulk_modulus: 1.0e8)"]);
     let (_, pc) = &vtu["preconsolidation"];
     let (_, v) = &vtu["specific_volume"];
@@ -261,9 +328,12 @@ fn the_clays_state_is_written_with_its_points() {
         );
         assert!(v[k] > 1.8 && v[k] < 1.85, "point {k}: v {}", v[k]);
     }
-    // The run's own figures: the base row and the loaded row.
-    assert!((u[0] - 675.0e3).abs() < 1e3, "{}", u[0]);
+    // The run's own figures: the base row and the loaded row; the base cell's four points
+    // share one value.
+    assert!((u[0] - 685.0e3).abs() < 1e3, "{}", u[0]);
     assert!((u[60] - 80.0e3).abs() < 1e3, "{}", u[60]);
+    let base: Vec<usize> = (0..64).filter(|&k| u[k] == u[0]).collect();
+    assert_eq!(base.len(), 4, "{base:?}");
     // The drained clay's points hold no water.
     let vtu = oedometer_points("vtu-drained", &[]);
     assert!(vtu["excess_pore_pressure"].1.iter().all(|&u| u == 0.0));
