@@ -15,6 +15,7 @@
 //! the soil's at each kinetic-energy peak.
 
 pub mod contact;
+pub mod filter;
 pub mod geometry;
 pub mod mesh;
 pub mod reach;
@@ -22,6 +23,7 @@ pub mod sampling;
 pub mod stl;
 
 pub use contact::Contact;
+pub use filter::FilterSpec;
 pub use geometry::{Geometry, Sample};
 pub use reach::Reach;
 
@@ -51,6 +53,10 @@ pub struct RigidBodySpec {
     /// for the mean pressure in `curve.csv` and `limit_pressure` in summary.json.
     #[serde(default)]
     pub area: Option<f64>,
+    /// Pore-pressure filters on its surface (the piezocone's u2), each read at every
+    /// static state ([`filter`]).
+    #[serde(default)]
+    pub filters: Vec<FilterSpec>,
 }
 
 /// A body's surface samples in its starting frame, each with the index of its part.
@@ -295,6 +301,24 @@ impl RigidBodySpec {
                 i.check()
                     .map_err(|r| Refusal::new(format!("parts[{k}].interface"), r))?;
             }
+        }
+        let (lo, hi) = self.bounds(n);
+        let size = (0..n).map(|a| hi[a] - lo[a]).fold(0.0, f64::max);
+        for (k, f) in self.filters.iter().enumerate() {
+            let taken = self.parts.iter().any(|p| p.name == f.name)
+                || self.filters[..k].iter().any(|o| o.name == f.name);
+            if taken {
+                return bad(
+                    &format!("filters[{k}].name"),
+                    format!(
+                        "\"{}\" is already the name of a part or a filter of the body: its row of \
+                         curve.csv needs its own",
+                        f.name
+                    ),
+                );
+            }
+            f.check(n, |x| self.distance(x, n).0, size)
+                .map_err(|r| r.under(&format!("filters[{k}]")))?;
         }
         self.check_interface_and_motion(n, axisymmetric)
     }

@@ -454,7 +454,7 @@ fn initial_state(s: &Scene) -> SolverState {
 }
 
 /// Each rigid body as `kdmpm check` prints it: name, parts, its contact samples, control
-/// and travel.
+/// and travel, and its filters.
 fn describe_bodies(bodies: &[RigidBody]) -> Vec<String> {
     bodies
         .iter()
@@ -470,8 +470,12 @@ fn describe_bodies(bodies: &[RigidBody]) -> Vec<String> {
                 (_, Some(l)) => format!("under a load of {:?} N in {} increment(s)", l.force, l.increments),
                 _ => "holds its place".into(),
             };
+            let filters = match b.filters.len() {
+                0 => String::new(),
+                k => format!(", {k} pore-pressure filter(s)"),
+            };
             format!(
-                "\"{}\": {} part(s), {samples} contact samples, {:?} interface, {control}",
+                "\"{}\": {} part(s), {samples} contact samples, {:?} interface, {control}{filters}",
                 b.name,
                 b.parts.len(),
                 b.interface

@@ -32,12 +32,13 @@
 //! on the surface along the normal. The count and the deepest entry are kept
 //! ([`crate::rigid::BodyState::entries`]).
 
-use crate::components::{Displacement, Position};
+use crate::components::{Displacement, MaterialId, Position, Volume};
 use crate::context::Context;
 use crate::dim::Dim;
 use crate::error::StepError;
 use crate::grid::Grid;
-use crate::infra::columns::{col_mut, points_with};
+use crate::infra::columns::{col, col_mut, points_with};
+use crate::materials::{visit_states, MaterialState, StateVisitor};
 use crate::model::CurvePoint;
 use crate::model::LoadStage;
 use crate::rigid::{BodyLoad, BodyState, RigidBodySpec};
@@ -221,9 +222,22 @@ impl<D: Dim> System<D> for RigidControl {
         if s.stop != Some(StopReason::Converged) && !s.control.milestone {
             return Ok(());
         }
-        // Every body holds (a moving one blocks convergence): a static state.
+        // Every body holds (a moving one blocks convergence): a static state. Its filters'
+        // readings first, every rank taking part in each.
+        let readings: Vec<Vec<Option<f64>>> = (self.bodies.iter().zip(&ctx.state.control.bodies))
+            .map(|(spec, b)| {
+                (spec.filters.iter())
+                    .map(|f| {
+                        let x = std::array::from_fn(|a| f.at.get(a).copied().unwrap_or(0.0) + b.offset[a]);
+                        filter_reading(ctx, x)
+                    })
+                    .collect()
+            })
+            .collect();
+        let s = &mut ctx.state;
         let mut more = false;
-        for ((spec, b), &first) in self.bodies.iter().zip(&mut s.control.bodies).zip(&self.first) {
+        let bodies = self.bodies.iter().zip(&mut s.control.bodies).zip(&self.first);
+        for (((spec, b), &first), readings) in bodies.zip(&readings) {
             // The mean pressure along the motion, or, for a body that holds its place, of
             // the whole force.
             let along = |f: [f64; 3]| -> f64 {
@@ -253,6 +267,16 @@ impl<D: Dim> System<D> for RigidControl {
                     });
                 }
             }
+            for (filter, &u) in spec.filters.iter().zip(readings) {
+                s.control.curve.push(CurvePoint {
+                    name: format!("{}.{}", spec.name, filter.name),
+                    step: s.clock.step,
+                    time: s.clock.time,
+                    displacement: b.travel,
+                    force: [0.0; 3],
+                    pressure: u,
+                });
+            }
             if !driven(first, s.control.stage) || b.increments >= spec.increments() {
                 continue;
             }
@@ -275,5 +299,77 @@ impl<D: Dim> System<D> for RigidControl {
             s.go_on(&ctx.numerics);
         }
         Ok(())
+    }
+}
+
+/// The pore pressure (Pa, compression positive) a filter at `x` (m, x y z) reads: the
+/// volume-weighted mean over the points within one cell of it of their water table's
+/// pressure and the excess an undrained material holds ([`crate::rigid::filter`]); `None`
+/// when no point lies that near. Over MPI ranks the sums of every rank.
+fn filter_reading<D: Dim>(ctx: &Context<D>, x: [f64; 3]) -> Option<f64> {
+    let mut sums = [0.0; 2];
+    for arch in points_with::<Volume>(&ctx.world) {
+        let mut read = Reading::<D> {
+            arch,
+            ctx,
+            x,
+            sums: [0.0; 2],
+            done: false,
+        };
+        visit_states(&mut read);
+        if !read.done {
+            read.add::<()>(None);
+        }
+        sums[0] += read.sums[0];
+        sums[1] += read.sums[1];
+    }
+    ctx.comm.sum(&mut sums);
+    (sums[1] > 0.0).then(|| sums[0] / sums[1])
+}
+
+/// One archetype's share of a filter's reading, with the state column it carries.
+struct Reading<'a, D: Dim> {
+    arch: &'a hecs::Archetype,
+    ctx: &'a Context<D>,
+    x: [f64; 3],
+    /// Σ V u, Σ V.
+    sums: [f64; 2],
+    done: bool,
+}
+
+impl<D: Dim> StateVisitor for Reading<'_, D> {
+    fn visit<T: MaterialState>(&mut self) {
+        if self.done || std::mem::size_of::<T>() == 0 {
+            return;
+        }
+        if let Some(states) = self.arch.get::<&T>() {
+            self.add(Some(&states));
+            self.done = true;
+        }
+    }
+}
+
+impl<D: Dim> Reading<'_, D> {
+    /// Adds the archetype's points within a cell of the filter; `states` their state column,
+    /// `None` for points without state (no excess pore pressure).
+    fn add<T: MaterialState>(&mut self, states: Option<&[T]>) {
+        let (xg, vg, mg) = (
+            col::<Position<D::Vec>>(self.arch),
+            col::<Volume>(self.arch),
+            col::<MaterialId>(self.arch),
+        );
+        let r2 = self.ctx.grid.cell_size * self.ctx.grid.cell_size;
+        let water = self.ctx.model.water.as_ref();
+        for p in 0..xg.len() {
+            let xp = D::vec_to3(xg[p].0);
+            let d2: f64 = (0..3).map(|a| (xp[a] - self.x[a]).powi(2)).sum();
+            if d2 > r2 {
+                continue;
+            }
+            let hydrostatic = water.map_or(0.0, |w| w.pore_pressure(mg[p].0, xp));
+            let excess = states.map_or(0.0, |s| s[p].excess_pore_pressure());
+            self.sums[0] += vg[p].0 * (hydrostatic + excess);
+            self.sums[1] += vg[p].0;
+        }
     }
 }

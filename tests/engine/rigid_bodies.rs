@@ -792,3 +792,67 @@ fn an_increment_shorter_than_one_steps_travel_is_refused() {
         "{e}"
     );
 }
+
+#[test]
+fn a_filter_off_the_bodys_surface_is_refused() {
+    let e = refused(
+        "interface: Smooth,",
+        "interface: Smooth, filters: [(name: \"u2\", at: [0.25, 1.25])],",
+    );
+    assert!(
+        e.contains("rigid_bodies[0].filters[0].at") && e.contains("on the body's surface"),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_filter_named_as_a_part_is_refused() {
+    let e = refused(
+        "interface: Smooth,",
+        "interface: Smooth, filters: [(name: \"base\", at: [0.5, 1.25])],",
+    );
+    assert!(e.contains("rigid_bodies[0].filters[0].name"), "{e}");
+}
+
+/// A wall held in a saturated sand whose water table is its top: a filter on the wall's
+/// face 2 m down reads the hydrostatic pressure of the points within a cell of it, which lie
+/// evenly above and below it: γ_w (2 m + s) with s the sand's settlement there under its
+/// buoyant weight, γ′ (4 · 2 − 2²/2) m²/M′ = 2.19 mm (γ′ = 9.81 kN/m³, M′ = 26.9 MPa):
+/// 19.641 kPa, as the row `wall.filter` of the curve.
+#[test]
+fn a_filter_on_a_held_wall_reads_the_hydrostatic_pore_pressure() {
+    let scene = r#"Scene(
+    dimension: 2,
+    grid: (origin: [0.0, 0.0], cell_size: 0.25, cells: [16, 18]),
+    shape: QuadraticBSpline,
+    materials: {
+        "sand": MohrCoulomb(density: 1800.0, youngs_modulus: 2.0e7, poisson_ratio: 0.3,
+            cohesion: 0.0, friction_angle: 30.0),
+    },
+    bodies: [(material: "sand", region: Box(min: [1.0, 0.0], max: [4.0, 4.0]), points_per_cell: [2, 2])],
+    boundaries: [
+        (face: XMin, condition: Roller),
+        (face: XMax, condition: Roller),
+        (face: YMin, condition: Roller),
+    ],
+    gravity: (acceleration: [0.0, -9.81]),
+    water: (table: Level(4.0), saturated_density: {"sand": 2000.0}),
+    rigid_bodies: [
+        (
+            name: "wall",
+            parts: [(name: "stem", geometry: Polygon(vertices: [[0.5, 0.0], [1.0, 0.0], [1.0, 4.5], [0.5, 4.5]]))],
+            interface: Smooth,
+            filters: [(name: "filter", at: [1.0, 2.0])],
+        ),
+    ],
+    solver: (damping: Kinetic, time_step: Courant(0.5), tolerance: 1e-3, max_time: 10.0),
+)"#;
+    let s = common::run_text("filter", scene);
+    assert!(s.converged, "{:?}", s.error);
+    let rows: Vec<_> = s.curve.iter().filter(|c| c.name == "wall.filter").collect();
+    assert_eq!(rows.len(), 1);
+    let u = rows[0].pressure.expect("a reading");
+    eprintln!("u = {u} Pa");
+    assert_eq!(rows[0].force, [0.0; 3]);
+    assert!((u - 19_641.36).abs() < 0.01, "{u}");
+}
