@@ -402,3 +402,35 @@ fn a_smooth_ball_on_the_axis_has_the_flow_round_factor() {
     let ball = &s.rigid_bodies[0];
     assert!(ball.deepest_entry < 0.1 * 0.125, "{ball:?}");
 }
+
+/// `scenes/cptu_clay.ron` on a smaller block (2.5 m wide, 4 m deep, its grid with it) over
+/// its first D/4: the piezocone's three readings come from their rows of the curve: q_t
+/// from the tip, f_s from the sleeve, u2 from the filter at the shoulder, u2 the clay's
+/// excess pore pressure near the shoulder (no water table). Pinned at this run's figures;
+/// the full scene's are in docs/verification.md ("The piezocone in Cam Clay").
+#[test]
+fn a_piezocone_in_undrained_cam_clay_reads_tip_sleeve_and_u2() {
+    let s = run(
+        "cptu_clay.ron",
+        &[
+            "grid.origin=[0.0, 10.0]",
+            "grid.cells=[10, 64]",
+            "bodies[0].region=Box(min: [0.0, 10.0], max: [2.5, 14.0])",
+            "rigid_bodies[0].motion.travel=0.25",
+        ],
+    );
+    assert!(s.converged, "{:?}", s.error);
+    let reading = |name: &str| {
+        let rows: Vec<&CurvePoint> = s.curve.iter().filter(|c| c.name == name).collect();
+        assert_eq!(rows.len(), 1, "{name}");
+        rows[0].pressure.expect("a pressure")
+    };
+    let (qt, fs, u2) = (reading("cone.tip"), reading("cone.sleeve"), reading("cone.u2"));
+    eprintln!("q_t {qt}, f_s {fs}, u2 {u2}, B_q {}", u2 / (qt - 100e3));
+    assert!((qt - 301_738.75).abs() < 0.01, "{qt}");
+    assert!((fs - 558.31).abs() < 0.01, "{fs}");
+    assert!((u2 - 109_221.43).abs() < 0.01, "{u2}");
+    // The filter's row carries no force.
+    let filter = s.curve.iter().find(|c| c.name == "cone.u2").unwrap();
+    assert_eq!(filter.force, [0.0; 3]);
+}
