@@ -818,7 +818,7 @@ fn a_filter_named_as_a_part_is_refused() {
 /// face 2 m down reads the hydrostatic pressure of the points within a cell of it, which lie
 /// evenly above and below it: γ_w (2 m + s) with s the sand's settlement there under its
 /// buoyant weight, γ′ (4 · 2 − 2²/2) m²/M′ = 2.19 mm (γ′ = 9.81 kN/m³, M′ = 26.9 MPa):
-/// 19.641 kPa, as the row `wall.filter` of the curve.
+/// 19.641 kPa, as the row `wall.filter` of the curve; a filter above the sand reads none.
 #[test]
 fn a_filter_on_a_held_wall_reads_the_hydrostatic_pore_pressure() {
     let scene = r#"Scene(
@@ -842,7 +842,7 @@ fn a_filter_on_a_held_wall_reads_the_hydrostatic_pore_pressure() {
             name: "wall",
             parts: [(name: "stem", geometry: Polygon(vertices: [[0.5, 0.0], [1.0, 0.0], [1.0, 4.5], [0.5, 4.5]]))],
             interface: Smooth,
-            filters: [(name: "filter", at: [1.0, 2.0])],
+            filters: [(name: "filter", at: [1.0, 2.0]), (name: "dry", at: [1.0, 4.5])],
         ),
     ],
     solver: (damping: Kinetic, time_step: Courant(0.5), tolerance: 1e-3, max_time: 10.0),
@@ -855,4 +855,8 @@ fn a_filter_on_a_held_wall_reads_the_hydrostatic_pore_pressure() {
     eprintln!("u = {u} Pa");
     assert_eq!(rows[0].force, [0.0; 3]);
     assert!((u - 19_641.36).abs() < 0.01, "{u}");
+    // A filter with no soil within a cell of it (half a metre over the sand) reads nothing.
+    let dry: Vec<_> = s.curve.iter().filter(|c| c.name == "wall.dry").collect();
+    assert_eq!(dry.len(), 1);
+    assert_eq!(dry[0].pressure, None);
 }
