@@ -202,8 +202,14 @@ impl Summary {
     /// share of each system, in schedule order.
     pub fn profile_table(&self) -> String {
         let total: f64 = self.systems.iter().map(|t| t.seconds).sum();
+        // The name column as wide as the longest name (`volumetric_smoothing`: 20).
+        let w = self
+            .systems
+            .iter()
+            .map(|t| t.name.chars().count())
+            .fold(18, usize::max);
         let mut text = format!(
-            "{:<18} {:>10} {:>12} {:>12} {:>7}\n",
+            "{:<w$} {:>10} {:>12} {:>12} {:>7}\n",
             "system", "calls", "total (s)", "mean (µs)", "share"
         );
         for t in &self.systems {
@@ -218,7 +224,7 @@ impl Summary {
                 0.0
             };
             text += &format!(
-                "{:<18} {:>10} {:>12.4} {:>12.2} {:>6.1}%\n",
+                "{:<w$} {:>10} {:>12.4} {:>12.2} {:>6.1}%\n",
                 t.name, t.calls, t.seconds, mean, share
             );
         }
