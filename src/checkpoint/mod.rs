@@ -37,7 +37,7 @@ use thiserror::Error;
 /// The first bytes of a checkpoint file.
 const MAGIC: &[u8; 8] = b"KDMPMCK\0";
 /// Format version; a file of another version is refused.
-const VERSION: u32 = 13;
+const VERSION: u32 = 14;
 /// The build that writes and reads checkpoints: the crate's version and a fingerprint of
 /// its sources (build.rs).
 pub const BUILD_ID: &str = concat!(env!("CARGO_PKG_VERSION"), "+", env!("KDMPM_SOURCE_HASH"));
@@ -627,6 +627,7 @@ fn encode_control(w: &mut Writer, c: &Control) {
             parts,
             entries,
             deepest_entry,
+            in_situ,
         } = b;
         w.str(name);
         velocity
@@ -641,6 +642,14 @@ fn encode_control(w: &mut Writer, c: &Control) {
         parts.iter().flatten().for_each(|&c| w.f64(c));
         w.u64(*entries);
         w.f64(*deepest_entry);
+        // A piezocone's ground: its slices after a flag (0 before its push began).
+        w.u8(in_situ.is_some() as u8);
+        if let Some(g) = in_situ {
+            w.f64(g.width);
+            w.f64(g.start);
+            w.u64(g.slices.len() as u64);
+            g.slices.iter().flatten().for_each(|&c| w.f64(c));
+        }
     }
     w.u64(contact_memory.len() as u64);
     for &(k, lambda) in contact_memory {
@@ -718,6 +727,17 @@ fn decode_control(r: &mut Reader) -> Result<Control, CheckpointError> {
             },
             entries: r.u64()?,
             deepest_entry: r.f64()?,
+            in_situ: match r.u8()? {
+                0 => None,
+                _ => {
+                    let (width, start) = (r.f64()?, r.f64()?);
+                    let mut slices = Vec::new();
+                    for _ in 0..r.u64()? {
+                        slices.push([r.f64()?, r.f64()?, r.f64()?, r.f64()?, r.f64()?]);
+                    }
+                    Some(crate::rigid::InSitu { width, start, slices })
+                }
+            },
         });
     }
     for _ in 0..r.u64()? {
@@ -908,6 +928,36 @@ mod tests {
     use crate::components::*;
     use crate::dim::{Dim, Dim2, Dim3};
     use std::mem::size_of;
+
+    /// A body's state round-trips with its piezocone's ground and without one.
+    #[test]
+    fn a_bodys_state_with_its_ground_reads_back_as_written() {
+        use crate::model::Control;
+        use crate::rigid::{BodyState, InSitu};
+        let mut ground = InSitu::new(0.25, -14.0, -10.0);
+        ground.add(-13.9, 0.5, 100e3, 3e3, Some(25e3));
+        let control = Control {
+            bodies: vec![
+                BodyState {
+                    name: "cone".into(),
+                    travel: 0.5,
+                    parts: vec![[1.0, 2.0, 0.0]],
+                    in_situ: Some(ground),
+                    ..BodyState::default()
+                },
+                BodyState {
+                    name: "wall".into(),
+                    ..BodyState::default()
+                },
+            ],
+            ..Control::default()
+        };
+        let mut w = super::Writer(Vec::new());
+        super::encode_control(&mut w, &control);
+        let mut r = super::Reader::new(&w.0, std::path::Path::new("test"));
+        assert_eq!(super::decode_control(&mut r).expect("reads"), control);
+        assert_eq!(r.at, w.0.len(), "every byte read");
+    }
 
     /// Checkpoints copy point columns byte for byte: no component may hold padding, whose
     /// bytes are uninitialised. Each size must equal the sum of its fields' sizes.

@@ -112,6 +112,12 @@ pub trait Material: Send + Sync {
     fn holds_water(&self) -> bool {
         false
     }
+    /// The undrained shear strength s_u (Pa) of a point at `stress` (Pa, the point's stress
+    /// column) and `state`: what a penetrometer's N_kt divides by (`rigid/cpt.rs`). `None`
+    /// for a model without one (an elastic or frictional soil).
+    fn undrained_strength(&self, _stress: &Sym3, _state: &Self::State) -> Option<f64> {
+        None
+    }
 }
 
 /// A material as a scene gives it: the serde struct is its schema.
@@ -366,6 +372,17 @@ macro_rules! define_materials {
                     $(MaterialModel::$variant(m) => match same_type(&mut own) {
                         Some(own) => m.admits(stress, own),
                         None => m.admits(stress, &stateless::<<$spec as SceneMaterial>::Model>()),
+                    },)*
+                }
+            }
+
+            /// [`Material::undrained_strength`] of a point whose state column is of type `S`.
+            pub fn undrained_strength<S: MaterialState>(&self, stress: &Sym3, state: &S) -> Option<f64> {
+                let mut own = *state;
+                match self {
+                    $(MaterialModel::$variant(m) => match same_type(&mut own) {
+                        Some(own) => m.undrained_strength(stress, own),
+                        None => m.undrained_strength(stress, &stateless::<<$spec as SceneMaterial>::Model>()),
                     },)*
                 }
             }

@@ -491,6 +491,21 @@ impl Material for ModifiedCamClay {
     fn holds_water(&self) -> bool {
         self.fluid_bulk > 0.0
     }
+    /// The strength of undrained triaxial compression from the point's state: its volume
+    /// stays v, so it ends on the critical state line at p′_f = exp((Γ − v)/λ) (kPa, Γ =
+    /// N − (λ − κ) ln 2) with q_f = M p′_f, and s_u = q_f/2 = (M/2) p′_f whatever the path
+    /// (Wood 1990, §7.4; from an isotropic p′₀ and R₀ = p′_c/p′₀ this is
+    /// (M/2) p′₀ (R₀/2)^Λ). A point not yet updated takes the state its stress gives it.
+    fn undrained_strength(&self, stress: &Sym3, state: &CamClayState) -> Option<f64> {
+        let state = if state.preconsolidation == 0.0 {
+            self.initial_state(&(*stress + Sym3::IDENTITY * state.excess_pore_pressure))
+        } else {
+            *state
+        };
+        let gamma = self.ncl_volume - (self.lambda - self.kappa) * std::f64::consts::LN_2;
+        let p_f = REFERENCE_PRESSURE * ((gamma - state.specific_volume) / self.lambda).exp();
+        Some(0.5 * self.m * p_f)
+    }
 }
 
 #[cfg(test)]
@@ -529,6 +544,26 @@ mod tests {
             "it hardens: {}",
             state.preconsolidation
         );
+    }
+
+    #[test]
+    fn the_undrained_strength_is_wood_s_closed_form_from_any_start() {
+        // s_u/p′₀ = (M/2)(R₀/2)^Λ, Λ = 0.8 (Wood 1990, §7.4), before and after a first
+        // update that leaves the point elastic.
+        for r in [1.0, 2.0, 4.0, 8.0] {
+            let m = clay(Preconsolidation::Ratio(r));
+            let mut stress = Sym3::diagonal(-100e3, -100e3, -100e3);
+            let mut state = CamClayState::default();
+            let closed = 0.45 * 100e3 * (r / 2.0f64).powf(0.8);
+            let before = m.undrained_strength(&stress, &state).unwrap();
+            assert!(
+                (before / closed - 1.0).abs() < 1e-12,
+                "R₀ {r}: {before} vs {closed}"
+            );
+            m.update(&mut stress, &Sym3::diagonal(1e-6, -1e-6, 0.0), &mut state);
+            let after = m.undrained_strength(&stress, &state).unwrap();
+            assert!((after / closed - 1.0).abs() < 1e-9, "R₀ {r}: {after} vs {closed}");
+        }
     }
 
     #[test]

@@ -438,6 +438,10 @@ impl Material for MohrCoulomb {
     fn density(&self) -> f64 {
         self.density
     }
+    /// Tresca (φ = 0): c, whatever the stress. A frictional soil has none.
+    fn undrained_strength(&self, _: &Sym3, _: &PlasticStrain) -> Option<f64> {
+        (self.friction == 0.0).then_some(self.cohesion)
+    }
     fn p_wave_modulus(&self) -> f64 {
         self.elasticity.p_wave()
     }

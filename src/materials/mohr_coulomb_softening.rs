@@ -205,6 +205,12 @@ impl Material for MohrCoulombSoftening {
     fn admits(&self, stress: &Sym3, state: &SofteningStrain) -> bool {
         self.with_strength(state.0, |mc| mc.admits(stress, &PlasticStrain(state.0)))
     }
+    /// Tresca at the point's softened strength (c at κ when φ there is 0).
+    fn undrained_strength(&self, stress: &Sym3, state: &SofteningStrain) -> Option<f64> {
+        self.with_strength(state.0, |mc| {
+            mc.undrained_strength(stress, &PlasticStrain(state.0))
+        })
+    }
     #[inline(always)]
     fn update(&self, stress: &mut Sym3, de: &Sym3, state: &mut SofteningStrain) {
         self.with_strength(state.0, |mc| {

@@ -20,6 +20,9 @@ pub const FILES: [&str; 4] = [
 /// The load–displacement plot, drawn when the run wrote `curve.csv`.
 pub const CURVE_PLOT: &str = "curve.svg";
 
+/// A piezocone's log drawn as a CPT log, when the run wrote `cpt.csv`.
+pub const CPT_PLOT: &str = "cpt.svg";
+
 /// `history.csv` as columns of numbers (an empty cell, or `undefined` in the files of
 /// earlier versions, is NaN here, and
 /// left out of every plot).
@@ -193,7 +196,80 @@ pub fn draw(dir: &Path) -> std::io::Result<(Vec<&'static str>, Vec<String>)> {
             written.push(CURVE_PLOT);
         }
     }
+    if let Ok(log) = History::read(&dir.join(crate::output::recorder::CPT)) {
+        if let Some(svg) = cpt_log(&log) {
+            save(CPT_PLOT, svg)?;
+            written.push(CPT_PLOT);
+        }
+    }
     Ok((written, skipped))
+}
+
+/// The piezocone's three readings against depth, as a CPT log is read: q_t, f_s, and u2
+/// with the hydrostatic u0, side by side, depth down; `None` without a row.
+fn cpt_log(log: &History) -> Option<String> {
+    let depth = log.column("depth")?;
+    if depth.iter().all(|d| !d.is_finite()) {
+        return None;
+    }
+    let kpa = |name: &str| {
+        log.column(name)
+            .map(|c| c.iter().map(|v| v / 1e3).collect::<Vec<f64>>())
+    };
+    // Each panel: its axis label and its series (values in kPa, name).
+    type Series = (Vec<f64>, &'static str);
+    let panels: [(&str, Vec<Series>); 3] = [
+        ("q_t (kPa)", vec![(kpa("q_t")?, "q_t")]),
+        ("f_s (kPa)", vec![(kpa("f_s")?, "f_s")]),
+        ("u (kPa)", vec![(kpa("u2")?, "u2"), (kpa("u0")?, "u0")]),
+    ];
+    let deepest = depth
+        .iter()
+        .copied()
+        .filter(|d| d.is_finite())
+        .fold(0.0f64, f64::max);
+    Some(svg((1200, 700), |root| {
+        let root = root.titled("Piezocone log (static states)", ("sans-serif", 22))?;
+        for (area, (label, series)) in root.split_evenly((1, 3)).iter().zip(&panels) {
+            let (lo, hi) = (series.iter().flat_map(|s| s.0.iter()))
+                .filter(|v| v.is_finite())
+                .fold((0.0f64, 0.0f64), |(a, b), &v| (a.min(v), b.max(v)));
+            let pad = 0.05 * (hi - lo).max(1e-30);
+            let mut c = ChartBuilder::on(area)
+                .margin(15)
+                .x_label_area_size(45)
+                .y_label_area_size(60)
+                .build_cartesian_2d((lo - pad)..(hi + pad), (deepest * 1.05).max(1e-30)..0.0)?;
+            // Five labels, with a decimal where the panel spans less than 20 kPa.
+            let decimals = if hi - lo < 20.0 { 1 } else { 0 };
+            c.configure_mesh()
+                .x_labels(5)
+                .x_label_formatter(&|v| format!("{v:.decimals$}"))
+                .x_desc(*label)
+                .y_desc("depth of the apex (m)")
+                .label_style(("sans-serif", 15))
+                .draw()?;
+            for (k, (values, name)) in series.iter().enumerate() {
+                let colour = Palette99::pick(k).to_rgba();
+                let pts: Vec<(f64, f64)> = (values.iter().zip(&depth))
+                    .filter(|(v, d)| v.is_finite() && d.is_finite())
+                    .map(|(v, d)| (*v, *d))
+                    .collect();
+                c.draw_series(LineSeries::new(pts.clone(), colour.stroke_width(2)))?
+                    .label(*name)
+                    .legend(move |(x, y)| {
+                        PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
+                    });
+                c.draw_series(pts.into_iter().map(|p| Circle::new(p, 3, colour.filled())))?;
+            }
+            c.configure_series_labels()
+                .border_style(BLACK)
+                .background_style(WHITE.mix(0.9))
+                .label_font(("sans-serif", 14))
+                .draw()?;
+        }
+        Ok(())
+    }))
 }
 
 /// Each motion's static states: pressure (or force) against displacement.

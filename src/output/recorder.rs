@@ -49,6 +49,9 @@ fn curve_csv<D: Dim>(curve: &[CurvePoint]) -> String {
     t
 }
 
+/// A piezocone's log ([`crate::rigid::cpt`]).
+pub const CPT: &str = "cpt.csv";
+
 /// The loading stages' file.
 pub const STAGES: &str = "stages.csv";
 
@@ -99,8 +102,10 @@ fn clear_earlier_results(dir: &OutputDir) -> std::io::Result<()> {
         "points.vtu",
         "points.pvtu",
         CURVE,
+        CPT,
         STAGES,
         crate::output::plots::CURVE_PLOT,
+        crate::output::plots::CPT_PLOT,
     ];
     let names = fixed.iter().chain(&crate::output::plots::FILES);
     for name in names {
@@ -204,6 +209,17 @@ impl Recorder {
             dir.write_atomic(CURVE, |out| {
                 out.write_all(curve_csv::<D>(&sim.ctx.state.control.curve).as_bytes())
             })?;
+        }
+        let control = &sim.ctx.state.control;
+        for (body, b) in sim.ctx.model.bodies.iter().zip(&control.bodies) {
+            // One piezocone a run (`scene::validate` refuses a second).
+            if let (Some(cpt), Some(ground)) = (&body.cpt, &b.in_situ) {
+                let rows = crate::rigid::cpt::log(&body.spec, cpt, ground, &control.curve, D::N);
+                dir.write_atomic(CPT, |out| {
+                    out.write_all(crate::rigid::cpt::log_csv(&rows).as_bytes())
+                })?;
+                break;
+            }
         }
         // After the output, so that the peak memory covers the whole run.
         let mut summary = Summary::collect(scene, sim, wall_seconds, error);

@@ -15,6 +15,7 @@
 //! the soil's at each kinetic-energy peak.
 
 pub mod contact;
+pub mod cpt;
 pub mod filter;
 pub mod geometry;
 pub mod mesh;
@@ -23,6 +24,7 @@ pub mod sampling;
 pub mod stl;
 
 pub use contact::Contact;
+pub use cpt::{Cpt, CptSpec, InSitu};
 pub use filter::FilterSpec;
 pub use geometry::{Geometry, Sample};
 pub use reach::Reach;
@@ -57,6 +59,10 @@ pub struct RigidBodySpec {
     /// static state ([`filter`]).
     #[serde(default)]
     pub filters: Vec<FilterSpec>,
+    /// The body read as a piezocone: its tip, sleeve and u2 filter by name, logged against
+    /// the ground it enters in `cpt.csv` ([`cpt`]).
+    #[serde(default)]
+    pub cpt: Option<CptSpec>,
 }
 
 /// A body's surface samples in its starting frame, each with the index of its part.
@@ -75,6 +81,8 @@ pub struct RigidBody {
     pub samples: Samples,
     /// Per part: (tan δ, adhesion a in Pa) of its interface ([`Interface::friction`]).
     pub interfaces: Vec<(f64, f64)>,
+    /// Its piezocone readings, checked ([`CptSpec::check`]).
+    pub cpt: Option<Cpt>,
 }
 
 impl RigidBody {
@@ -83,10 +91,15 @@ impl RigidBody {
         let interfaces = (0..spec.parts.len())
             .map(|k| spec.interface_of(k).friction())
             .collect();
+        let cpt = (spec.cpt.as_ref()).map(|c| {
+            c.check(&spec)
+                .expect("a scene's bodies are checked before set-up")
+        });
         RigidBody {
             spec,
             samples,
             interfaces,
+            cpt,
         }
     }
 }
@@ -319,6 +332,9 @@ impl RigidBodySpec {
             }
             f.check(n, |x| self.distance(x, n).0, size)
                 .map_err(|r| r.under(&format!("filters[{k}]")))?;
+        }
+        if let Some(c) = &self.cpt {
+            c.check(self).map_err(|r| r.under("cpt"))?;
         }
         self.check_interface_and_motion(n, axisymmetric)
     }
@@ -647,4 +663,7 @@ pub struct BodyState {
     pub entries: u64,
     /// The deepest such entry (m).
     pub deepest_entry: f64,
+    /// For a body read as a piezocone, the ground as it was the step its push began
+    /// (`systems/rigid_control.rs`); `None` before.
+    pub in_situ: Option<InSitu>,
 }

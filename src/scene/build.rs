@@ -474,8 +474,15 @@ fn describe_bodies(bodies: &[RigidBody]) -> Vec<String> {
                 0 => String::new(),
                 k => format!(", {k} pore-pressure filter(s)"),
             };
+            let cpt = match &b.cpt {
+                Some(c) => format!(
+                    ", logged as a piezocone (tip {:?}, sleeve {:?}, u2 {:?}) in cpt.csv",
+                    c.tip, c.sleeve, c.u2
+                ),
+                None => String::new(),
+            };
             format!(
-                "\"{}\": {} part(s), {samples} contact samples, {:?} interface, {control}{filters}",
+                "\"{}\": {} part(s), {samples} contact samples, {:?} interface, {control}{filters}{cpt}",
                 b.name,
                 b.parts.len(),
                 b.interface

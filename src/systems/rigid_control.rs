@@ -32,7 +32,7 @@
 //! on the surface along the normal. The count and the deepest entry are kept
 //! ([`crate::rigid::BodyState::entries`]).
 
-use crate::components::{Displacement, MaterialId, Position, Volume};
+use crate::components::{Displacement, MaterialId, Position, Stress, Volume};
 use crate::context::Context;
 use crate::dim::Dim;
 use crate::error::StepError;
@@ -41,11 +41,12 @@ use crate::infra::columns::{col, col_mut, points_with};
 use crate::materials::{visit_states, MaterialState, StateVisitor};
 use crate::model::CurvePoint;
 use crate::model::LoadStage;
-use crate::rigid::{BodyLoad, BodyState, RigidBodySpec};
+use crate::rigid::{BodyLoad, BodyState, InSitu, RigidBodySpec};
 use crate::schedule::System;
 use crate::state::StopReason;
 use crate::state::{Numerics, SolverState};
 use crate::systems::increments::Increments;
+use crate::tensor::StoredSym;
 
 /// Moves the bodies, holds them at the end of an increment and, at the static state that
 /// follows, records the curve and starts the next increment.
@@ -186,6 +187,16 @@ impl<D: Dim> System<D> for RigidControl {
     }
 
     fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
+        // A piezocone's ground, the step its push begins, before it has moved.
+        for (k, spec) in self.bodies.iter().enumerate() {
+            let b = &ctx.state.control.bodies[k];
+            if let (Some(m), Some(_), None, 0.0) = (&spec.motion, &spec.cpt, &b.in_situ, b.travel) {
+                if b.velocity != [0.0; 3] {
+                    let unit = m.vector().map(|c| c / m.speed());
+                    ctx.state.control.bodies[k].in_situ = Some(in_situ(ctx, unit));
+                }
+            }
+        }
         let s = &mut ctx.state;
         let dt = s.resets.motion_dt(ctx.numerics.dt).unwrap_or(0.0);
         for (spec, b) in self.bodies.iter().zip(&mut s.control.bodies) {
@@ -370,6 +381,102 @@ impl<D: Dim> Reading<'_, D> {
             let excess = states.map_or(0.0, |s| s[p].excess_pore_pressure());
             self.sums[0] += vg[p].0 * (hydrostatic + excess);
             self.sums[1] += vg[p].0;
+        }
+    }
+}
+
+/// The ground as it stands now, in slices one cell thick across the direction `unit` (x y
+/// z), from the first point's to the last's ([`InSitu`]); over MPI ranks every rank's
+/// points, the slices' ends agreed first.
+fn in_situ<D: Dim>(ctx: &Context<D>, unit: [f64; 3]) -> InSitu {
+    let along = |x: D::Vec| -> f64 {
+        let x = D::vec_to3(x);
+        (0..3).map(|a| x[a] * unit[a]).sum()
+    };
+    // Both ends as largest values: the first point's as −s.
+    let mut ends = [f64::NEG_INFINITY; 2];
+    for arch in points_with::<Volume>(&ctx.world) {
+        for x in col::<Position<D::Vec>>(arch).iter() {
+            let s = along(x.0);
+            ends = [ends[0].max(-s), ends[1].max(s)];
+        }
+    }
+    ctx.comm.max(&mut ends);
+    let h = ctx.grid.cell_size;
+    if !(ends[0].is_finite() && ends[1].is_finite()) {
+        return InSitu::new(h, 0.0, 0.0);
+    }
+    let mut ground = InSitu::new(h, (-ends[0] / h).floor() * h, ends[1]);
+    for arch in points_with::<Volume>(&ctx.world) {
+        let mut slicer = Slicer::<D> {
+            arch,
+            ctx,
+            unit,
+            ground: &mut ground,
+            done: false,
+        };
+        visit_states(&mut slicer);
+        if !slicer.done {
+            slicer.add::<()>(None);
+        }
+    }
+    let mut flat: Vec<f64> = ground.slices.iter().flatten().copied().collect();
+    ctx.comm.sum(&mut flat);
+    for (slice, sums) in ground.slices.iter_mut().zip(flat.chunks_exact(5)) {
+        slice.copy_from_slice(sums);
+    }
+    ground
+}
+
+/// One archetype's points added to the ground's slices, with the state column it carries.
+struct Slicer<'a, D: Dim> {
+    arch: &'a hecs::Archetype,
+    ctx: &'a Context<D>,
+    unit: [f64; 3],
+    ground: &'a mut InSitu,
+    done: bool,
+}
+
+impl<D: Dim> StateVisitor for Slicer<'_, D> {
+    fn visit<T: MaterialState>(&mut self) {
+        if self.done || std::mem::size_of::<T>() == 0 {
+            return;
+        }
+        if let Some(states) = self.arch.get::<&T>() {
+            self.add(Some(&states));
+            self.done = true;
+        }
+    }
+}
+
+impl<D: Dim> Slicer<'_, D> {
+    /// Adds the archetype's points; `states` their state column, `None` for points
+    /// without state.
+    fn add<T: MaterialState>(&mut self, states: Option<&[T]>) {
+        let (xg, vg, mg, sg) = (
+            col::<Position<D::Vec>>(self.arch),
+            col::<Volume>(self.arch),
+            col::<MaterialId>(self.arch),
+            col::<Stress<D::Stress>>(self.arch),
+        );
+        let water = self.ctx.model.water.as_ref();
+        let n = self.unit;
+        for p in 0..xg.len() {
+            let x = D::vec_to3(xg[p].0);
+            let sigma = sg[p].0.to_sym3();
+            // m̂ · σ · m̂ of the stress column (σ′ − u_excess I, tension positive).
+            let normal = n[0] * n[0] * sigma.xx
+                + n[1] * n[1] * sigma.yy
+                + n[2] * n[2] * sigma.zz
+                + 2.0 * (n[0] * n[1] * sigma.xy + n[1] * n[2] * sigma.yz + n[2] * n[0] * sigma.zx);
+            let u = water.map_or(0.0, |w| w.pore_pressure(mg[p].0, x));
+            let model = &self.ctx.materials[mg[p].0 as usize];
+            let strength = match states {
+                Some(s) => model.undrained_strength(&sigma, &s[p]),
+                None => model.undrained_strength(&sigma, &()),
+            };
+            let s = (0..3).map(|a| x[a] * n[a]).sum();
+            self.ground.add(s, vg[p].0, u - normal, u, strength);
         }
     }
 }

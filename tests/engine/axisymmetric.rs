@@ -5,6 +5,8 @@ use crate::common;
 
 use crate::common::{factors, refusal, rel, run};
 use kdmpm::model::CurvePoint;
+use kdmpm::run::Run;
+use kdmpm::scene::LoadedScene;
 
 /// Lamé's thick cylinder (`scenes/cylinder.ron`: a = 1 m, b = 2 m, p = 100 kPa on the bore,
 /// plane strain along the axis): σ_rr = A − B/r², σ_θθ = A + B/r², σ_zz = 2νA with
@@ -410,15 +412,18 @@ fn a_smooth_ball_on_the_axis_has_the_flow_round_factor() {
 /// the full scene's are in docs/verification.md ("The piezocone in Cam Clay").
 #[test]
 fn a_piezocone_in_undrained_cam_clay_reads_tip_sleeve_and_u2() {
-    let s = run(
-        "cptu_clay.ron",
-        &[
-            "grid.origin=[0.0, 10.0]",
-            "grid.cells=[10, 64]",
-            "bodies[0].region=Box(min: [0.0, 10.0], max: [2.5, 14.0])",
-            "rigid_bodies[0].motion.travel=0.25",
-        ],
-    );
+    let dir = common::scratch("axisymmetric", "cptu");
+    let overrides: Vec<String> = [
+        "grid.origin=[0.0, 10.0]",
+        "grid.cells=[10, 64]",
+        "bodies[0].region=Box(min: [0.0, 10.0], max: [2.5, 14.0])",
+        "rigid_bodies[0].motion.travel=0.25",
+    ]
+    .map(String::from)
+    .to_vec();
+    let loaded = LoadedScene::from_file(&common::scene("cptu_clay.ron"), &overrides).expect("loads");
+    let report = Run::scene(loaded).into_dir(&dir).quiet(true).go().expect("runs");
+    let s = &report.summary;
     assert!(s.converged, "{:?}", s.error);
     let reading = |name: &str| {
         let rows: Vec<&CurvePoint> = s.curve.iter().filter(|c| c.name == name).collect();
@@ -426,11 +431,44 @@ fn a_piezocone_in_undrained_cam_clay_reads_tip_sleeve_and_u2() {
         rows[0].pressure.expect("a pressure")
     };
     let (qt, fs, u2) = (reading("cone.tip"), reading("cone.sleeve"), reading("cone.u2"));
-    eprintln!("q_t {qt}, f_s {fs}, u2 {u2}, B_q {}", u2 / (qt - 100e3));
     assert!((qt - 301_738.75).abs() < 0.01, "{qt}");
     assert!((fs - 558.31).abs() < 0.01, "{fs}");
     assert!((u2 - 109_221.43).abs() < 0.01, "{u2}");
     // The filter's row carries no force.
     let filter = s.curve.iter().find(|c| c.name == "cone.u2").unwrap();
     assert_eq!(filter.force, [0.0; 3]);
+
+    // The log: the same readings at the apex's depth (0.866 m below the surface at the
+    // start, 1.116 m after D/4) against the ground as the push's first step left it: σ_v0
+    // 100 kPa (isotropic, weightless; 31.6 Pa more at the apex after that step), no water
+    // table, and the clay's s_u = (M/2)(1/2)^Λ p′₀ = 25.850 kPa (Wood 1990, §7.4; 25.846
+    // after the step).
+    let log = std::fs::read_to_string(dir.join("cpt.csv")).expect("cpt.csv");
+    let lines: Vec<&str> = log.lines().collect();
+    assert_eq!(
+        lines[0],
+        "step,travel,depth,q_t,f_s,u2,sigma_v0,u0,s_u,N_kt,N_du,B_q"
+    );
+    assert_eq!(lines.len(), 2, "{log}");
+    let row: Vec<f64> = lines[1].split(',').map(|v| v.parse().expect(v)).collect();
+    let su = 0.45 * 100e3 * 0.5f64.powf(0.8);
+    assert!(
+        (row[2] - (0.25 + 0.5 / (30f64.to_radians().tan()))).abs() < 1e-6,
+        "depth {}",
+        row[2]
+    );
+    for (logged, read) in [(row[3], qt), (row[4], fs), (row[5], u2)] {
+        assert!((logged / read - 1.0).abs() < 1e-9, "{logged} vs {read}");
+    }
+    assert!((row[6] - 100_031.567_1).abs() < 1e-3, "σ_v0 {}", row[6]);
+    assert_eq!(row[7], 0.0, "u0");
+    assert!((row[8] - 25_845.771_7).abs() < 1e-3, "s_u {}", row[8]);
+    assert!((row[8] / su - 1.0).abs() < 2e-4, "s_u {} vs {su}", row[8]);
+    // The factors as cpt.csv writes them (ten significant digits).
+    let factors = [(qt - row[6]) / row[8], u2 / row[8], u2 / (qt - row[6])];
+    for (logged, factor) in row[9..12].iter().zip(factors) {
+        assert!((logged / factor - 1.0).abs() < 1e-9, "{logged} vs {factor}");
+    }
+    let plot = std::fs::read_to_string(dir.join("cpt.svg")).expect("cpt.svg");
+    assert!(plot.contains("q_t (kPa)") && plot.contains("u2"));
 }

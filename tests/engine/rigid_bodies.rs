@@ -814,6 +814,25 @@ fn a_filter_named_as_a_part_is_refused() {
     assert!(e.contains("rigid_bodies[0].filters[0].name"), "{e}");
 }
 
+/// A piezocone's log reads its tip's and sleeve's pressures: a name that is no part of
+/// the body, or a part without an area, is refused where it is written.
+#[test]
+fn a_penetrometer_log_of_a_missing_part_or_one_without_area_is_refused() {
+    let e = refused("interface: Smooth,", "interface: Smooth, cpt: (tip: \"cone\"),");
+    assert!(
+        e.contains("rigid_bodies[0].cpt.tip") && e.contains("not a part"),
+        "{e}"
+    );
+    let e = refused(
+        "interface: Smooth,",
+        "interface: Smooth, cpt: (tip: \"base\", u2: \"u2\"),",
+    );
+    assert!(
+        e.contains("rigid_bodies[0].cpt.tip") && e.contains("no `area`"),
+        "{e}"
+    );
+}
+
 /// A wall held in a saturated sand whose water table is its top: a filter on the wall's
 /// face 2 m down reads the hydrostatic pressure of the points within a cell of it, which lie
 /// evenly above and below it: γ_w (2 m + s) with s the sand's settlement there under its

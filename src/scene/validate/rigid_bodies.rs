@@ -45,6 +45,15 @@ pub(super) fn check_rigid_bodies(r: &Rules) -> Result<(), SceneError> {
                 ),
             );
         }
+        if let (Some(_), Some(j)) = (&b.cpt, s.rigid_bodies[..i].iter().position(|o| o.cpt.is_some())) {
+            return r.bad(
+                &field("cpt"),
+                format!(
+                    "rigid_bodies[{j}] is already logged as the run's piezocone: cpt.csv holds \
+                     one; run the second cone in a scene of its own"
+                ),
+            );
+        }
         if let Some(stage) = b.stage() {
             if !s.stages.iter().any(|t| &t.name == stage) {
                 let names: Vec<&str> = s.stages.iter().map(|t| t.name.as_str()).collect();
