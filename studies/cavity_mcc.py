@@ -1,0 +1,146 @@
+#!/usr/bin/env python3
+"""Undrained cavity expansion in Modified Cam Clay, the reference for
+`scenes/cavity_clay.ron` (docs/verification.md, "Undrained cavity expansion").
+
+Collins & Yu (1996, "Undrained cavity expansions in critical state soils", IJNAMG 20)
+reduce the undrained expansion of a cavity in an infinite critical-state soil to one
+element's response: the soil is incompressible, so a particle now at r that started at
+r0 has the hoop log strain e = ln(r/r0), every particle follows the same path of
+deviatoric strain, and radial equilibrium integrates to the cavity pressure
+
+    cylinder:  psi - p0 = int_0^e_a (sigma_r - sigma_t)(e) de / (exp(2 e) - 1)
+    sphere:    psi - p0 = 2 int_0^e_a (sigma_r - sigma_t)(e) de / (exp(3 e) - 1)
+
+with e_a = ln(a/a0) at the cavity wall (a0 its radius at the start), the limit pressure
+as e_a grows without end. The element: plane-strain pure shear in the cylinder
+(eps_q = 2 e / sqrt 3, sigma_z the mean of the other two, q = sqrt 3 (sigma_r - sigma_t)/2),
+axisymmetric in the sphere (eps_q = 2 e, q = sigma_r - sigma_t). Its Cam Clay response
+undrained from an isotropic p'0 with R = p'c/p'0, integrated here on its own (not with
+the engine's code): elastic at constant p' up to the yield surface, then on it with
+kappa ln p' + (lambda - kappa) ln p'c fixed (no volume change), q^2 = M^2 p'(p'c - p'),
+and the shear strain dq/3G plus the associated flow's
+d eps_q^p = 2q/(M^2 (2p' - p'c)) * (-kappa dp'/(v p')), G from K = v p'/kappa and nu.
+At the wall the excess pore pressure is the total mean stress less p' (less u0 = 0):
+psi - q/sqrt 3 - p' (cylinder), psi - 2q/3 - p' (sphere).
+
+Run: `python3 studies/cavity_mcc.py [R]` (R = 1 by default) prints the pressure against
+a/a0 and the limits, for the clay of `scenes/cavity_clay.ron`; `python3
+studies/cavity_mcc.py R OUT` sets a finished run of that scene (or of
+`cavity_clay_r2.ron`) in OUT against it, stage by stage: the cavity's radius from the
+traced point `wall` (r0 = 1.025 m, its volume held: a² − a0² = r² − r0², both counted from
+the clay at rest under the cavity's 100 kPa, the stage `in situ`) and the pressure the
+reference gives at that a/a0.
+"""
+import csv
+import math
+import sys
+
+LAMBDA, KAPPA, M, NU, N = 0.25, 0.05, 0.9, 0.3, 3.0
+P0 = 100e3  # Pa, isotropic effective, u0 = 0
+REF = 1e3  # Pa, N's pressure
+
+
+def element(r_ocr, steps=200000):
+    """(eps_q, p', q) along the undrained path, from the start to near the critical state."""
+    pc0 = r_ocr * P0
+    v = N - LAMBDA * math.log(pc0 / REF) + KAPPA * math.log(pc0 / P0)
+    k = lambda p: v * p / KAPPA
+    g = lambda p: 3 * k(p) * (1 - 2 * NU) / (2 * (1 + NU))
+    path = [(0.0, P0, 0.0)]
+    # Elastic at p' = p'0 (no volume change, K acts on none): q to the yield surface.
+    qy = M * math.sqrt(max(P0 * (pc0 - P0), 0.0))
+    eq = qy / (3 * g(P0))
+    path.append((eq, P0, qy))
+    # On the surface: p' falls (R < 2) or rises (R > 2) towards the critical state
+    # p'f = p'0 (R/2)^Lambda; march p' in small steps.
+    lam_ = (LAMBDA - KAPPA) / LAMBDA
+    pf = P0 * (r_ocr / 2) ** lam_
+    c = KAPPA * math.log(P0) + (LAMBDA - KAPPA) * math.log(pc0)
+    pc = lambda p: math.exp((c - KAPPA * math.log(p)) / (LAMBDA - KAPPA))
+    p, q = P0, qy
+    for i in range(1, steps + 1):
+        # Geometric approach to p'f, stopping 1e-6 short (the flow rule's 2p' - p'c -> 0).
+        p_next = pf + (P0 - pf) * (1 - i / steps) ** 3
+        if abs(p_next - pf) < 1e-9 * P0:
+            break
+        pcn = pc(p_next)
+        qn = M * math.sqrt(max(p_next * (pcn - p_next), 0.0))
+        pm, qm = 0.5 * (p + p_next), 0.5 * (q + qn)
+        pcm = pc(pm)
+        dp = p_next - p
+        deq_p = 2 * qm / (M * M * (2 * pm - pcm)) * (-KAPPA * dp / (v * pm))
+        eq += (qn - q) / (3 * g(pm)) + deq_p
+        p, q = p_next, qn
+        path.append((eq, p, q))
+    return path, pf
+
+
+def q_at(path, eq):
+    """q and p' at the deviatoric strain eq (linear between path points; the critical
+    state beyond)."""
+    lo, hi = 0, len(path) - 1
+    if eq >= path[hi][0]:
+        return path[hi][2], path[hi][1]
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        if path[mid][0] <= eq:
+            lo = mid
+        else:
+            hi = mid
+    (e0, p0, q0), (e1, p1, q1) = path[lo], path[hi]
+    t = 0.0 if e1 == e0 else (eq - e0) / (e1 - e0)
+    return q0 + t * (q1 - q0), p0 + t * (p1 - p0)
+
+
+def pressure(path, e_a, sphere, n=200000):
+    """psi - p0 at the wall's hoop log strain e_a (midpoint rule in e)."""
+    total = 0.0
+    de = e_a / n
+    for i in range(n):
+        e = (i + 0.5) * de
+        if sphere:
+            q, _ = q_at(path, 2 * e)
+            total += 2 * q * de / math.expm1(3 * e)
+        else:
+            q, _ = q_at(path, 2 * e / math.sqrt(3))
+            total += (2 / math.sqrt(3)) * q * de / math.expm1(2 * e)
+    return total
+
+
+def compare(path, out):
+    """The run in `out` against the reference, stage by stage."""
+    history = {int(r["step"]): r for r in csv.DictReader(open(out + "/history.csv"))}
+    print("stage | a/a0 | kdmpm (kPa) | Collins & Yu (kPa) | difference")
+    r0 = a0 = None
+    for s in csv.DictReader(open(out + "/stages.csv")):
+        row = history[max(k for k in history if k <= int(s["step"]))]
+        r = 1.025 + float(row["wall_ux"])
+        if r0 is None:
+            r0, a0 = r, math.sqrt(1.0 + r * r - 1.025**2)
+            continue
+        ratio = math.sqrt(a0 * a0 + r * r - r0 * r0) / a0
+        psi = float(s["stage"].split()[0])
+        ref = (P0 + pressure(path, math.log(ratio), False, n=20000)) / 1e3
+        print(f"{s['stage']} | {ratio:.4f} | {psi:.1f} | {ref:.2f} | {(psi / ref - 1) * 100:+.2f} %")
+
+
+def main():
+    r_ocr = float(sys.argv[1]) if len(sys.argv) > 1 else 1.0
+    path, pf = element(r_ocr)
+    if len(sys.argv) > 2:
+        compare(path, sys.argv[2])
+        return
+    print(f"R = {r_ocr}: p'f = {pf / 1e3:.3f} kPa, s_u = {M * pf / 2e3:.3f} kPa")
+    for sphere in (False, True):
+        name = "sphere" if sphere else "cylinder"
+        for ratio in (1.1, 1.2, 1.5, 2.0, 3.0, 5.0, 10.0, 1e3):
+            e_a = math.log(ratio)
+            psi = P0 + pressure(path, e_a, sphere)
+            eq = (2 if sphere else 2 / math.sqrt(3)) * e_a
+            q, p = q_at(path, eq)
+            u = psi - (2 * q / 3 if sphere else q / math.sqrt(3)) - p
+            print(f"{name:8s} a/a0 {ratio:7.1f}: psi {psi / 1e3:8.2f} kPa, wall u {u / 1e3:8.2f} kPa")
+
+
+if __name__ == "__main__":
+    main()
