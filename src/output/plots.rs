@@ -196,7 +196,7 @@ pub fn draw(dir: &Path) -> std::io::Result<(Vec<&'static str>, Vec<String>)> {
             written.push(CURVE_PLOT);
         }
     }
-    if let Ok(log) = History::read(&dir.join(crate::output::recorder::CPT)) {
+    if let Ok(log) = History::read(&dir.join(crate::rigid::cpt::LOG_FILE)) {
         if let Some(svg) = cpt_log(&log) {
             save(CPT_PLOT, svg)?;
             written.push(CPT_PLOT);

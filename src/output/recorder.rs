@@ -49,8 +49,38 @@ fn curve_csv<D: Dim>(curve: &[CurvePoint]) -> String {
     t
 }
 
-/// A piezocone's log ([`crate::rigid::cpt`]).
-pub const CPT: &str = "cpt.csv";
+/// The log of `body` read as the piezocone `cpt`: each static state of its tip's row of
+/// `curve` with its sleeve's and filter's rows of the same step, against `ground`.
+fn cpt_log(
+    body: &crate::rigid::RigidBodySpec,
+    cpt: &crate::rigid::Cpt,
+    ground: &crate::rigid::InSitu,
+    curve: &[CurvePoint],
+    n: usize,
+) -> Vec<crate::rigid::cpt::LogRow> {
+    let row = |name: String| format!("{}.{name}", body.name);
+    let tip = row(body.parts[cpt.tip].name.clone());
+    let sleeve = cpt.sleeve.map(|k| row(body.parts[k].name.clone()));
+    let filter = cpt.filter.map(|k| row(body.filters[k].name.clone()));
+    let at = |name: &Option<String>, step: u64| -> Option<f64> {
+        let name = name.as_ref()?;
+        (curve.iter())
+            .find(|c| c.step == step && c.name == *name)?
+            .pressure
+    };
+    (curve.iter().filter(|c| c.name == tip))
+        .filter_map(|c| {
+            let readings = crate::rigid::cpt::Readings {
+                step: c.step,
+                travel: c.displacement,
+                tip: c.pressure?,
+                sleeve: at(&sleeve, c.step),
+                u2: at(&filter, c.step),
+            };
+            crate::rigid::cpt::log_row(body, cpt, ground, n, &readings)
+        })
+        .collect()
+}
 
 /// The loading stages' file.
 pub const STAGES: &str = "stages.csv";
@@ -102,7 +132,7 @@ fn clear_earlier_results(dir: &OutputDir) -> std::io::Result<()> {
         "points.vtu",
         "points.pvtu",
         CURVE,
-        CPT,
+        crate::rigid::cpt::LOG_FILE,
         STAGES,
         crate::output::plots::CURVE_PLOT,
         crate::output::plots::CPT_PLOT,
@@ -214,8 +244,8 @@ impl Recorder {
         for (body, b) in sim.ctx.model.bodies.iter().zip(&control.bodies) {
             // One piezocone a run (`scene::validate` refuses a second).
             if let (Some(cpt), Some(ground)) = (&body.cpt, &b.in_situ) {
-                let rows = crate::rigid::cpt::log(&body.spec, cpt, ground, &control.curve, D::N);
-                dir.write_atomic(CPT, |out| {
+                let rows = cpt_log(&body.spec, cpt, ground, &control.curve, D::N);
+                dir.write_atomic(crate::rigid::cpt::LOG_FILE, |out| {
                     out.write_all(crate::rigid::cpt::log_csv(&rows).as_bytes())
                 })?;
                 break;

@@ -4,7 +4,7 @@
 //!
 //! The three readings are rows `curve.csv` already holds: the tip part's mean pressure
 //! along the motion (q_t), the sleeve part's (f_s: its axial force over its lateral area),
-//! and the filter's pore pressure (u2). Against them the log sets the ground as it was when
+//! and the filter's pore pressure (u2); the recorder hands them here ([`Readings`]). Against them the log sets the ground as it was when
 //! the push began ([`InSitu`], recorded by `systems/rigid_control.rs` the step the body sets
 //! off): in slices one cell thick across the motion, the volume-weighted means of the total
 //! stress along the motion σ_v0 (the effective stress, the excess pore pressure and the
@@ -26,8 +26,10 @@
 
 use super::RigidBodySpec;
 use crate::error::Refusal;
-use crate::model::CurvePoint;
 use serde::{Deserialize, Serialize};
+
+/// The log's file in a run's directory.
+pub const LOG_FILE: &str = "cpt.csv";
 
 /// A body read as a piezocone, as the scene gives it: the names of its tip part, its
 /// sleeve part and its u2 filter.
@@ -216,15 +218,33 @@ pub struct LogRow {
     pub factors: [Option<f64>; 3],
 }
 
-/// The log of `body` read as `cpt`, from its rows of `curve` and the ground it entered
-/// (`in_situ`); `n` dimensions. Empty until the push has begun and reached a static state.
-pub fn log(body: &RigidBodySpec, cpt: &Cpt, in_situ: &InSitu, curve: &[CurvePoint], n: usize) -> Vec<LogRow> {
-    let Some(m) = &body.motion else {
-        return Vec::new();
-    };
-    let Some(surface) = in_situ.surface() else {
-        return Vec::new();
-    };
+/// A piezocone's three readings at one static state, as `curve.csv` holds them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Readings {
+    /// Step of the static state.
+    pub step: u64,
+    /// Travel (m).
+    pub travel: f64,
+    /// q_t (Pa): the tip's mean pressure along the motion.
+    pub tip: f64,
+    /// f_s (Pa): the sleeve's.
+    pub sleeve: Option<f64>,
+    /// u2 (Pa): the filter's pore pressure.
+    pub u2: Option<f64>,
+}
+
+/// The row of the log of `body` read as `cpt` at a static state with these `readings`,
+/// against the ground it entered (`in_situ`), in `n` dimensions; `None` where the ground
+/// held no soil.
+pub fn log_row(
+    body: &RigidBodySpec,
+    cpt: &Cpt,
+    in_situ: &InSitu,
+    n: usize,
+    readings: &Readings,
+) -> Option<LogRow> {
+    let m = body.motion.as_ref()?;
+    let surface = in_situ.surface()?;
     let speed = m.speed();
     let unit: [f64; 3] = m.vector().map(|c| c / speed);
     let along = |x: [f64; 3]| -> f64 { (0..3).map(|a| x[a] * unit[a]).sum() };
@@ -238,58 +258,38 @@ pub fn log(body: &RigidBodySpec, cpt: &Cpt, in_situ: &InSitu, curve: &[CurvePoin
             ))
         })
         .fold(f64::NEG_INFINITY, f64::max);
-    let filter = cpt.filter.map(|k| {
-        let at = &body.filters[k].at;
-        along(std::array::from_fn(|a| at.get(a).copied().unwrap_or(0.0)))
-    });
-    let row = |name: String, step: u64| -> Option<f64> {
-        curve
-            .iter()
-            .find(|c| c.step == step && c.name == name)
-            .and_then(|c| c.pressure)
+    let at_apex = in_situ.at(apex + readings.travel)?;
+    let u0 = match cpt.filter {
+        Some(k) => {
+            let at = &body.filters[k].at;
+            let s = along(std::array::from_fn(|a| at.get(a).copied().unwrap_or(0.0)));
+            in_situ
+                .at(s + readings.travel)
+                .map_or(at_apex.pore_pressure, |g| g.pore_pressure)
+        }
+        None => at_apex.pore_pressure,
     };
-    let tip_name = format!("{}.{}", body.name, body.parts[cpt.tip].name);
-    let mut rows = Vec::new();
-    for c in curve.iter().filter(|c| c.name == tip_name) {
-        let Some(q_t) = c.pressure else { continue };
-        let Some(at_apex) = in_situ.at(apex + c.displacement) else {
-            continue;
-        };
-        let u0 = match filter {
-            Some(s) => in_situ
-                .at(s + c.displacement)
-                .map_or(at_apex.pore_pressure, |g| g.pore_pressure),
-            None => at_apex.pore_pressure,
-        };
-        let ground = Ground {
-            pore_pressure: u0,
-            ..at_apex
-        };
-        let f_s = cpt
-            .sleeve
-            .and_then(|k| row(format!("{}.{}", body.name, body.parts[k].name), c.step));
-        let u2 = cpt
-            .filter
-            .and_then(|k| row(format!("{}.{}", body.name, body.filters[k].name), c.step));
-        let net = q_t - ground.total_stress;
-        let excess = u2.map(|u| u - u0);
-        let su = ground.undrained_strength.filter(|s| *s > 0.0);
-        rows.push(LogRow {
-            step: c.step,
-            travel: c.displacement,
-            depth: apex + c.displacement - surface,
-            tip_resistance: q_t,
-            sleeve_friction: f_s,
-            pore_pressure: u2,
-            ground,
-            factors: [
-                su.map(|s| net / s),
-                su.zip(excess).map(|(s, e)| e / s),
-                excess.filter(|_| net > 0.0).map(|e| e / net),
-            ],
-        });
-    }
-    rows
+    let ground = Ground {
+        pore_pressure: u0,
+        ..at_apex
+    };
+    let net = readings.tip - ground.total_stress;
+    let excess = readings.u2.map(|u| u - u0);
+    let su = ground.undrained_strength.filter(|s| *s > 0.0);
+    Some(LogRow {
+        step: readings.step,
+        travel: readings.travel,
+        depth: apex + readings.travel - surface,
+        tip_resistance: readings.tip,
+        sleeve_friction: readings.sleeve,
+        pore_pressure: readings.u2,
+        ground,
+        factors: [
+            su.map(|s| net / s),
+            su.zip(excess).map(|(s, e)| e / s),
+            excess.filter(|_| net > 0.0).map(|e| e / net),
+        ],
+    })
 }
 
 /// `cpt.csv`: one row a static state; a cell empty where its quantity is undefined.
