@@ -833,6 +833,31 @@ fn a_penetrometer_log_of_a_missing_part_or_one_without_area_is_refused() {
     );
 }
 
+/// `cpt.csv` is one piezocone's log: a second body read as one is refused.
+#[test]
+fn a_second_penetrometer_log_in_one_scene_is_refused() {
+    let area = "parts: [(name: \"base\", geometry: Polygon(vertices: [[0.0, 1.0], [0.5, 1.0], [0.5, 1.5], [0.0, 1.5]]))],";
+    let logged = "parts: [(name: \"base\", area: 0.5, geometry: Polygon(vertices: [[0.0, 1.0], [0.5, 1.0], [0.5, 1.5], [0.0, 1.5]]))],";
+    assert!(BODY.contains(area));
+    let one = BODY.replacen(area, logged, 1).replacen(
+        "interface: Smooth,",
+        "interface: Smooth, cpt: (tip: \"base\"),",
+        1,
+    );
+    let body = &one
+        [one.find("        (\n            name: \"pad\"").unwrap()..one.find("    ],\n    solver").unwrap()];
+    let second = body.replace("\"pad\"", "\"pad2\"").replace(
+        "[[0.0, 1.0], [0.5, 1.0], [0.5, 1.5], [0.0, 1.5]]",
+        "[[1.5, 1.0], [2.0, 1.0], [2.0, 1.5], [1.5, 1.5]]",
+    );
+    let two = one.replacen("    ],\n    solver", &format!("{second}    ],\n    solver"), 1);
+    let e = refusal(&two);
+    assert!(
+        e.contains("rigid_bodies[1].cpt") && e.contains("already logged"),
+        "{e}"
+    );
+}
+
 /// A wall held in a saturated sand whose water table is its top: a filter on the wall's
 /// face 2 m down reads the hydrostatic pressure of the points within a cell of it, which lie
 /// evenly above and below it: γ_w (2 m + s) with s the sand's settlement there under its
