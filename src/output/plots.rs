@@ -263,6 +263,8 @@ fn cpt_log(log: &History) -> Option<String> {
                 c.draw_series(pts.into_iter().map(|p| Circle::new(p, 3, colour.filled())))?;
             }
             c.configure_series_labels()
+                // At the top, above the first reading (the apex starts below the surface).
+                .position(SeriesLabelPosition::UpperRight)
                 .border_style(BLACK)
                 .background_style(WHITE.mix(0.9))
                 .label_font(("sans-serif", 14))
