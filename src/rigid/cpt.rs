@@ -335,4 +335,52 @@ mod tests {
         assert_eq!(g.at(0.0).unwrap().total_stress, 200e3);
         assert_eq!(InSitu::new(1.0, 0.0, 3.0).at(1.0), None);
     }
+
+    /// A cone pushed down y: the apex's depth below the ground's top, σ_v0 and s_u at the
+    /// apex, u0 at the filter (higher, so less), and the three factors from them; B_q
+    /// left out where q_t does not exceed σ_v0.
+    #[test]
+    fn a_row_of_the_log_reads_the_ground_at_the_apex_and_u0_at_the_filter() {
+        let body: RigidBodySpec = ron::from_str(
+            r#"(name: "cone", parts: [
+                (name: "tip", geometry: Polygon(vertices: [[0.0, 9.0], [0.5, 10.0], [0.0, 10.0]]), area: Some(0.125)),
+                (name: "sleeve", geometry: Polygon(vertices: [[0.0, 10.0], [0.5, 10.0], [0.5, 12.0], [0.0, 12.0]]), area: Some(1.0))],
+                filters: [(name: "u2", at: [0.5, 10.0])],
+                motion: Some((velocity: [0.0, -0.1], travel: 2.0)),
+                cpt: Some((tip: "tip", sleeve: Some("sleeve"), u2: Some("u2"))))"#,
+        )
+        .unwrap();
+        let cpt = body.cpt.as_ref().unwrap().check(&body).unwrap();
+        assert_eq!((cpt.tip, cpt.sleeve, cpt.filter), (0, Some(1), Some(0)));
+        // Ground from y = 10.5 (s = −10.5) down: σ_v0 = 20 kPa a metre, u0 = 10 kPa a metre,
+        // s_u = 5 kPa a metre, one point at each slice's centre.
+        let mut g = InSitu::new(0.5, -10.5, 0.0);
+        for k in 0..21 {
+            let s = -10.5 + 0.5 * (k as f64 + 0.5);
+            let depth = s + 10.5;
+            g.add(s, 1.0, 20e3 * depth, 10e3 * depth, Some(5e3 * depth));
+        }
+        let readings = Readings {
+            step: 7,
+            travel: 1.0,
+            tip: 500e3,
+            sleeve: Some(10e3),
+            u2: Some(100e3),
+        };
+        let row = log_row(&body, &cpt, &g, 2, &readings).unwrap();
+        // Apex at y = 9 − 1 = 8: 2.5 m below the top; the filter at y = 9: 1.5 m.
+        assert!((row.depth - 2.5).abs() < 1e-12);
+        assert!((row.ground.total_stress - 50e3).abs() < 1e-6);
+        assert!((row.ground.pore_pressure - 15e3).abs() < 1e-6);
+        assert!((row.ground.undrained_strength.unwrap() - 12.5e3).abs() < 1e-6);
+        let [n_kt, n_du, b_q] = row.factors.map(Option::unwrap);
+        assert!((n_kt - 450e3 / 12.5e3).abs() < 1e-9);
+        assert!((n_du - 85e3 / 12.5e3).abs() < 1e-9);
+        assert!((b_q - 85e3 / 450e3).abs() < 1e-12);
+        let below = Readings {
+            tip: 40e3,
+            ..readings
+        };
+        assert_eq!(log_row(&body, &cpt, &g, 2, &below).unwrap().factors[2], None);
+    }
 }
