@@ -488,6 +488,35 @@ impl Elasticity {
     }
 }
 
+/// Something done with the points of one archetype and their material state column,
+/// whatever its type ([`with_state_column`]).
+pub trait WithStates {
+    /// `states`: the state column of `arch`, `None` when its points carry no state.
+    fn with<S: MaterialState>(&mut self, arch: &Archetype, states: Option<&[S]>);
+}
+
+/// Calls `user` once with the state column of `arch` (the first registered state type of
+/// some size it holds), or with none.
+pub fn with_state_column(arch: &Archetype, user: &mut impl WithStates) {
+    struct Find<'a, U>(&'a Archetype, &'a mut U, bool);
+    impl<U: WithStates> StateVisitor for Find<'_, U> {
+        fn visit<S: MaterialState>(&mut self) {
+            if self.2 || std::mem::size_of::<S>() == 0 {
+                return;
+            }
+            if let Some(states) = self.0.get::<&S>() {
+                self.1.with(self.0, Some(&states));
+                self.2 = true;
+            }
+        }
+    }
+    let mut find = Find(arch, user, false);
+    visit_states(&mut find);
+    if !find.2 {
+        find.1.with::<()>(arch, None);
+    }
+}
+
 /// Appends the accumulated plastic strain of each point of `arch` to `out`, in row order:
 /// from the column of its material's state, 0 where the points carry no state.
 pub fn extend_plastic_strain(arch: &Archetype, out: &mut Vec<f64>) {

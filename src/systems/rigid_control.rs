@@ -38,7 +38,7 @@ use crate::dim::Dim;
 use crate::error::StepError;
 use crate::grid::Grid;
 use crate::infra::columns::{col, col_mut, points_with};
-use crate::materials::{visit_states, MaterialState, StateVisitor};
+use crate::materials::{with_state_column, MaterialState, WithStates};
 use crate::model::CurvePoint;
 use crate::model::LoadStage;
 use crate::rigid::{BodyLoad, BodyState, InSitu, RigidBodySpec};
@@ -187,16 +187,7 @@ impl<D: Dim> System<D> for RigidControl {
     }
 
     fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
-        // A piezocone's ground, the step its push begins, before it has moved.
-        for (k, spec) in self.bodies.iter().enumerate() {
-            let b = &ctx.state.control.bodies[k];
-            if let (Some(m), Some(_), None, 0.0) = (&spec.motion, &spec.cpt, &b.in_situ, b.travel) {
-                if b.velocity != [0.0; 3] {
-                    let unit = m.vector().map(|c| c / m.speed());
-                    ctx.state.control.bodies[k].in_situ = Some(in_situ(ctx, unit));
-                }
-            }
-        }
+        record_ground(&self.bodies, ctx);
         let s = &mut ctx.state;
         let dt = s.resets.motion_dt(ctx.numerics.dt).unwrap_or(0.0);
         for (spec, b) in self.bodies.iter().zip(&mut s.control.bodies) {
@@ -318,56 +309,34 @@ impl<D: Dim> System<D> for RigidControl {
 /// pressure and the excess an undrained material holds ([`crate::rigid::filter`]); `None`
 /// when no point lies that near. Over MPI ranks the sums of every rank.
 fn filter_reading<D: Dim>(ctx: &Context<D>, x: [f64; 3]) -> Option<f64> {
-    let mut sums = [0.0; 2];
+    let mut read = Reading::<D> {
+        ctx,
+        x,
+        sums: [0.0; 2],
+    };
     for arch in points_with::<Volume>(&ctx.world) {
-        let mut read = Reading::<D> {
-            arch,
-            ctx,
-            x,
-            sums: [0.0; 2],
-            done: false,
-        };
-        visit_states(&mut read);
-        if !read.done {
-            read.add::<()>(None);
-        }
-        sums[0] += read.sums[0];
-        sums[1] += read.sums[1];
+        with_state_column(arch, &mut read);
     }
-    ctx.comm.sum(&mut sums);
-    (sums[1] > 0.0).then(|| sums[0] / sums[1])
+    ctx.comm.sum(&mut read.sums);
+    (read.sums[1] > 0.0).then(|| read.sums[0] / read.sums[1])
 }
 
-/// One archetype's share of a filter's reading, with the state column it carries.
+/// A filter's reading, summed archetype by archetype.
 struct Reading<'a, D: Dim> {
-    arch: &'a hecs::Archetype,
     ctx: &'a Context<D>,
     x: [f64; 3],
     /// Σ V u, Σ V.
     sums: [f64; 2],
-    done: bool,
 }
 
-impl<D: Dim> StateVisitor for Reading<'_, D> {
-    fn visit<T: MaterialState>(&mut self) {
-        if self.done || std::mem::size_of::<T>() == 0 {
-            return;
-        }
-        if let Some(states) = self.arch.get::<&T>() {
-            self.add(Some(&states));
-            self.done = true;
-        }
-    }
-}
-
-impl<D: Dim> Reading<'_, D> {
+impl<D: Dim> WithStates for Reading<'_, D> {
     /// Adds the archetype's points within a cell of the filter; `states` their state column,
     /// `None` for points without state (no excess pore pressure).
-    fn add<T: MaterialState>(&mut self, states: Option<&[T]>) {
+    fn with<T: MaterialState>(&mut self, arch: &hecs::Archetype, states: Option<&[T]>) {
         let (xg, vg, mg) = (
-            col::<Position<D::Vec>>(self.arch),
-            col::<Volume>(self.arch),
-            col::<MaterialId>(self.arch),
+            col::<Position<D::Vec>>(arch),
+            col::<Volume>(arch),
+            col::<MaterialId>(arch),
         );
         let r2 = self.ctx.grid.cell_size * self.ctx.grid.cell_size;
         let water = self.ctx.model.water.as_ref();
@@ -381,6 +350,19 @@ impl<D: Dim> Reading<'_, D> {
             let excess = states.map_or(0.0, |s| s[p].excess_pore_pressure());
             self.sums[0] += vg[p].0 * (hydrostatic + excess);
             self.sums[1] += vg[p].0;
+        }
+    }
+}
+
+/// Each piezocone's ground (`cpt`), the step its push begins, before it has moved.
+fn record_ground<D: Dim>(bodies: &[RigidBodySpec], ctx: &mut Context<D>) {
+    for (k, spec) in bodies.iter().enumerate() {
+        let b = &ctx.state.control.bodies[k];
+        if let (Some(m), Some(_), None, 0.0) = (&spec.motion, &spec.cpt, &b.in_situ, b.travel) {
+            if b.velocity != [0.0; 3] {
+                let unit = m.vector().map(|c| c / m.speed());
+                ctx.state.control.bodies[k].in_situ = Some(in_situ(ctx, unit));
+            }
         }
     }
 }
@@ -406,20 +388,15 @@ fn in_situ<D: Dim>(ctx: &Context<D>, unit: [f64; 3]) -> InSitu {
     if !(ends[0].is_finite() && ends[1].is_finite()) {
         return InSitu::new(h, 0.0, 0.0);
     }
-    let mut ground = InSitu::new(h, (-ends[0] / h).floor() * h, ends[1]);
+    let mut slicer = Slicer::<D> {
+        ctx,
+        unit,
+        ground: InSitu::new(h, (-ends[0] / h).floor() * h, ends[1]),
+    };
     for arch in points_with::<Volume>(&ctx.world) {
-        let mut slicer = Slicer::<D> {
-            arch,
-            ctx,
-            unit,
-            ground: &mut ground,
-            done: false,
-        };
-        visit_states(&mut slicer);
-        if !slicer.done {
-            slicer.add::<()>(None);
-        }
+        with_state_column(arch, &mut slicer);
     }
+    let mut ground = slicer.ground;
     let mut flat: Vec<f64> = ground.slices.iter().flatten().copied().collect();
     ctx.comm.sum(&mut flat);
     for (slice, sums) in ground.slices.iter_mut().zip(flat.chunks_exact(5)) {
@@ -428,36 +405,22 @@ fn in_situ<D: Dim>(ctx: &Context<D>, unit: [f64; 3]) -> InSitu {
     ground
 }
 
-/// One archetype's points added to the ground's slices, with the state column it carries.
+/// The ground's slices, added to archetype by archetype.
 struct Slicer<'a, D: Dim> {
-    arch: &'a hecs::Archetype,
     ctx: &'a Context<D>,
     unit: [f64; 3],
-    ground: &'a mut InSitu,
-    done: bool,
+    ground: InSitu,
 }
 
-impl<D: Dim> StateVisitor for Slicer<'_, D> {
-    fn visit<T: MaterialState>(&mut self) {
-        if self.done || std::mem::size_of::<T>() == 0 {
-            return;
-        }
-        if let Some(states) = self.arch.get::<&T>() {
-            self.add(Some(&states));
-            self.done = true;
-        }
-    }
-}
-
-impl<D: Dim> Slicer<'_, D> {
+impl<D: Dim> WithStates for Slicer<'_, D> {
     /// Adds the archetype's points; `states` their state column, `None` for points
     /// without state.
-    fn add<T: MaterialState>(&mut self, states: Option<&[T]>) {
+    fn with<T: MaterialState>(&mut self, arch: &hecs::Archetype, states: Option<&[T]>) {
         let (xg, vg, mg, sg) = (
-            col::<Position<D::Vec>>(self.arch),
-            col::<Volume>(self.arch),
-            col::<MaterialId>(self.arch),
-            col::<Stress<D::Stress>>(self.arch),
+            col::<Position<D::Vec>>(arch),
+            col::<Volume>(arch),
+            col::<MaterialId>(arch),
+            col::<Stress<D::Stress>>(arch),
         );
         let water = self.ctx.model.water.as_ref();
         let n = self.unit;
