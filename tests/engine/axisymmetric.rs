@@ -422,7 +422,7 @@ fn a_piezocone_in_undrained_cam_clay_reads_tip_sleeve_and_u2() {
     .map(String::from)
     .to_vec();
     let loaded = LoadedScene::from_file(&common::scene("cptu_clay.ron"), &overrides).expect("loads");
-    let report = Run::scene(loaded).into_dir(&dir).quiet(true).go().expect("runs");
+    let report = common::on_own_thread(|| Run::scene(loaded).into_dir(&dir).quiet(true).go()).expect("runs");
     let s = &report.summary;
     assert!(s.converged, "{:?}", s.error);
     let reading = |name: &str| {

@@ -5,7 +5,7 @@
 //! The clay is `scenes/clay_oedometer.ron`'s: λ = 0.25, κ = 0.05 (Λ = (λ − κ)/λ = 0.8),
 //! M = 0.9, ν = 0.25, N = 3.0 at 1 kPa, Γ = N − (λ − κ) ln 2.
 
-use crate::common::{rel, run, scene};
+use crate::common::{on_own_thread, rel, run, scene};
 use kdmpm::element_test::{oedometer, triaxial, Drainage, Row, Triaxial};
 use kdmpm::materials::{MaterialModel, MaterialSpec};
 use kdmpm::LoadedScene;
@@ -468,11 +468,8 @@ fn an_undrained_cavity_expands_as_collins_and_yu_s_cam_clay() {
     .map(String::from)
     .to_vec();
     let loaded = LoadedScene::from_file(&scene("cavity_clay.ron"), &sets).expect("loads");
-    let report = kdmpm::run::Run::scene(loaded)
-        .into_dir(&dir)
-        .quiet(true)
-        .go()
-        .expect("runs");
+    let report =
+        on_own_thread(|| kdmpm::run::Run::scene(loaded).into_dir(&dir).quiet(true).go()).expect("runs");
     assert!(report.summary.converged, "{:?}", report.summary.error);
     let read = |file: &str| std::fs::read_to_string(dir.join(file)).expect(file);
     let (stages, history) = (read("stages.csv"), read("history.csv"));

@@ -112,7 +112,7 @@ fn scatters_sharing_their_slabs_give_the_bits_of_slabs_built_for_every_scatter()
         );
         let mut overrides = common::COARSE_SLOPE.to_vec();
         overrides.extend([
-            "solver.max_steps=300",
+            "solver.max_steps=120",
             "solver.sort_every=25",
             &locking_set,
             &scheme_set,

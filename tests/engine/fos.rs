@@ -36,7 +36,8 @@ fn strength_reduction_divides_cohesion_and_the_tangents_of_the_angles() {
 #[test]
 fn the_griffiths_lane_slope_has_bishops_factor_of_safety() {
     let out = common::scratch("fos", "griffiths-lane");
-    let r = strength_reduction(&slope(), &out, |_| {}).expect("the bracket holds the factor");
+    let r = common::on_own_thread(|| strength_reduction(&slope(), &out, |_| {}))
+        .expect("the bracket holds the factor");
     assert!(r.bracket[1] - r.bracket[0] <= 0.02, "{:?}", r.bracket);
     assert_eq!(r.bracket, [1.375, 1.390625]);
     // Every standing trial lies below every failing one.

@@ -633,11 +633,8 @@ fn run_beside(dir: &std::path::Path, text: &str) -> Result<kdmpm::output::summar
     let path = dir.join("scene.ron");
     std::fs::write(&path, text).unwrap();
     let loaded = kdmpm::scene::LoadedScene::from_file(&path, &[]).map_err(|e| e.to_string())?;
-    Ok(kdmpm::run::Run::scene(loaded)
-        .quiet(true)
-        .go()
-        .map_err(|e| e.to_string())?
-        .summary)
+    let report = common::on_own_thread(|| kdmpm::run::Run::scene(loaded).quiet(true).go());
+    Ok(report.map_err(|e| e.to_string())?.summary)
 }
 
 /// A footing read from an STL file (a closed box of twelve triangles) is the footing of

@@ -58,7 +58,7 @@ fn softening_puts_the_factor_of_safety_between_the_residual_and_the_peak() {
         let out = common::scratch("softening", name);
         let mut overrides: Vec<String> = coarse.iter().map(|s| s.to_string()).collect();
         overrides.push(material);
-        strength_reduction(&slope(&overrides), &out, |_| {})
+        common::on_own_thread(|| strength_reduction(&slope(&overrides), &out, |_| {}))
             .expect("the bracket holds the factor")
             .factor_of_safety
     };
