@@ -30,6 +30,15 @@ studies/cavity_mcc.py R OUT` sets a finished run of that scene (or of
 traced point `wall` (r0 = 1.025 m, its volume held: a² − a0² = r² − r0², both counted from
 the clay at rest under the cavity's 100 kPa, the stage `in situ`) and the pressure the
 reference gives at that a/a0.
+
+`python3 studies/cavity_mcc.py R OUT --sphere` does the same for a run of
+`scenes/cavity_sphere.ron` (or `cavity_sphere_r2.ron`): a thick sphere of outer radius
+b = 6 m under the far field's 100 kPa, whose reference is the same integral from the
+outer face's strain e_b = -ln(1 - (a^3 - a0^3)/b^3)/3 instead of 0 (the kinematics of an
+incompressible sphere hold in a finite one; only the far field's pressure now acts at b),
+and whose cavity radius comes from the volume of the cavity: the traced points `wall9`,
+`wall27`, ... `wall81` stand for the wall's 18-degree zones, a^3 = a0^3 + the zones'
+mean of rho^3 - rho0^3 weighted by their share of the sphere, cos(phi) dphi.
 """
 import csv
 import math
@@ -92,12 +101,13 @@ def q_at(path, eq):
     return q0 + t * (q1 - q0), p0 + t * (p1 - p0)
 
 
-def pressure(path, e_a, sphere, n=200000):
-    """psi - p0 at the wall's hoop log strain e_a (midpoint rule in e)."""
+def pressure(path, e_a, sphere, n=200000, e_b=0.0):
+    """psi - p0 at the wall's hoop log strain e_a (midpoint rule in e), the far field's p0
+    acting where the strain is e_b (0: an infinite body)."""
     total = 0.0
-    de = e_a / n
+    de = (e_a - e_b) / n
     for i in range(n):
-        e = (i + 0.5) * de
+        e = e_b + (i + 0.5) * de
         if sphere:
             q, _ = q_at(path, 2 * e)
             total += 2 * q * de / math.expm1(3 * e)
@@ -124,11 +134,54 @@ def compare(path, out):
         print(f"{s['stage']} | {ratio:.4f} | {psi:.1f} | {ref:.2f} | {(psi / ref - 1) * 100:+.2f} %")
 
 
+B_SPHERE = 6.0  # m, the outer radius of scenes/cavity_sphere.ron
+
+
+def compare_sphere(path, out):
+    """The spherical run in `out` against the reference for its thick sphere."""
+    import json
+
+    history = {int(r["step"]): r for r in csv.DictReader(open(out + "/history.csv"))}
+    traced = json.load(open(out + "/summary.json"))["traced"]
+    walls = []
+    for t in traced:
+        if t["name"].startswith("wall"):
+            phi = math.radians(float(t["name"][4:]))
+            weight = math.sin(phi + math.radians(9)) - math.sin(phi - math.radians(9))
+            walls.append((t["name"], t["initial_position"], weight))
+    print("stage | a/a0 | kdmpm (kPa) | Collins & Yu, b = 6 m (kPa) | difference | wall u (kPa)")
+    base = None
+    for s in csv.DictReader(open(out + "/stages.csv")):
+        row = history[max(k for k in history if k <= int(s["step"]))]
+        rho3 = []
+        for name, x0, _ in walls:
+            x, y = x0[0] + float(row[name + "_ux"]), x0[1] + float(row[name + "_uy"])
+            rho3.append(math.hypot(x, y) ** 3)
+        if base is None:
+            base = rho3
+            continue
+        total = sum(w for _, _, w in walls)
+        grown = sum(w * (r - r0) for (_, _, w), r, r0 in zip(walls, rho3, base)) / total
+        ratio = (1.0 + grown) ** (1 / 3)
+        e_b = -math.log(1 - grown / B_SPHERE**3) / 3
+        psi = float(s["stage"].split()[0])
+        ref = P0 + pressure(path, math.log(ratio), True, n=20000, e_b=e_b)
+        q, p = q_at(path, 2 * math.log(ratio))
+        u = ref - 2 * q / 3 - p
+        print(
+            f"{s['stage']} | {ratio:.4f} | {psi:.1f} | {ref / 1e3:.2f} | "
+            f"{(psi * 1e3 / ref - 1) * 100:+.2f} % | {u / 1e3:.2f}"
+        )
+
+
 def main():
     r_ocr = float(sys.argv[1]) if len(sys.argv) > 1 else 1.0
     path, pf = element(r_ocr)
     if len(sys.argv) > 2:
-        compare(path, sys.argv[2])
+        if "--sphere" in sys.argv[3:]:
+            compare_sphere(path, sys.argv[2])
+        else:
+            compare(path, sys.argv[2])
         return
     print(f"R = {r_ocr}: p'f = {pf / 1e3:.3f} kPa, s_u = {M * pf / 2e3:.3f} kPa")
     for sphere in (False, True):

@@ -175,7 +175,7 @@ fn stages<D: Dim>(
     loaded: &LoadedScene,
     checked: Vec<CheckedStage>,
     load_ids: &[(String, u32)],
-    shares: &[(String, Vec<(u32, f64)>)],
+    shares: &[(String, Vec<super::tractions::Share>)],
 ) -> Vec<LoadStage> {
     let mut out = Vec::new();
     for (
@@ -203,8 +203,11 @@ fn stages<D: Dim>(
                 .iter()
                 .find(|s| s.name == *name)
                 .expect("validated");
-            let t = spec.vector_of(t);
-            loads.extend(points.iter().map(|&(id, share)| (id, t.map(|c| c * share))));
+            loads.extend(
+                points
+                    .iter()
+                    .map(|p| (p.id, spec.load_at(t, p.normal).map(|c| c * p.share))),
+            );
         }
         loads.sort_by_key(|l| l.0);
         let gravity = st.gravity.as_ref().map(|g| Gravity {

@@ -23,6 +23,6 @@ pub use loaded::LoadedScene;
 pub use spec::{
     BodySpec, BoundarySpec, CheckpointEvery, Condition, Dimension, GravitySpec, GridSpec, InitialStress,
     OutputSpec, PointLoadSpec, Region, Scene, SolverSpec, StageSpec, StrengthReductionSpec, TimeStep,
-    TracedSpec, TractionSpec,
+    TracedSpec, TractionSpec, TractionSurface,
 };
 pub use validate::{check, Checked, CheckedGrid, CheckedStage, Derived, Estimate, FaceHold};

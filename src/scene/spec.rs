@@ -293,8 +293,9 @@ pub struct PointLoadSpec {
 pub struct TractionSpec {
     /// Name (for messages).
     pub name: String,
-    /// The side of the bodies the surface faces, as a grid face: `YMax` loads a top surface.
-    pub surface: Face,
+    /// The surface: a side of the bodies named as the grid face it looks towards (`YMax`
+    /// loads a top surface), or a circular `Arc`.
+    pub surface: TractionSurface,
     /// Lower corner of the box that holds the loaded part of the surface (m).
     pub min: Vec<f64>,
     /// Upper corner (m).
@@ -315,26 +316,64 @@ pub struct TractionSpec {
     pub increments: Option<u32>,
 }
 
+/// The surface a traction loads.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub enum TractionSurface {
+    /// The bodies' side facing −x.
+    XMin,
+    /// The side facing +x.
+    XMax,
+    /// The side facing −y.
+    YMin,
+    /// The side facing +y (a top surface).
+    YMax,
+    /// The side facing −z.
+    ZMin,
+    /// The side facing +z.
+    ZMax,
+    /// The part inside the traction's box of the circle of `centre` and `radius` (m) in the
+    /// x-y plane, under a pressure: the wall of a hole when the bodies lie outside it, the
+    /// rim of a disc when they lie inside. In plane strain a cylinder along z; in
+    /// axisymmetry a sphere (centre on the axis) or a ring. 2D and axisymmetric scenes.
+    Arc {
+        /// The circle's centre `[x, y]` (m).
+        centre: Vec<f64>,
+        /// Its radius (m, > 0).
+        radius: f64,
+    },
+}
+
+impl TractionSurface {
+    /// The grid face this surface is, if it is one.
+    pub fn face(&self) -> Option<Face> {
+        Some(match self {
+            Self::XMin => Face::XMin,
+            Self::XMax => Face::XMax,
+            Self::YMin => Face::YMin,
+            Self::YMax => Face::YMax,
+            Self::ZMin => Face::ZMin,
+            Self::ZMax => Face::ZMax,
+            Self::Arc { .. } => return None,
+        })
+    }
+}
+
 impl TractionSpec {
-    /// The traction at set-up (Pa), x y z: as given, or a pressure's −p n with n the
-    /// outward normal of its face.
-    pub fn vector(&self) -> [f64; 3] {
+    /// Whether it loads at all: a non-zero pressure or traction entry.
+    pub fn loads(&self) -> bool {
         match self.pressure {
-            Some(p) => self.vector_of(&[p]),
-            None => self.vector_of(&self.traction),
+            Some(p) => p != 0.0,
+            None => self.traction.iter().any(|&t| t != 0.0),
         }
     }
 
-    /// What a value of this traction (a stage's new one) stands for at set-up (Pa), x y z:
-    /// a traction's entries as given, a pressure's one entry p as −p n.
-    pub fn vector_of(&self, value: &[f64]) -> [f64; 3] {
+    /// What a value of this traction (a stage's new one) stands for at set-up (Pa), x y z,
+    /// on a piece of surface of outward normal `normal` (unit): a traction's entries as
+    /// given, a pressure's one entry p as −p n.
+    pub fn load_at(&self, value: &[f64], normal: [f64; 3]) -> [f64; 3] {
         match self.pressure {
-            Some(_) => {
-                let (axis, upper) = self.surface.axis_side();
-                let mut v = [0.0; 3];
-                v[axis] = if upper { -value[0] } else { value[0] };
-                v
-            }
+            // Components across the normal stay +0.
+            Some(_) => normal.map(|n| if n == 0.0 { 0.0 } else { -value[0] * n }),
             None => pad3(value),
         }
     }

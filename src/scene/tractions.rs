@@ -2,11 +2,12 @@
 
 use super::loaded::LoadedScene;
 use super::region::BodyPoint;
+use super::spec::TractionSurface;
 use crate::components::*;
 use crate::dim::Dim;
 use crate::error::SceneError;
 use crate::model::LoadSteps;
-use crate::surface_pressure::{SurfacePoint, SurfacePressures, NONE};
+use crate::surface_pressure::{ArcPoint, SurfacePoint, SurfacePressures, NONE};
 use hecs::{Entity, World};
 use std::collections::BTreeMap;
 
@@ -27,10 +28,14 @@ pub(super) fn place<D: Dim, I: Iterator<Item = BodyPoint>>(
     let mut placed = Placed::default();
     // Each traction's columns, then the entities of the loaded points this rank holds.
     let columns = (0..s.tractions.len())
-        .map(|i| outermost::<D>(every(), loaded, i))
+        .map(|i| match &s.tractions[i].surface {
+            TractionSurface::Arc { centre, radius } => {
+                on_arc::<D>(every(), loaded, i, centre, *radius).map(Loaded::Arc)
+            }
+            _ => outermost::<D>(every(), loaded, i).map(Loaded::Face),
+        })
         .collect::<Result<Vec<_>, _>>()?;
-    let wanted: std::collections::BTreeSet<u32> =
-        columns.iter().flat_map(|c| c.values().map(|v| v.1.id)).collect();
+    let wanted: std::collections::BTreeSet<u32> = columns.iter().flat_map(Loaded::ids).collect();
     let held: BTreeMap<u32, Entity> = world
         .query::<(Entity, &PointId)>()
         .iter()
@@ -41,9 +46,43 @@ pub(super) fn place<D: Dim, I: Iterator<Item = BodyPoint>>(
     let mut loaded_by: BTreeMap<u32, (usize, bool)> = BTreeMap::new();
     // The points under a pressure and their places in its surface.
     let mut followers: Vec<(u32, SurfacePoint)> = Vec::new();
-    for ((i, t), outermost) in s.tractions.iter().enumerate().zip(&columns) {
-        let (normal, upper) = t.surface.axis_side();
+    // The arc points' set-up places, to finish their `ArcPoint`s.
+    let mut arc_places: BTreeMap<u32, [f64; 3]> = BTreeMap::new();
+    for ((i, t), loaded_points) in s.tractions.iter().enumerate().zip(&columns) {
+        let outermost = match loaded_points {
+            Loaded::Face(c) => c,
+            Loaded::Arc(arc) => {
+                let mut shares = Vec::new();
+                for q in arc {
+                    let id = q.point.id;
+                    if let Some(&(j, _)) = loaded_by.get(&id) {
+                        return Err(shared_point(loaded, i, j, q.point.x[..n].to_vec()));
+                    }
+                    loaded_by.insert(id, (i, true));
+                    let f = D::vec_from(t.load_at(&[t.pressure.expect("validated")], q.normal)) * q.share;
+                    if let Some(&e) = held.get(&id) {
+                        world.insert_one(e, PointLoad(f)).expect("a live point");
+                    }
+                    shares.push(Share {
+                        id,
+                        share: q.share,
+                        normal: q.normal,
+                    });
+                    arc_places.insert(id, q.point.x);
+                    followers.push((id, q.surface_point(s.grid.cell_size)));
+                }
+                placed.shares.push((t.name.clone(), shares));
+                continue;
+            }
+        };
+        let face = t.surface.face().expect("a face");
+        let (normal, upper) = face.axis_side();
+        let mut face_normal = [0.0; 3];
+        face_normal[normal] = if upper { 1.0 } else { -1.0 };
         let pressed = t.pressure.is_some();
+        let value = t.pressure.map_or_else(|| t.traction.clone(), |p| vec![p]);
+        // The traction at set-up (Pa), x y z.
+        let load = t.load_at(&value, face_normal);
         let across: Vec<usize> = (0..n).filter(|&a| a != normal).collect();
         let ids: BTreeMap<&Vec<i64>, u32> = outermost.iter().map(|(k, v)| (k, v.1.id)).collect();
         let (mut points, mut shares) = (Vec::new(), Vec::new());
@@ -55,7 +94,7 @@ pub(super) fn place<D: Dim, I: Iterator<Item = BodyPoint>>(
                 }
             }
             loaded_by.entry(id).or_insert((i, pressed));
-            let f = D::vec_from(t.vector()) * share;
+            let f = D::vec_from(load) * share;
             if let Some(&e) = held.get(&id) {
                 let earlier = world.get::<&PointLoad<D::Vec>>(e).map(|p| p.0).ok();
                 world
@@ -63,7 +102,11 @@ pub(super) fn place<D: Dim, I: Iterator<Item = BodyPoint>>(
                     .expect("a live point");
             }
             points.push((id, D::vec_to3(f)));
-            shares.push((id, share));
+            shares.push(Share {
+                id,
+                share,
+                normal: face_normal,
+            });
             if pressed {
                 let column = Column {
                     key,
@@ -82,7 +125,7 @@ pub(super) fn place<D: Dim, I: Iterator<Item = BodyPoint>>(
                 name: t.name.clone(),
                 points,
                 increments: k,
-                pressure: t.vector().iter().map(|c| c * c).sum::<f64>().sqrt(),
+                pressure: load.iter().map(|c| c * c).sum::<f64>().sqrt(),
             });
         }
     }
@@ -91,7 +134,287 @@ pub(super) fn place<D: Dim, I: Iterator<Item = BodyPoint>>(
         ids: followers.iter().map(|f| f.0).collect(),
         points: followers.into_iter().map(|f| f.1).collect(),
     };
+    finish_arcs::<D>(&mut placed.pressures, &arc_places);
     Ok(placed)
+}
+
+/// A traction's loaded points: a face's columns or an arc's pieces.
+enum Loaded {
+    Face(Columns),
+    Arc(Vec<OnArc>),
+}
+
+impl Loaded {
+    /// The loaded points' ids.
+    fn ids(&self) -> Vec<u32> {
+        match self {
+            Loaded::Face(c) => c.values().map(|v| v.1.id).collect(),
+            Loaded::Arc(a) => a.iter().map(|q| q.point.id).collect(),
+        }
+    }
+}
+
+/// A point that loads a piece of an arc.
+struct OnArc {
+    /// The point (the nearest to the arc of those behind its piece).
+    point: BodyPoint,
+    /// Its piece's area (m, per radian in axisymmetry: ∫ r dl).
+    share: f64,
+    /// The bodies' outward normal at the point at set-up (unit, x y z).
+    normal: [f64; 3],
+    /// The point's distance from the arc (m).
+    depth: f64,
+    /// The ids of the points on the pieces before and after (`NONE` where none).
+    links: [u32; 2],
+    /// The arc's length a piece (m).
+    spacing: f64,
+    /// How many pieces a cell holds (the tangents' reach).
+    reach: u32,
+}
+
+impl OnArc {
+    /// Its place in the chain of a pressed surface; the orientation, chord and scale are
+    /// set once the whole chain is known ([`finish_arcs`]).
+    fn surface_point(&self, _cell_size: f64) -> SurfacePoint {
+        SurfacePoint {
+            across: [0, 0],
+            links: [self.links, [NONE; 2]],
+            spacing: [self.spacing, 0.0],
+            reach: [self.reach, self.reach],
+            normal: self.normal,
+            share: self.share,
+            radius_offset: 0.0,
+            arc: Some(ArcPoint {
+                sign: 1.0,
+                depth: self.depth,
+                chord: 1.0,
+                radius: self.point.x[0],
+                scale: 1.0,
+            }),
+        }
+    }
+}
+
+/// The pieces of the circle (`centre`, `radius`) inside traction `i`'s box and the point
+/// of the bodies `every` nearest to each (on the bodies' side, within a cell): pieces of
+/// about a sub-cell along the arc, each with its exact share of the arc.
+fn on_arc<D: Dim>(
+    every: impl Iterator<Item = BodyPoint>,
+    loaded: &LoadedScene,
+    i: usize,
+    centre: &[f64],
+    radius: f64,
+) -> Result<Vec<OnArc>, SceneError> {
+    use std::f64::consts::{PI, TAU};
+    let s = &loaded.scene;
+    let t = &s.tractions[i];
+    let field = format!("tractions[{i}].surface");
+    let (cx, cy) = (centre[0], centre[1]);
+    let inside = |phi: f64| {
+        let (x, y) = (cx + radius * phi.cos(), cy + radius * phi.sin());
+        x >= t.min[0] && x <= t.max[0] && y >= t.min[1] && y <= t.max[1]
+    };
+    // The arc inside the box, [lo, hi] (rad, counter-clockwise from +x): sampled finely,
+    // its ends found by bisection.
+    const SAMPLES: usize = 1 << 14;
+    let at = |j: usize| -PI + TAU * j as f64 / SAMPLES as f64;
+    let flags: Vec<bool> = (0..SAMPLES).map(|j| inside(at(j))).collect();
+    let starts: Vec<usize> = (0..SAMPLES)
+        .filter(|&j| flags[j] && !flags[(j + SAMPLES - 1) % SAMPLES])
+        .collect();
+    let bisect = |mut out: f64, mut inn: f64| {
+        for _ in 0..60 {
+            let mid = 0.5 * (out + inn);
+            if inside(mid) {
+                inn = mid;
+            } else {
+                out = mid;
+            }
+        }
+        inn
+    };
+    let (lo, hi, closed) = match starts.as_slice() {
+        [] if flags[0] => (-PI, PI, true),
+        [] => {
+            return Err(loaded.invalid(
+                &format!("tractions[{i}].min"),
+                format!("traction \"{}\": its box holds no part of the circle", t.name),
+            ))
+        }
+        [j] => {
+            let end = (*j..*j + SAMPLES).find(|&k| !flags[k % SAMPLES]).expect("an end");
+            let lo = bisect(at(*j) - TAU / SAMPLES as f64, at(*j));
+            let hi = bisect(
+                at(*j) + TAU * (end - j) as f64 / SAMPLES as f64,
+                at(*j) + TAU * (end - j - 1) as f64 / SAMPLES as f64,
+            );
+            (lo, hi, false)
+        }
+        _ => {
+            return Err(loaded.invalid(
+                &format!("tractions[{i}].min"),
+                format!(
+                    "traction \"{}\": its box holds {} separate arcs of the circle; give each its \
+                     own traction",
+                    t.name,
+                    starts.len()
+                ),
+            ))
+        }
+    };
+    // The points in the box: their radius and angle from the centre.
+    let mut candidates = Vec::new();
+    let (mut outside, mut within) = (0usize, 0usize);
+    let mut sub = f64::INFINITY;
+    for p in every {
+        let x = p.x;
+        if !(0..2).all(|a| x[a] >= t.min[a] && x[a] <= t.max[a]) {
+            continue;
+        }
+        let (dx, dy) = (x[0] - cx, x[1] - cy);
+        let rho = dx.hypot(dy);
+        if rho > radius {
+            outside += 1;
+        } else {
+            within += 1;
+        }
+        let ppc = &s.bodies[p.body].points_per_cell;
+        sub = sub.min(s.grid.cell_size / ppc[0].max(ppc[1]) as f64);
+        candidates.push((p, rho, dy.atan2(dx)));
+    }
+    if candidates.is_empty() {
+        return Err(loaded.invalid(
+            &format!("tractions[{i}].min"),
+            format!("traction \"{}\": no point of a body lies in its box", t.name),
+        ));
+    }
+    // A hole's wall when the points lie outside the circle, a disc's rim when inside.
+    let hole = outside >= within;
+    let pieces = ((radius * (hi - lo) / sub).round() as usize).max(2);
+    let width = (hi - lo) / pieces as f64;
+    let mut nearest: Vec<Option<(f64, BodyPoint, f64)>> = vec![None; pieces];
+    for (p, rho, phi) in candidates {
+        if (hole && rho < radius) || (!hole && rho > radius) {
+            continue;
+        }
+        let turned = lo + (phi - lo).rem_euclid(TAU);
+        if turned >= hi {
+            continue;
+        }
+        let k = (((turned - lo) / width) as usize).min(pieces - 1);
+        let depth = (rho - radius).abs();
+        if depth > s.grid.cell_size {
+            continue;
+        }
+        if nearest[k].is_none_or(|n| depth < n.0 || (depth == n.0 && p.id < n.1.id)) {
+            nearest[k] = Some((depth, p, rho));
+        }
+    }
+    let ids: Vec<u32> = nearest.iter().map(|n| n.map_or(NONE, |n| n.1.id)).collect();
+    let reach = (s.grid.cell_size / sub).round().max(1.0) as u32;
+    let mut out = Vec::new();
+    for (k, n) in nearest.iter().enumerate() {
+        let Some((depth, point, rho)) = *n else { continue };
+        let (a, b) = (lo + k as f64 * width, lo + (k + 1) as f64 * width);
+        let share = if D::AXISYMMETRIC {
+            radius * (cx * width + radius * (b.sin() - a.sin()))
+        } else {
+            radius * width
+        };
+        if share <= 0.0 {
+            return Err(loaded.invalid(
+                &field,
+                format!(
+                    "traction \"{}\": its arc reaches r < 0 across the axis; an arc in an \
+                     axisymmetric scene lies in r ≥ 0",
+                    t.name
+                ),
+            ));
+        }
+        let side = if hole { -1.0 } else { 1.0 };
+        let normal = [
+            side * (point.x[0] - cx) / rho,
+            side * (point.x[1] - cy) / rho,
+            0.0,
+        ];
+        let link = |j: Option<usize>| j.map_or(NONE, |j| ids[j]);
+        let before = if k > 0 {
+            Some(k - 1)
+        } else {
+            closed.then_some(pieces - 1)
+        };
+        let after = if k + 1 < pieces {
+            Some(k + 1)
+        } else {
+            closed.then_some(0)
+        };
+        out.push(OnArc {
+            point,
+            share,
+            normal,
+            depth,
+            links: [link(before), link(after)],
+            spacing: radius * width,
+            reach,
+        });
+    }
+    if out.len() < 2 {
+        return Err(loaded.invalid(
+            &format!("tractions[{i}].min"),
+            format!(
+                "traction \"{}\": fewer than two points lie within a cell of its arc, which \
+                 needs a chain of them",
+                t.name
+            ),
+        ));
+    }
+    Ok(out)
+}
+
+/// Sets each arc point's orientation, chord and scale from the set-up places `places` of
+/// the arcs' points ([`ArcPoint`]).
+fn finish_arcs<D: Dim>(pressures: &mut SurfacePressures, places: &BTreeMap<u32, [f64; 3]>) {
+    if places.is_empty() {
+        return;
+    }
+    let place = |id: u32| places.get(&id).copied().unwrap_or([0.0; 3]);
+    let arcs: Vec<usize> = (0..pressures.points.len())
+        .filter(|&k| pressures.points[k].arc.is_some())
+        .collect();
+    for &k in &arcs {
+        let raw = pressures.raw_area::<D>(k, place);
+        let size = raw.iter().map(|c| c * c).sum::<f64>().sqrt();
+        let p = &mut pressures.points[k];
+        let towards = (0..3).map(|c| raw[c] * p.normal[c]).sum::<f64>();
+        let a = p.arc.as_mut().expect("an arc point");
+        a.sign = if towards >= 0.0 { 1.0 } else { -1.0 };
+        a.chord = size;
+    }
+    // The places on the wall at set-up, and each point's exact share against its area
+    // vector there.
+    let mut on: Vec<[f64; 3]> = Vec::new();
+    let xs: Vec<[f64; 3]> = pressures
+        .ids
+        .iter()
+        .map(|&id| places.get(&id).copied().unwrap_or([0.0; 3]))
+        .collect();
+    pressures.surface_places::<D>(&xs, &mut on);
+    let wall = |id: u32| on[pressures.index(id).expect("loaded")];
+    let areas: Vec<f64> = arcs
+        .iter()
+        .map(|&k| {
+            let size = pressures
+                .area::<D>(k, wall)
+                .iter()
+                .map(|c| c * c)
+                .sum::<f64>()
+                .sqrt();
+            pressures.points[k].share / size
+        })
+        .collect();
+    for (&k, scale) in arcs.iter().zip(areas) {
+        pressures.points[k].arc.as_mut().expect("an arc point").scale = scale;
+    }
 }
 
 /// Traction `i`'s points in each column across its surface's normal: key (the point's
@@ -109,7 +432,7 @@ fn outermost<D: Dim>(
     let s = &loaded.scene;
     let n = D::N;
     let t = &s.tractions[i];
-    let (normal, upper) = t.surface.axis_side();
+    let (normal, upper) = t.surface.face().expect("a face").axis_side();
     let mut outermost = Columns::new();
     for p in every {
         let x = p.x;
@@ -215,6 +538,7 @@ impl Column<'_> {
             normal: outward,
             share: self.share,
             radius_offset,
+            arc: None,
         }
     }
 }
@@ -231,13 +555,24 @@ fn shared_point(loaded: &LoadedScene, i: usize, j: usize, x: Vec<f64>) -> SceneE
     )
 }
 
+/// A point that a traction loads.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Share {
+    /// The point's id.
+    pub id: u32,
+    /// Its share of the surface (m²; m in 2D; per radian in axisymmetry).
+    pub share: f64,
+    /// The surface's outward normal there at set-up (unit, x y z).
+    pub normal: [f64; 3],
+}
+
 /// Where the tractions went.
 #[derive(Default)]
 pub(super) struct Placed {
     /// The tractions applied in increments.
     pub steps: Vec<LoadSteps>,
-    /// Each traction's points (ids) and their shares of the surface (m²; m in 2D).
-    pub shares: Vec<(String, Vec<(u32, f64)>)>,
+    /// Each traction's name and loaded points.
+    pub shares: Vec<(String, Vec<Share>)>,
     /// The points under pressures and their places in their surfaces.
     pub pressures: SurfacePressures,
 }

@@ -23,6 +23,8 @@ use std::marker::PhantomData;
 pub struct PointLoads<D, S> {
     /// The current place of each point under a pressure, in the order of its ids (scratch).
     places: Vec<[f64; 3]>,
+    /// Their places on the surface they load (scratch; [`crate::SurfacePressures`]).
+    on_surface: Vec<[f64; 3]>,
     dims: PhantomData<fn() -> (D, S)>,
 }
 
@@ -30,6 +32,7 @@ impl<D, S> Default for PointLoads<D, S> {
     fn default() -> Self {
         PointLoads {
             places: Vec::new(),
+            on_surface: Vec::new(),
             dims: PhantomData,
         }
     }
@@ -65,8 +68,9 @@ impl<D: Dim, S: Shape> System<D> for PointLoads<D, S> {
             // Over several ranks a point's neighbours along its surface may be another
             // rank's: each rank holds its own points' places and zeros, the sums all.
             ctx.comm.sum(self.places.as_flattened_mut());
+            pressures.surface_places::<D>(&self.places, &mut self.on_surface);
         }
-        let places = &self.places;
+        let places = &self.on_surface;
         let place = |id: u32| {
             places[pressures
                 .index(id)

@@ -194,3 +194,118 @@ fn a_pressure_is_given_alone_on_points_of_its_own() {
         "{e}"
     );
 }
+
+/// A quarter of a thick elastic sphere (axisymmetric, a0 = 1 m to b = 3 m, h = 0.1 m) at
+/// rest under 100 kPa on both its faces, given as `Arc`s, and then 110 kPa in its cavity.
+/// The polygon of its section has sides of 1°.
+fn thick_sphere(stages: &str) -> String {
+    let arc = |r: f64, from: f64, to: f64| -> Vec<[f64; 2]> {
+        (0..=90)
+            .map(|k| {
+                let phi = (from + (to - from) * k as f64 / 90.0).to_radians();
+                [r * phi.cos(), r * phi.sin()]
+            })
+            .collect()
+    };
+    let mut vertices = vec![[1.0, 0.0]];
+    vertices.extend(arc(3.0, 0.0, 90.0));
+    vertices.extend(arc(1.0, 90.0, 0.0).into_iter().take(90));
+    let polygon: Vec<String> = vertices
+        .iter()
+        .map(|v| format!("[{:.9}, {:.9}]", v[0].max(0.0), v[1].max(0.0)))
+        .collect();
+    format!(
+        r#"Scene(
+    dimension: Axisymmetric,
+    grid: (origin: [0.0, 0.0], cell_size: 0.1, cells: [32, 32]),
+    shape: QuadraticBSpline,
+    materials: {{ "soil": LinearElastic(density: 1700.0, youngs_modulus: 1.0e7, poisson_ratio: 0.3) }},
+    bodies: [(material: "soil", region: Polygon(vertices: [{}]), points_per_cell: [2, 2],
+              initial_stress: Isotropic(100.0e3))],
+    boundaries: [(face: XMin, condition: Roller), (face: YMin, condition: Roller)],
+    tractions: [
+        (name: "cavity", surface: Arc(centre: [0.0, 0.0], radius: 1.0), min: [0.0, 0.0], max: [1.5, 1.5], pressure: 100.0e3),
+        (name: "far field", surface: Arc(centre: [0.0, 0.0], radius: 3.0), min: [0.0, 0.0], max: [3.5, 3.5], pressure: 100.0e3),
+    ],
+    traced: [(name: "wall9", position: [1.025, 0.175]), (name: "wall27", position: [0.925, 0.475]),
+             (name: "wall45", position: [0.725, 0.725]), (name: "wall63", position: [0.475, 0.925]),
+             (name: "wall81", position: [0.175, 1.025])],
+    stages: [{stages}],
+    solver: (time_step: Courant(0.5), tolerance: 1e-4, max_time: 200.0),
+)"#,
+        polygon.join(", ")
+    )
+}
+
+/// The thick sphere's cavity pressure raised by Δp = 10 kPa: Lamé's solution (Timoshenko &
+/// Goodier 1970, §141) moves a point at r by u = Δp a³/(b³ − a³) (r/(3K) + b³/(4G r²)).
+/// The wall's five traced points, each standing for an 18° zone of the sphere (weight
+/// cos φ dφ), give the cavity's growth of volume, Σ w ρ0² u_r: −1.6 % on Lamé's, pinned
+/// (the points one by one −4.4 % at 45° to +2.3 % at 81°: the wall is a staircase of
+/// sub-cells round the circle, its loaded points up to a sub-cell from it).
+#[test]
+fn a_pressure_on_an_arc_opens_a_thick_sphere_as_lames_solution() {
+    let s = run_text(
+        "thick_sphere.ron",
+        &thick_sphere(
+            r#"(name: "in situ"), (name: "110 kPa", reset_displacements: true, tractions: {"cavity": [110.0e3]})"#,
+        ),
+    );
+    assert!(s.converged, "{:?}", s.error);
+    let (e, nu, a, b, dp): (f64, f64, f64, f64, f64) = (1.0e7, 0.3, 1.0, 3.0, 10.0e3);
+    let (k, g) = (e / (3.0 * (1.0 - 2.0 * nu)), e / (2.0 * (1.0 + nu)));
+    let lame =
+        |r: f64| dp * a.powi(3) / (b.powi(3) - a.powi(3)) * (r / (3.0 * k) + b.powi(3) / (4.0 * g * r * r));
+    let (mut grown, mut expected) = (0.0, 0.0);
+    for t in &s.traced {
+        let phi: f64 = t.name[4..].parse::<f64>().unwrap().to_radians();
+        let w = (phi + 9f64.to_radians()).sin() - (phi - 9f64.to_radians()).sin();
+        let x0 = t.initial_position;
+        let rho0 = x0[0].hypot(x0[1]);
+        let ur = (t.displacement[0] * x0[0] + t.displacement[1] * x0[1]) / rho0;
+        assert!(
+            rel(ur, lame(rho0)).abs() < 0.05,
+            "{}: u_r {ur} against {}",
+            t.name,
+            lame(rho0)
+        );
+        grown += w * rho0 * rho0 * ur;
+        expected += w * rho0 * rho0 * lame(rho0);
+    }
+    assert!(rel(grown, expected).abs() < 0.02, "{grown} against {expected}");
+    assert_eq!(grown, 0.000680910837248523, "pinned");
+}
+
+#[test]
+fn an_arc_is_loaded_by_a_pressure_in_stages_in_a_2d_scene() {
+    let sphere = thick_sphere(r#"(name: "in situ")"#);
+    let e = refusal(&sphere.replace(
+        "pressure: 100.0e3),\n        (name: \"far",
+        "traction: [1.0, 0.0]),\n        (name: \"far",
+    ));
+    assert!(
+        e.contains("tractions[0].traction") && e.contains("pressure"),
+        "{e}"
+    );
+    let e = refusal(&sphere.replacen("pressure: 100.0e3)", "pressure: 100.0e3, increments: 4)", 1));
+    assert!(
+        e.contains("tractions[0].increments") && e.contains("stages"),
+        "{e}"
+    );
+    let e = refusal(&sphere.replacen("radius: 1.0)", "radius: 0.0)", 1));
+    assert!(e.contains("tractions[0].surface.radius"), "{e}");
+    let e = refusal(&sphere.replacen("max: [1.5, 1.5]", "max: [0.5, 0.5]", 1));
+    assert!(
+        e.contains("tractions[0].min") && e.contains("no part of the circle"),
+        "{e}"
+    );
+    let e = refusal(&sphere.replacen(
+        "min: [0.0, 0.0], max: [1.5, 1.5]",
+        "min: [-1.5, 0.3], max: [1.5, 0.7]",
+        1,
+    ));
+    assert!(
+        e.contains("tractions[0].min") && e.contains("2 separate arcs"),
+        "{e}"
+    );
+}

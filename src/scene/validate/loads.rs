@@ -5,6 +5,7 @@ use super::materials::{check_cell_means, check_mass_finite, check_smoothing};
 use super::rules::*;
 use crate::error::SceneError;
 use crate::materials::MaterialModel;
+use crate::scene::spec::TractionSurface;
 
 /// Gravity, point loads, and what the materials make of them.
 pub(super) fn check_loads(r: &Rules, table: &[(String, MaterialModel)]) -> Result<(), SceneError> {
@@ -98,11 +99,45 @@ pub(super) fn check_tractions_and_traced(r: &Rules) -> Result<(), SceneError> {
                     .into(),
             );
         }
-        if t.surface.axis_side().0 >= n {
-            return r.bad(
-                &format!("tractions[{i}].surface"),
-                format!("{:?} is not a face of a {n}D grid", t.surface),
-            );
+        match (&t.surface, t.surface.face()) {
+            (_, Some(face)) if face.axis_side().0 >= n => {
+                return r.bad(
+                    &format!("tractions[{i}].surface"),
+                    format!("{face:?} is not a face of a {n}D grid"),
+                );
+            }
+            (TractionSurface::Arc { centre, radius }, _) => {
+                let field = format!("tractions[{i}].surface");
+                if n != 2 {
+                    return r.bad(
+                        &field,
+                        "an Arc is a circle in the x-y plane: a 2D or axisymmetric scene's \
+                         (a cylinder's wall in plane strain, a sphere's in axisymmetry)"
+                            .into(),
+                    );
+                }
+                r.len(&format!("{field}.centre"), centre.len())?;
+                r.finite(&format!("{field}.centre"), centre, "m")?;
+                if !(radius.is_finite() && *radius > 0.0) {
+                    return r.bad(&format!("{field}.radius"), "must be a length > 0 (m)".into());
+                }
+                if t.pressure.is_none() {
+                    return r.bad(
+                        &format!("tractions[{i}].traction"),
+                        "an Arc is loaded by a pressure (Pa), normal to it wherever it turns".into(),
+                    );
+                }
+                if t.increments.is_some() {
+                    return r.bad(
+                        &format!("tractions[{i}].increments"),
+                        "an Arc's pressure is raised in stages (`stages[k].tractions`): the \
+                         curve of load increments follows a face's settlement, which an arc \
+                         has not"
+                            .into(),
+                    );
+                }
+            }
+            _ => {}
         }
     }
     for (i, t) in s.traced.iter().enumerate() {
@@ -122,7 +157,7 @@ pub(super) fn check_has_load(r: &Rules) -> Result<(), SceneError> {
         .as_ref()
         .is_some_and(|g| g.acceleration.iter().any(|&a| a != 0.0));
     let loads = s.point_loads.iter().any(|l| l.force.iter().any(|&f| f != 0.0))
-        || s.tractions.iter().any(|t| t.vector().iter().any(|&f| f != 0.0));
+        || s.tractions.iter().any(|t| t.loads());
     // A rigid body loads the soil only when something drives it: one that holds its place
     // (a base, a wall at rest) only answers to what else acts.
     let driven = s
