@@ -133,13 +133,13 @@ fn a_run_resumed_inside_its_static_check_window_has_the_bits_of_the_run_that_nev
     resumes_bit_for_bit::<Dim2>(&loaded, true);
 }
 
-/// A rigid footing pushed into clay (`scenes/footing_rigid.ron`), checkpointed half way
-/// through its travel (inside an increment) and at the first reset after that: the resumed
-/// run ends with the same bits, the body's place, reaction and the contact's warm-start
-/// impulses included.
+/// A rigid footing pushed into clay (`scenes/footing_rigid.ron`, its first three
+/// increments), checkpointed half way through its travel (inside an increment) and at the
+/// first reset after that: the resumed run ends with the same bits, the body's place,
+/// reaction and the contact's warm-start impulses included.
 #[test]
 fn a_body_resumed_mid_penetration_has_the_bits_of_the_run_that_never_stopped() {
-    let loaded = load("footing_rigid.ron", &[]);
+    let loaded = load("footing_rigid.ron", &["rigid_bodies[0].motion.travel=0.03"]);
     let mut whole = sim::<Dim2>(&loaded);
     let r = pool(2).install(|| reference(&mut whole));
     let half = r.steps / 2;
