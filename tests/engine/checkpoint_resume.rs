@@ -296,7 +296,7 @@ fn ctrl_c_checkpoints_and_a_resumed_run_writes_the_files_of_one_never_interrupte
     let path = common::scene("slope.ron");
     let scene = path.to_str().unwrap();
     let (whole, cut) = (dir.join("whole"), dir.join("cut"));
-    let mut sets = vec!["--set", "solver.max_steps=3000"];
+    let mut sets = vec!["--set", "solver.max_steps=2000"];
     for s in &common::COARSE_SLOPE {
         sets.extend(["--set", s]);
     }
@@ -316,7 +316,7 @@ fn ctrl_c_checkpoints_and_a_resumed_run_writes_the_files_of_one_never_interrupte
     common::interrupt(child, &cut, "INT");
     let summary = common::summary_numbers(&cut);
     assert_eq!(summary["outcome"], "interrupted");
-    assert!(summary["steps"].as_u64().unwrap() < 3000);
+    assert!(summary["steps"].as_u64().unwrap() < 2000);
     assert!(cut.join("checkpoint.kdc").exists());
     let o = common::kdmpm(&["resume", cut.to_str().unwrap(), "--quiet", "--threads", "2"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));

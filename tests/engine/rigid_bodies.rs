@@ -256,44 +256,45 @@ fn a_negative_initial_pressure_is_refused_at_its_field() {
     assert!(e.contains("finite pressure ≥ 0 Pa, found -1"), "{e}");
 }
 
-/// `scenes/tbar.ron` with 2 × 2 points a cell (the scene has 3 × 3) over 0.15 D, with
-/// `extra` overrides: its summary and N = F/(c_u D) at its three static states.
+/// `scenes/tbar.ron` with 2 × 2 points a cell (the scene has 3 × 3) over 0.1 D, with
+/// `extra` overrides: its summary and N = F/(c_u D) at its two static states.
 fn coarse_tbar(extra: &[&str]) -> (kdmpm::output::summary::Summary, Vec<f64>) {
     let coarse = [
         &[
             "bodies[0].points_per_cell=[2, 2]",
-            "rigid_bodies[0].motion.travel=0.15",
+            "rigid_bodies[0].motion.travel=0.1",
         ][..],
         extra,
     ]
     .concat();
     let s = run("tbar.ron", &coarse);
     let n = factors(&s, 10.0e3);
-    assert_eq!(n.len(), 3);
+    assert_eq!(n.len(), 2);
     (s, n)
 }
 
-/// `scenes/tbar.ron`, coarser and shorter (2 × 2 points a cell, 0.15 D of travel): a
+/// `scenes/tbar.ron`, coarser and shorter (2 × 2 points a cell, 0.1 D of travel): a
 /// smooth T-bar in confined Tresca clay. Randolph & Houlsby (1984) and Martin & Randolph
 /// (2006) give N = F/(c_u D) = 9.14 for full flow round a smooth cylinder; the static
-/// states here (9.21, 9.38, 9.62) average 9.40, +2.9 %, within 5 % (the swing as the bar
-/// crosses the cells is a few per cent; over 0.25 D the mean is 9.23), and the last is
-/// pinned.
+/// states here (9.21, 9.38) average 9.30, +1.7 %, within 5 % (the swing as the bar crosses
+/// the cells is a few per cent: the third, 9.62; over 0.25 D the mean is 9.23), and the
+/// last is pinned.
 #[test]
 fn a_smooth_tbar_in_confined_tresca_clay_has_the_flow_round_factor() {
     let (s, n) = coarse_tbar(&[]);
     let mean = n.iter().sum::<f64>() / n.len() as f64;
     assert!(rel(mean, 9.14).abs() < 0.05, "N {n:?}, mean {mean} against 9.14");
-    assert_eq!(n[2], 9.617132670959384);
+    assert_eq!(n[1], 9.3768029810758);
     // No point ended a step inside the bar by more than a tenth of a cell.
     let bar = &s.rigid_bodies[0];
-    assert!((bar.travel - 0.15).abs() < 1e-12, "{bar:?}");
+    assert!((bar.travel - 0.1).abs() < 1e-12, "{bar:?}");
     assert!(bar.deepest_entry < 0.1 * 0.125, "{bar:?}");
 }
 
 /// The same T-bar fully rough (no slip where the clay presses): 11.94 for full flow round
 /// a rough cylinder (Randolph & Houlsby 1984; Martin & Randolph 2006). At h = D/8 the
-/// static states (11.55, 12.54, 12.54) average 12.21, +2.3 %; the last is pinned.
+/// static states (11.55, 12.54) average 12.05, +0.9 % (the third, 12.54); the last is
+/// pinned.
 #[test]
 fn a_rough_tbar_has_the_rough_flow_round_factor() {
     let (_, n) = coarse_tbar(&["rigid_bodies[0].interface=Rough"]);
@@ -302,7 +303,7 @@ fn a_rough_tbar_has_the_rough_flow_round_factor() {
         rel(mean, 11.94).abs() < 0.05,
         "N {n:?}, mean {mean} against 11.94"
     );
-    assert_eq!(n[2], 12.543257894351555);
+    assert_eq!(n[1], 12.535068766338998);
 }
 
 /// `scenes/block_on_rigid_base.ron`: an elastic block on a rigid base with friction
