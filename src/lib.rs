@@ -79,4 +79,4 @@ pub use scene::LoadedScene;
 pub use schedule::{FnSystem, Schedule, System, Timing};
 pub use simulation::{AnySimulation, Simulation, TracedResult};
 pub use state::SolverState;
-pub use surface_pressure::{SurfacePoint, SurfacePressures};
+pub use surface_pressure::{ArcPoint, SurfacePoint, SurfacePressures};
