@@ -60,6 +60,11 @@ pub enum Preconsolidation {
     /// p′_c itself (Pa, > 0); a point whose first stress lies outside that surface starts on
     /// the surface through it instead (normally consolidated there).
     Pressure(f64),
+    /// A pre-overburden pressure POP (Pa, ≥ 0): the surface through the point's first stress
+    /// grown by (σ′_v + POP)/σ′_v, σ′_v read as p′ + 2q/3 (the major effective stress of a
+    /// K0 state, the vertical in the ground). The ratio 1 + POP/σ′_v falls with depth, as
+    /// in a clay whose crust was loaded, dried or eroded.
+    Pop(f64),
 }
 
 /// How the water in a clay's pores behaves.
@@ -100,7 +105,7 @@ pub struct ModifiedCamClaySpec {
     pub poisson_ratio: f64,
     /// N, the specific volume on the isotropic normal compression line at p′ = 1 kPa, > 1.
     pub ncl_volume: f64,
-    /// The preconsolidation: `Ratio(R)` or `Pressure(p′_c)`.
+    /// The preconsolidation: `Ratio(R)`, `Pressure(p′_c)` or `Pop(POP)`.
     pub preconsolidation: Preconsolidation,
     /// The largest mean effective stress (Pa, > 0) the run will reach: the stiffness
     /// there, N·p′/κ, sets the time step.
@@ -187,6 +192,9 @@ impl SceneMaterial for ModifiedCamClaySpec {
                     "preconsolidation",
                     format!("a Pressure must be > 0 Pa, found {p}"),
                 );
+            }
+            Preconsolidation::Pop(pop) if !(pop.is_finite() && pop >= 0.0) => {
+                return bad("preconsolidation", format!("a Pop must be ≥ 0 Pa, found {pop}"));
             }
             _ => {}
         }
@@ -353,6 +361,7 @@ impl ModifiedCamClay {
         let pc = match self.preconsolidation {
             Preconsolidation::Ratio(r) => r * through,
             Preconsolidation::Pressure(pc) => pc.max(through),
+            Preconsolidation::Pop(pop) => through * (1.0 + pop / (p + 2.0 * q / 3.0)),
         };
         CamClayState {
             preconsolidation: pc,
@@ -602,6 +611,9 @@ mod tests {
         assert_eq!(e.field, "critical_state_ratio", "{e:?}");
         spec.critical_state_angle = None;
         spec.preconsolidation = Preconsolidation::Ratio(0.5);
+        let e = spec.model(&|f| f.to_string()).unwrap_err();
+        assert_eq!(e.field, "preconsolidation", "{e:?}");
+        spec.preconsolidation = Preconsolidation::Pop(-1.0);
         let e = spec.model(&|f| f.to_string()).unwrap_err();
         assert_eq!(e.field, "preconsolidation", "{e:?}");
         spec.preconsolidation = Preconsolidation::Ratio(1.0);

@@ -388,6 +388,45 @@ const LAYER: &str = r#"Scene(
     solver: (damping: Kinetic, time_step: Courant(0.5), tolerance: 1e-4, max_time: 50.0),
 )"#;
 
+/// The layer's clay given a pre-overburden pressure of 20 kPa instead of a ratio: each
+/// point's p′_c is the surface through its K0 stress grown by (σ′_v + 20 kPa)/σ′_v, so the
+/// ratio falls from about 10 at 0.125 m to 1.29 at 3.875 m, as in a crust.
+#[test]
+fn a_pop_gives_a_clay_an_overconsolidation_that_falls_with_depth() {
+    let out = crate::common::scratch("cam_clay", "pop");
+    std::fs::write(
+        out.join("layer.ron"),
+        LAYER.replace("preconsolidation: Ratio(2.0)", "preconsolidation: Pop(20.0e3)"),
+    )
+    .unwrap();
+    let run = crate::common::run_into(&out.join("layer.ron"), &out.join("run"), &[]);
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let vtu = crate::common::read_vtu(&out.join("run/points.vtu"));
+    let (_, pc) = &vtu["preconsolidation"];
+    let (_, stress) = &vtu["stress"];
+    let (_, y) = &vtu["Points"];
+    let mut ratios = Vec::new();
+    for k in 0..pc.len() {
+        let s = &stress[6 * k..6 * k + 6];
+        let (sv, sh) = (-s[1], -s[0]);
+        // The clay reads p′ from 1 kPa up (MIN_STIFFNESS_PRESSURE), as the layer's test.
+        let p = ((sv + 2.0 * sh) / 3.0).max(kdmpm::materials::MIN_STIFFNESS_PRESSURE);
+        let q = sv - sh;
+        let through = p + q * q / (M * M * p);
+        let ratio = pc[k] / through;
+        let expected = 1.0 + 20.0e3 / (p + 2.0 * q / 3.0);
+        assert!(
+            rel(ratio, expected).abs() < 0.01,
+            "point {k} at y {}: R {ratio} against {expected}",
+            y[3 * k + 1],
+        );
+        ratios.push((4.0 - y[3 * k + 1], ratio));
+    }
+    ratios.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let (top, bottom) = (ratios[0], ratios[ratios.len() - 1]);
+    assert!(top.1 > 3.0 && bottom.1 < 1.4, "{top:?} {bottom:?}");
+}
+
 #[test]
 fn a_clay_given_after_a_geostatic_stage_starts_from_its_k0_state() {
     // Each point's p′_c is R times the isotropic pressure of the surface through the K0
