@@ -2,7 +2,7 @@
 
 use super::loaded::LoadedScene;
 use super::region::BodyPoint;
-use super::spec::TractionSurface;
+use super::spec::{TractionSpec, TractionSurface};
 use crate::components::*;
 use crate::dim::Dim;
 use crate::error::SceneError;
@@ -69,7 +69,7 @@ pub(super) fn place<D: Dim, I: Iterator<Item = BodyPoint>>(
                         normal: q.normal,
                     });
                     arc_places.insert(id, q.point.x);
-                    followers.push((id, q.surface_point(s.grid.cell_size)));
+                    followers.push((id, q.surface_point()));
                 }
                 placed.shares.push((t.name.clone(), shares));
                 continue;
@@ -175,7 +175,7 @@ struct OnArc {
 impl OnArc {
     /// Its place in the chain of a pressed surface; the orientation, chord and scale are
     /// set once the whole chain is known ([`finish_arcs`]).
-    fn surface_point(&self, _cell_size: f64) -> SurfacePoint {
+    fn surface_point(&self) -> SurfacePoint {
         SurfacePoint {
             across: [0, 0],
             links: [self.links, [NONE; 2]],
@@ -205,91 +205,36 @@ fn on_arc<D: Dim>(
     centre: &[f64],
     radius: f64,
 ) -> Result<Vec<OnArc>, SceneError> {
-    use std::f64::consts::{PI, TAU};
+    use std::f64::consts::TAU;
     let s = &loaded.scene;
     let t = &s.tractions[i];
-    let field = format!("tractions[{i}].surface");
     let (cx, cy) = (centre[0], centre[1]);
-    let inside = |phi: f64| {
-        let (x, y) = (cx + radius * phi.cos(), cy + radius * phi.sin());
-        x >= t.min[0] && x <= t.max[0] && y >= t.min[1] && y <= t.max[1]
-    };
-    // The arc inside the box, [lo, hi] (rad, counter-clockwise from +x): sampled finely,
-    // its ends found by bisection.
-    const SAMPLES: usize = 1 << 14;
-    let at = |j: usize| -PI + TAU * j as f64 / SAMPLES as f64;
-    let flags: Vec<bool> = (0..SAMPLES).map(|j| inside(at(j))).collect();
-    let starts: Vec<usize> = (0..SAMPLES)
-        .filter(|&j| flags[j] && !flags[(j + SAMPLES - 1) % SAMPLES])
-        .collect();
-    let bisect = |mut out: f64, mut inn: f64| {
-        for _ in 0..60 {
-            let mid = 0.5 * (out + inn);
-            if inside(mid) {
-                inn = mid;
-            } else {
-                out = mid;
-            }
-        }
-        inn
-    };
-    let (lo, hi, closed) = match starts.as_slice() {
-        [] if flags[0] => (-PI, PI, true),
-        [] => {
+    let (lo, hi, closed) = match arc_in_box(t, centre, radius) {
+        Ok(span) => span,
+        Err(0) => {
             return Err(loaded.invalid(
                 &format!("tractions[{i}].min"),
                 format!("traction \"{}\": its box holds no part of the circle", t.name),
             ))
         }
-        [j] => {
-            let end = (*j..*j + SAMPLES).find(|&k| !flags[k % SAMPLES]).expect("an end");
-            let lo = bisect(at(*j) - TAU / SAMPLES as f64, at(*j));
-            let hi = bisect(
-                at(*j) + TAU * (end - j) as f64 / SAMPLES as f64,
-                at(*j) + TAU * (end - j - 1) as f64 / SAMPLES as f64,
-            );
-            (lo, hi, false)
-        }
-        _ => {
+        Err(arcs) => {
             return Err(loaded.invalid(
                 &format!("tractions[{i}].min"),
                 format!(
-                    "traction \"{}\": its box holds {} separate arcs of the circle; give each its \
-                     own traction",
-                    t.name,
-                    starts.len()
+                    "traction \"{}\": its box holds {arcs} separate arcs of the circle; give each \
+                     its own traction",
+                    t.name
                 ),
             ))
         }
     };
-    // The points in the box: their radius and angle from the centre.
-    let mut candidates = Vec::new();
-    let (mut outside, mut within) = (0usize, 0usize);
-    let mut sub = f64::INFINITY;
-    for p in every {
-        let x = p.x;
-        if !(0..2).all(|a| x[a] >= t.min[a] && x[a] <= t.max[a]) {
-            continue;
-        }
-        let (dx, dy) = (x[0] - cx, x[1] - cy);
-        let rho = dx.hypot(dy);
-        if rho > radius {
-            outside += 1;
-        } else {
-            within += 1;
-        }
-        let ppc = &s.bodies[p.body].points_per_cell;
-        sub = sub.min(s.grid.cell_size / ppc[0].max(ppc[1]) as f64);
-        candidates.push((p, rho, dy.atan2(dx)));
-    }
+    let (candidates, sub, hole) = around(every, loaded, t, centre, radius);
     if candidates.is_empty() {
         return Err(loaded.invalid(
             &format!("tractions[{i}].min"),
             format!("traction \"{}\": no point of a body lies in its box", t.name),
         ));
     }
-    // A hole's wall when the points lie outside the circle, a disc's rim when inside.
-    let hole = outside >= within;
     let pieces = ((radius * (hi - lo) / sub).round() as usize).max(2);
     let width = (hi - lo) / pieces as f64;
     let mut nearest: Vec<Option<(f64, BodyPoint, f64)>> = vec![None; pieces];
@@ -323,7 +268,7 @@ fn on_arc<D: Dim>(
         };
         if share <= 0.0 {
             return Err(loaded.invalid(
-                &field,
+                &format!("tractions[{i}].surface"),
                 format!(
                     "traction \"{}\": its arc reaches r < 0 across the axis; an arc in an \
                      axisymmetric scene lies in r ≥ 0",
@@ -369,6 +314,82 @@ fn on_arc<D: Dim>(
         ));
     }
     Ok(out)
+}
+
+/// The points of the bodies `every` in traction `t`'s box with their radius and angle from
+/// the circle's `centre`; the smallest sub-cell among them (m); whether the circle is a
+/// hole's wall (the points lie outside it) rather than a disc's rim.
+fn around(
+    every: impl Iterator<Item = BodyPoint>,
+    loaded: &LoadedScene,
+    t: &TractionSpec,
+    centre: &[f64],
+    radius: f64,
+) -> (Vec<(BodyPoint, f64, f64)>, f64, bool) {
+    let s = &loaded.scene;
+    let (cx, cy) = (centre[0], centre[1]);
+    let mut candidates = Vec::new();
+    let (mut outside, mut within) = (0usize, 0usize);
+    let mut sub = f64::INFINITY;
+    for p in every {
+        let x = p.x;
+        if !(0..2).all(|a| x[a] >= t.min[a] && x[a] <= t.max[a]) {
+            continue;
+        }
+        let (dx, dy) = (x[0] - cx, x[1] - cy);
+        let rho = dx.hypot(dy);
+        if rho > radius {
+            outside += 1;
+        } else {
+            within += 1;
+        }
+        let ppc = &s.bodies[p.body].points_per_cell;
+        sub = sub.min(s.grid.cell_size / ppc[0].max(ppc[1]) as f64);
+        candidates.push((p, rho, dy.atan2(dx)));
+    }
+    (candidates, sub, outside >= within)
+}
+
+/// The arc of the circle (`centre`, `radius`) inside traction `t`'s box, as its ends
+/// [lo, hi] (rad, counter-clockwise from +x) and whether it is the whole circle: sampled
+/// finely, its ends found by bisection. Err(n): the box holds n ≠ 1 separate arcs.
+fn arc_in_box(t: &TractionSpec, centre: &[f64], radius: f64) -> Result<(f64, f64, bool), usize> {
+    use std::f64::consts::{PI, TAU};
+    const SAMPLES: usize = 1 << 14;
+    let (cx, cy) = (centre[0], centre[1]);
+    let inside = |phi: f64| {
+        let (x, y) = (cx + radius * phi.cos(), cy + radius * phi.sin());
+        x >= t.min[0] && x <= t.max[0] && y >= t.min[1] && y <= t.max[1]
+    };
+    let at = |j: usize| -PI + TAU * j as f64 / SAMPLES as f64;
+    let flags: Vec<bool> = (0..SAMPLES).map(|j| inside(at(j))).collect();
+    let starts: Vec<usize> = (0..SAMPLES)
+        .filter(|&j| flags[j] && !flags[(j + SAMPLES - 1) % SAMPLES])
+        .collect();
+    let bisect = |mut out: f64, mut inn: f64| {
+        for _ in 0..60 {
+            let mid = 0.5 * (out + inn);
+            if inside(mid) {
+                inn = mid;
+            } else {
+                out = mid;
+            }
+        }
+        inn
+    };
+    match starts.as_slice() {
+        [] if flags[0] => Ok((-PI, PI, true)),
+        [j] => {
+            let end = (*j..*j + SAMPLES).find(|&k| !flags[k % SAMPLES]).expect("an end");
+            let lo = bisect(at(*j) - TAU / SAMPLES as f64, at(*j));
+            let hi = bisect(
+                at(*j) + TAU * (end - j) as f64 / SAMPLES as f64,
+                at(*j) + TAU * (end - j - 1) as f64 / SAMPLES as f64,
+            );
+            Ok((lo, hi, false))
+        }
+        _ => Err(starts.len()),
+    }
 }
 
 /// Sets each arc point's orientation, chord and scale from the set-up places `places` of
