@@ -700,24 +700,27 @@ fn an_open_or_missing_stl_mesh_or_one_in_a_plane_scene_is_refused() {
 
 /// `scenes/ball_3d.ron` over its first 0.2 D (h = D/4, a quarter ball): a smooth sphere
 /// in confined Tresca clay. Randolph, Martin & Hu (2000) give N = F/(c_u π D²/4) = 11.0
-/// for full flow round a smooth sphere; the two static states here (12.25, 11.87) average
-/// 12.06, +9.6 %, within 10 %, and the second is pinned. Over the second diameter the
-/// scene's mean is 11.75 (+6.8 %; docs/verification.md).
+/// for full flow round a smooth sphere; the two static states here (11.31, 11.43) average
+/// 11.37, +3.4 %, within 5 %, and the second is pinned. Over the second diameter the
+/// scene's mean is 11.28 (+2.5 %; docs/verification.md).
 #[test]
 fn a_smooth_ball_in_confined_tresca_clay_has_the_flow_round_factor() {
     let s = run("ball_3d.ron", &["rigid_bodies[0].motion.travel=0.2"]);
     let n = factors(&s, 10.0e3);
     assert_eq!(n.len(), 2);
     let mean = n.iter().sum::<f64>() / 2.0;
-    assert!(rel(mean, 11.0).abs() < 0.10, "N {n:?}, mean {mean} against 11.0");
-    assert_eq!(n[1], 11.868216445944032);
+    assert!(rel(mean, 11.0).abs() < 0.05, "N {n:?}, mean {mean} against 11.0");
+    assert_eq!(n[1], 11.429779739433881);
     let ball = &s.rigid_bodies[0];
     assert!(ball.deepest_entry < 0.1 * 0.25, "{ball:?}");
 }
 
 /// `scenes/ball_3d.ron`'s ball read from an STL file, a UV sphere of `around` × `rings`
 /// pieces, over its first 0.2 D: the mean N, checked within 2 % of the smooth `Sphere`'s
-/// 12.06 (the test above) and returned.
+/// and returned. Both at the paper's tolerance 0.01, where the sphere's two states read
+/// 12.25 and 11.87 (mean 12.06), at 60 % of the steps the scene's 1e-3 takes: the facets
+/// are set against the sphere at the same tolerance (at 1e-3 the 528 and 3 480 triangles
+/// read −0.1 % and −1.7 % on the sphere's 11.37).
 fn faceted_ball(around: usize, rings: usize) -> f64 {
     let dir = common::scratch("rigid_bodies", &format!("faceted_ball_{around}"));
     let text = std::fs::read_to_string(common::scene("ball_3d.ron"))
@@ -726,7 +729,8 @@ fn faceted_ball(around: usize, rings: usize) -> f64 {
             "Sphere(centre: [0.0, 0.0, 4.0], radius: 0.5)",
             r#"Mesh(file: "ball.stl")"#,
         )
-        .replace("travel: 2.0", "travel: 0.2");
+        .replace("travel: 2.0", "travel: 0.2")
+        .replace("tolerance: 1.0e-3", "tolerance: 0.01");
     let sphere = (12.247583251817822 + 11.868216445944032) / 2.0;
     let t = kdmpm::rigid::mesh::sphere_triangles([0.0, 0.0, 4.0], 0.5, around, rings);
     std::fs::write(
