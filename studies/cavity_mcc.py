@@ -172,6 +172,63 @@ def compare_sphere(path, out):
             f"{s['stage']} | {ratio:.4f} | {psi:.1f} | {ref / 1e3:.2f} | "
             f"{(psi * 1e3 / ref - 1) * 100:+.2f} % | {u / 1e3:.2f}"
         )
+    # The last stage's points.vtu: the excess pore pressure of the clay a cell out from the
+    # wall against the reference at each point's own strain.
+    near_wall(path, out, grown, e_b)
+
+
+def vtu_arrays(name, wanted):
+    """The arrays `wanted` of a points.vtu (raw appended, UInt64 headers), as lists of
+    tuples (or numbers), by name; 'points' for the positions."""
+    import re
+    import struct
+
+    data = open(name, "rb").read()
+    head, _, rest = data.partition(b'<AppendedData encoding="raw">')
+    blob = rest[rest.index(b"_") + 1 :]
+    found = {}
+    for m in re.finditer(rb"<DataArray ([^>]*)/>", head):
+        attrs = dict(re.findall(rb'(\w+)="([^"]*)"', m.group(1)))
+        key = attrs.get(b"Name", b"points").decode()
+        if key not in wanted or attrs[b"type"] != b"Float64":
+            continue
+        off = int(attrs[b"offset"])
+        size = struct.unpack("<Q", blob[off : off + 8])[0]
+        values = struct.unpack(f"<{size // 8}d", blob[off + 8 : off + 8 + size])
+        nc = int(attrs.get(b"NumberOfComponents", b"1"))
+        found[key] = [values[i : i + nc] for i in range(0, len(values), nc)] if nc > 1 else list(values)
+    return found
+
+
+def near_wall(path, out, grown, e_b, band=(1.075, 1.175)):
+    """The clay that started `band` m from the centre (about a cell out from the cavity's
+    wall at a0 = 1 m, past the loaded points): its excess pore pressure at the last stage
+    and the reference's at each point's strain, e = ln(rho/rho0) with rho^3 = rho0^3 +
+    (a^3 - a0^3), u = sigma_r - 2q/3 - p' (sigma_r from the integral between e_b and e)."""
+    import os
+
+    name = out + "/points.vtu"
+    if not os.path.exists(name):
+        return
+    a = vtu_arrays(name, {"points", "displacement", "excess_pore_pressure"})
+    engine, ref = [], []
+    for x, d, u in zip(a["points"], a["displacement"], a["excess_pore_pressure"]):
+        rho0 = math.hypot(x[0] - d[0], x[1] - d[1])
+        if not band[0] < rho0 < band[1]:
+            continue
+        rho = (rho0**3 + grown) ** (1 / 3)
+        e = math.log(rho / rho0)
+        q, p = q_at(path, 2 * e)
+        sigma_r = P0 + pressure(path, e, True, n=2000, e_b=e_b)
+        engine.append(u)
+        ref.append(sigma_r - 2 * q / 3 - p)
+    if engine:
+        mean = lambda v: sum(v) / len(v) / 1e3
+        print(
+            f"clay {band[0]}-{band[1]} m out at the start ({len(engine)} points): excess pore "
+            f"pressure {mean(engine):.1f} kPa ({min(engine) / 1e3:.1f} to {max(engine) / 1e3:.1f}), "
+            f"reference {mean(ref):.1f} kPa ({min(ref) / 1e3:.1f} to {max(ref) / 1e3:.1f})"
+        )
 
 
 def main():
