@@ -404,7 +404,6 @@ fn a_smooth_ball_on_the_axis_has_the_flow_round_factor() {
     let n = factors(&s, 10.0e3);
     assert_eq!(n.len(), 3);
     let mean = n.iter().sum::<f64>() / 3.0;
-    let mean = n.iter().sum::<f64>() / 3.0;
     assert!(n.iter().all(|&f| f < 11.0), "N {n:?} against 11.0");
     assert!(rel(mean, 11.0).abs() < 0.10, "N {n:?}, mean {mean} against 11.0");
     assert_eq!(n[2], 10.357935869704056);
