@@ -172,9 +172,10 @@ def compare_sphere(path, out):
             f"{s['stage']} | {ratio:.4f} | {psi:.1f} | {ref / 1e3:.2f} | "
             f"{(psi * 1e3 / ref - 1) * 100:+.2f} % | {u / 1e3:.2f}"
         )
-    # The last stage's points.vtu: the excess pore pressure of the clay a cell out from the
-    # wall against the reference at each point's own strain.
-    near_wall(path, out, grown, e_b)
+    # The last stage's points.vtu: the excess pore pressure of the clay in shells out from
+    # the wall against the reference at each point's own strain.
+    for band in ((1.075, 1.175), (1.175, 1.275), (1.275, 1.4), (1.4, 1.6)):
+        near_wall(path, out, grown, e_b, band)
 
 
 def vtu_arrays(name, wanted):
@@ -200,11 +201,12 @@ def vtu_arrays(name, wanted):
     return found
 
 
-def near_wall(path, out, grown, e_b, band=(1.075, 1.175)):
-    """The clay that started `band` m from the centre (about a cell out from the cavity's
-    wall at a0 = 1 m, past the loaded points): its excess pore pressure at the last stage
-    and the reference's at each point's strain, e = ln(rho/rho0) with rho^3 = rho0^3 +
-    (a^3 - a0^3), u = sigma_r - 2q/3 - p' (sigma_r from the integral between e_b and e)."""
+def near_wall(path, out, grown, e_b, band):
+    """The clay that started `band` m from the centre (the first, from 1.075 m, about a cell
+    out from the cavity's wall at a0 = 1 m, past the loaded points): its excess pore
+    pressure at the last stage (mean, median, range) and the reference's mean at each
+    point's strain, e = ln(rho/rho0) with rho^3 = rho0^3 + (a^3 - a0^3),
+    u = sigma_r - 2q/3 - p' (sigma_r from the integral between e_b and e)."""
     import os
 
     name = out + "/points.vtu"
@@ -224,9 +226,11 @@ def near_wall(path, out, grown, e_b, band=(1.075, 1.175)):
         ref.append(sigma_r - 2 * q / 3 - p)
     if engine:
         mean = lambda v: sum(v) / len(v) / 1e3
+        median = sorted(engine)[len(engine) // 2] / 1e3
         print(
-            f"clay {band[0]}-{band[1]} m out at the start ({len(engine)} points): excess pore "
-            f"pressure {mean(engine):.1f} kPa ({min(engine) / 1e3:.1f} to {max(engine) / 1e3:.1f}), "
+            f"clay {band[0]}-{band[1]} m from the centre at the start ({len(engine)} points): "
+            f"excess pore pressure mean {mean(engine):.1f} kPa, median {median:.1f} "
+            f"({min(engine) / 1e3:.1f} to {max(engine) / 1e3:.1f}); "
             f"reference {mean(ref):.1f} kPa ({min(ref) / 1e3:.1f} to {max(ref) / 1e3:.1f})"
         )
 
