@@ -359,6 +359,12 @@ impl TractionSurface {
 }
 
 impl TractionSpec {
+    /// Whether the place `x` (m, one entry an axis of the box) lies in its box, faces
+    /// included.
+    pub fn holds(&self, x: &[f64]) -> bool {
+        (0..self.min.len()).all(|a| x[a] >= self.min[a] && x[a] <= self.max[a])
+    }
+
     /// Whether it loads at all: a non-zero pressure or traction entry.
     pub fn loads(&self) -> bool {
         match self.pressure {

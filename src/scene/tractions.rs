@@ -333,7 +333,7 @@ fn around(
     let mut sub = f64::INFINITY;
     for p in every {
         let x = p.x;
-        if !(0..2).all(|a| x[a] >= t.min[a] && x[a] <= t.max[a]) {
+        if !t.holds(&x) {
             continue;
         }
         let (dx, dy) = (x[0] - cx, x[1] - cy);
@@ -357,10 +357,7 @@ fn arc_in_box(t: &TractionSpec, centre: &[f64], radius: f64) -> Result<(f64, f64
     use std::f64::consts::{PI, TAU};
     const SAMPLES: usize = 1 << 14;
     let (cx, cy) = (centre[0], centre[1]);
-    let inside = |phi: f64| {
-        let (x, y) = (cx + radius * phi.cos(), cy + radius * phi.sin());
-        x >= t.min[0] && x <= t.max[0] && y >= t.min[1] && y <= t.max[1]
-    };
+    let inside = |phi: f64| t.holds(&[cx + radius * phi.cos(), cy + radius * phi.sin()]);
     let at = |j: usize| -PI + TAU * j as f64 / SAMPLES as f64;
     let flags: Vec<bool> = (0..SAMPLES).map(|j| inside(at(j))).collect();
     let starts: Vec<usize> = (0..SAMPLES)
@@ -457,7 +454,7 @@ fn outermost<D: Dim>(
     let mut outermost = Columns::new();
     for p in every {
         let x = p.x;
-        if !(0..n).all(|a| x[a] >= t.min[a] && x[a] <= t.max[a]) {
+        if !t.holds(&x) {
             continue;
         }
         let ppc = &s.bodies[p.body].points_per_cell;
