@@ -174,8 +174,13 @@ def compare_sphere(path, out):
         )
     # The last stage's points.vtu: the excess pore pressure of the clay in shells out from
     # the wall against the reference at each point's own strain.
+    import os
+
+    if not os.path.exists(out + "/points.vtu"):
+        return
+    points = vtu_arrays(out + "/points.vtu", {"points", "displacement", "excess_pore_pressure"})
     for band in ((1.075, 1.175), (1.175, 1.275), (1.275, 1.4), (1.4, 1.6)):
-        near_wall(path, out, grown, e_b, band)
+        near_wall(path, points, grown, e_b, band)
 
 
 def vtu_arrays(name, wanted):
@@ -201,18 +206,13 @@ def vtu_arrays(name, wanted):
     return found
 
 
-def near_wall(path, out, grown, e_b, band):
+def near_wall(path, a, grown, e_b, band):
     """The clay that started `band` m from the centre (the first, from 1.075 m, about a cell
     out from the cavity's wall at a0 = 1 m, past the loaded points): its excess pore
     pressure at the last stage (mean, median, range) and the reference's mean at each
     point's strain, e = ln(rho/rho0) with rho^3 = rho0^3 + (a^3 - a0^3),
-    u = sigma_r - 2q/3 - p' (sigma_r from the integral between e_b and e)."""
-    import os
-
-    name = out + "/points.vtu"
-    if not os.path.exists(name):
-        return
-    a = vtu_arrays(name, {"points", "displacement", "excess_pore_pressure"})
+    u = sigma_r - 2q/3 - p' (sigma_r from the integral between e_b and e); `a` holds the
+    last stage's points.vtu arrays (`vtu_arrays`)."""
     engine, ref = [], []
     for x, d, u in zip(a["points"], a["displacement"], a["excess_pore_pressure"]):
         rho0 = math.hypot(x[0] - d[0], x[1] - d[1])
