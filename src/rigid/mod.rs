@@ -15,6 +15,7 @@
 //! the soil's at each kinetic-energy peak.
 
 pub mod contact;
+pub mod corners;
 pub mod cpt;
 pub mod filter;
 pub mod geometry;
@@ -24,6 +25,7 @@ pub mod sampling;
 pub mod stl;
 
 pub use contact::Contact;
+pub use corners::{CornerTest, Corners};
 pub use cpt::{Cpt, CptSpec, InSitu};
 pub use filter::FilterSpec;
 pub use geometry::{Geometry, Sample};
@@ -44,6 +46,10 @@ pub struct RigidBodySpec {
     /// How the soil slides along it (along every part that does not give its own).
     #[serde(default)]
     pub interface: Interface,
+    /// Whether its contact samples hold the soil past its corners (`Held`, the default) or
+    /// let it go (`Released`, [`corners`]).
+    #[serde(default)]
+    pub corners: Corners,
     /// How it moves; without one the body holds its place (a rigid base, a wall at rest)
     /// and its reaction is recorded at every static state another control reaches.
     #[serde(default)]

@@ -3,7 +3,9 @@
 //! Each body's surface is sampled every half cell ([`crate::rigid::Sample`]: a place, the
 //! geometry's outward normal n and the surface it stands for). At a sample x_s the soil's
 //! velocity is the grid's, v(x_s) = Σ_i w_i(x_s) v_i / Σ_i w_i over the nodes that carry
-//! soil, built from the trial velocities v_i* = p_i/m_i + f_i Δt/m̃_i (m̃ the node's
+//! soil (with `corners: Released`, less those outside the body that face a corner of it,
+//! [`crate::rigid::corners`]: past a footing's edge the soil is not under its base), built
+//! from the trial velocities v_i* = p_i/m_i + f_i Δt/m̃_i (m̃ the node's
 //! inertia, as `integrate` takes it). Contact holds (v(x_s) − v_b)·n ≥ 0: the soil may
 //! leave the body but not enter it. A violated sample takes an impulse λ n spread over its
 //! nodes as Δv_i = λ w_i n / m̃_i, with λ = −C / Σ w_i²/m̃_i for the violation C; the
@@ -36,6 +38,7 @@ use crate::error::StepError;
 use crate::grid::NodeBox;
 use crate::infra::columns::{col, col_mut, nodes};
 use crate::rigid::contact::{key, remember, solve, Contact, Contacts, Memory, Slot};
+use crate::rigid::{CornerTest, Corners};
 use crate::schedule::System;
 use crate::shape::{for_each_node, Shape};
 use crate::systems::exchange::{exchange, EXTERNAL, FORCE, MASS, MOMENTUM};
@@ -179,7 +182,9 @@ fn soil<'a, D: Dim, S: Shape>(
 
 /// Places every sample that meets soil at its body's current place: its nodes that carry
 /// soil and their weights, each node's trial velocity p/m + f Δt/m̃. A sample meets soil
-/// when nodes carrying mass hold at least half its support. `slot_of` (one entry a node)
+/// when nodes carrying mass hold at least half its support; it holds them all, or with
+/// `corners: Released` those that do not face a corner of the body
+/// ([`crate::rigid::corners`]). `slot_of` (one entry a node)
 /// is all `u32::MAX` on entry and is left so.
 fn place<D: Dim, S: Shape>(ctx: &Context<D>, soil: &Soil<D>, slot_of: &mut Vec<u32>) -> Contacts {
     let fix = col::<NodeFixity>(nodes(&ctx.world));
@@ -237,6 +242,15 @@ fn place<D: Dim, S: Shape>(ctx: &Context<D>, soil: &Soil<D>, slot_of: &mut Vec<u
                 impulse: [0.0; 3],
             });
         }
+        // The grid's corners in the body's starting frame.
+        let (lo, hi) = (D::vec_to3(grid.origin), D::vec_to3(grid.max_corner()));
+        let corners = (spec.corners == Corners::Released).then(|| CornerTest {
+            parts: &spec.parts,
+            n: D::N,
+            lo: std::array::from_fn(|a| lo[a] - state.offset[a]),
+            hi: std::array::from_fn(|a| hi[a] - state.offset[a]),
+            tolerance: 1e-9 * grid.cell_size,
+        });
         for (index, (s, part)) in body.samples.iter().enumerate() {
             let x3: [f64; 3] = std::array::from_fn(|a| s.x[a] + state.offset[a]);
             let x = D::vec_from(x3);
@@ -244,16 +258,28 @@ fn place<D: Dim, S: Shape>(ctx: &Context<D>, soil: &Soil<D>, slot_of: &mut Vec<u
                 continue;
             }
             let mut reach = Vec::new();
-            let mut weight = 0.0;
+            // Σ w over the nodes that carry soil (whether the sample meets soil), and over
+            // those it holds.
+            let (mut soil_weight, mut weight) = (0.0, 0.0);
             for_each_node::<D, S>(grid, x, |i, w, _| {
                 if w <= 0.0 || !grid.carries(i, soil.at(i).0, st.min_node_mass) {
                     return;
+                }
+                soil_weight += w;
+                // With `Released` corners, not a node beyond the body that faces a corner.
+                if let Some(test) = &corners {
+                    let xn = D::vec_to3(grid.node_position(grid.node_ijk(i)));
+                    let at: [f64; 3] = std::array::from_fn(|a| xn[a] - state.offset[a]);
+                    let (phi, n, _) = spec.distance(at, D::N);
+                    if !test.holds(at, phi, n, s.normal) {
+                        return;
+                    }
                 }
                 let k = slot(&mut set.slots, slot_of, i);
                 reach.push((k, w));
                 weight += w;
             });
-            if weight < 0.5 {
+            if soil_weight < 0.5 || weight <= 0.0 {
                 continue;
             }
             // The sample's surface, per radian when axisymmetric (as volumes are).

@@ -1,0 +1,247 @@
+//! Which grid nodes beyond a body's surface a surface sample holds: not those that face a
+//! corner of the body.
+//!
+//! A sample's soil velocity is the mean of its nodes' (`systems::rigid_contact`), and the
+//! nodes at and inside the body already move with it; so whatever node outside the body a
+//! sample reaches moves with it too, up to 1.5 h beyond the surface. Under a flat face that
+//! is the soil the face pushes. Past a corner it is not: below a footing's edge the soil
+//! within a node's distance of the edge is not under the base (Prandtl's active wedge
+//! narrows to nothing at the edge), and holding it to the base widened a rigid strip
+//! footing by that band, +11.6 % on Prandtl's pressure at h = B/8 (+9.2 % at B/16; the
+//! node-driven footing, which holds one row, −2 %).
+//!
+//! The test is the node's mirror image in the surface. A node at distance φ outside the
+//! body, with outward normal n at its nearest surface point, has its mirror at
+//! q = x − 2φ n, at depth φ in the body. Where the surface round the node's foot is flat
+//! (or curves away, as a sphere's) no surface point lies nearer q than φ; where it turns at
+//! a corner within that reach, the other face does. A sample does not hold a node when a
+//! point of the body's surface nearer its mirror than φ has a normal more than 45° from
+//! the sample's own ([`CORNER`]): a box's or a footing's edge (90°) and a pile's base edge
+//! are corners; a cone's shoulder (30°) and a faceted sphere's edges are not. A node
+//! diagonally past an edge, whose nearest surface point is the edge itself, mirrors to a
+//! point as far from the side as the node is, nearer than φ: not held either.
+//!
+//! The surface is each part's own (its exact geometry: the nearest point of each part to
+//! the mirror, of each edge of a polygon), less what is not the body's surface: a point inside another part (the face
+//! a cone's tip and shaft share) or on or beyond a face of the grid (the axis of an
+//! axisymmetric cone or pile, a wall's foot on the grid's base), where no soil flows round.
+
+use super::{Geometry, PartSpec};
+use serde::{Deserialize, Serialize};
+
+/// cos 45°: a surface point whose normal's cosine with a sample's is below this is
+/// another face.
+pub const CORNER: f64 = std::f64::consts::FRAC_1_SQRT_2;
+
+/// Whether a body's contact samples hold the soil past its corners (`corners` of a rigid
+/// body in a scene).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Corners {
+    /// A sample holds every node of its support that carries soil.
+    #[default]
+    Held,
+    /// A sample does not hold the nodes past a corner ([`CornerTest`]).
+    Released,
+}
+
+/// A body's corner test in a grid (`systems::rigid_contact` places one per body a step).
+#[derive(Clone, Copy, Debug)]
+pub struct CornerTest<'a> {
+    /// The body's parts.
+    pub parts: &'a [PartSpec],
+    /// Dimensions.
+    pub n: usize,
+    /// The grid's corners (m) in the body's starting frame (less its displacement): a
+    /// surface point on or beyond a face of the grid is not one the soil flows round.
+    pub lo: [f64; 3],
+    /// Upper corner, as `lo`.
+    pub hi: [f64; 3],
+    /// Distances below this (m) are on a face: 1e-9 cell.
+    pub tolerance: f64,
+}
+
+impl CornerTest<'_> {
+    /// Whether `x` (body frame) is a point of the body's surface the soil can meet: not
+    /// inside a part other than `part`, nor on or beyond a face of the grid.
+    fn open(&self, x: [f64; 3], part: usize) -> bool {
+        let t = self.tolerance;
+        (0..self.n).all(|a| x[a] > self.lo[a] + t && x[a] < self.hi[a] - t)
+            && self
+                .parts
+                .iter()
+                .enumerate()
+                .all(|(j, p)| j == part || p.geometry.distance(x, self.n).0 > t)
+    }
+
+    /// Whether a sample with outward `normal` holds a node at `at` (body frame, m) that
+    /// lies `phi` m from the body (outside when positive) with outward normal `nearest` at
+    /// its nearest surface point: false when a surface point nearer the node's mirror
+    /// `at − 2 φ n` than φ has a normal more than 45° from `normal`.
+    pub fn holds(&self, at: [f64; 3], phi: f64, nearest: [f64; 3], normal: [f64; 3]) -> bool {
+        if phi <= self.tolerance {
+            return true;
+        }
+        let q: [f64; 3] = std::array::from_fn(|a| at[a] - 2.0 * phi * nearest[a]);
+        let reach = phi * (1.0 - 1e-9);
+        // A face nearer the mirror than φ, turned from the sample's, and the body's surface.
+        let corner = |p: [f64; 3], m: [f64; 3], k: usize| {
+            let d2: f64 = (0..3).map(|a| (p[a] - q[a]).powi(2)).sum();
+            let cos: f64 = (0..3).map(|a| m[a] * normal[a]).sum();
+            d2 < reach * reach && cos < CORNER && self.open(p, k)
+        };
+        for (k, part) in self.parts.iter().enumerate() {
+            if let Geometry::Polygon { vertices } = &part.geometry {
+                // Each edge's nearest point: a polygon's nearest edge may be one it shares
+                // with another part, with a face of the body behind it.
+                if polygon_edges(vertices, q).any(|(p, m)| corner(p, m, k)) {
+                    return false;
+                }
+            } else {
+                let (d, m) = part.geometry.distance(q, self.n);
+                let p: [f64; 3] = std::array::from_fn(|a| q[a] - d * m[a]);
+                if corner(p, m, k) {
+                    return false;
+                }
+            }
+        }
+        true
+    }
+}
+
+/// Each edge of a polygon: its nearest point to `x` and its outward normal.
+fn polygon_edges(v: &[Vec<f64>], x: [f64; 3]) -> impl Iterator<Item = ([f64; 3], [f64; 3])> + '_ {
+    let ccw = crate::polygon::signed_area(v) > 0.0;
+    (0..v.len()).filter_map(move |i| {
+        let (a, b) = (&v[i], &v[(i + 1) % v.len()]);
+        let e = [b[0] - a[0], b[1] - a[1]];
+        let len2 = e[0] * e[0] + e[1] * e[1];
+        if len2 <= 0.0 {
+            return None;
+        }
+        let t = (((x[0] - a[0]) * e[0] + (x[1] - a[1]) * e[1]) / len2).clamp(0.0, 1.0);
+        let l = len2.sqrt();
+        let out = [e[1] / l, -e[0] / l, 0.0];
+        let m = if ccw { out } else { out.map(|c| -c) };
+        Some(([a[0] + t * e[0], a[1] + t * e[1], 0.0], m))
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn part(geometry: Geometry) -> PartSpec {
+        PartSpec {
+            name: "p".into(),
+            geometry,
+            area: None,
+            interface: None,
+        }
+    }
+
+    fn corners(parts: &[PartSpec]) -> CornerTest<'_> {
+        CornerTest {
+            parts,
+            n: 2,
+            lo: [-10.0; 3],
+            hi: [10.0; 3],
+            tolerance: 1e-12,
+        }
+    }
+
+    /// A 2 m × 0.5 m block whose base lies on y = 0.
+    fn block() -> Vec<PartSpec> {
+        vec![part(Geometry::Polygon {
+            vertices: vec![vec![-1.0, 0.0], vec![1.0, 0.0], vec![1.0, 0.5], vec![-1.0, 0.5]],
+        })]
+    }
+
+    #[test]
+    fn a_base_sample_holds_the_nodes_under_the_base_and_not_those_past_its_edge() {
+        let parts = block();
+        let c = corners(&parts);
+        let down = [0.0, -1.0, 0.0];
+        // A cell below the middle of the base, and one 0.5 m in from the edge.
+        assert!(c.holds([0.0, -0.25, 0.0], 0.25, down, down));
+        assert!(c.holds([0.5, -0.25, 0.0], 0.25, down, down));
+        // Below the edge, and nearer the side than the node's depth: the side is nearer
+        // the mirror than the node.
+        assert!(!c.holds([1.0, -0.25, 0.0], 0.25, down, down));
+        assert!(!c.holds([0.9, -0.25, 0.0], 0.25, down, down));
+        // Diagonally past the edge.
+        let d = (0.2f64 * 0.2 + 0.05 * 0.05).sqrt();
+        let diagonal = [0.2 / d, -0.05 / d, 0.0];
+        assert!(!c.holds([1.2, -0.05, 0.0], d, diagonal, down));
+        // A node on or inside the body is always held.
+        assert!(c.holds([1.0, 0.1, 0.0], -0.1, down, down));
+    }
+
+    #[test]
+    fn a_circle_and_a_blunt_bend_have_no_corners() {
+        let parts = vec![part(Geometry::Circle {
+            centre: vec![0.0, 0.0],
+            radius: 0.5,
+        })];
+        let c = corners(&parts);
+        for k in 0..36 {
+            let t = k as f64 * std::f64::consts::PI / 18.0;
+            let n = [t.cos(), t.sin(), 0.0];
+            for phi in [0.05, 0.1, 0.1875] {
+                let at = n.map(|c| c * (0.5 + phi));
+                assert!(c.holds(at, phi, n, n), "angle {t}, distance {phi}");
+            }
+        }
+        // A 30° bend (a cone's shoulder: its face's normal 30° below the shaft's): the
+        // face beyond the bend is not another face for the nodes in front of it.
+        let rise = 60f64.to_radians().tan();
+        let parts = vec![part(Geometry::Polygon {
+            vertices: vec![
+                vec![0.0, -1.0],
+                vec![1.0, -1.0 + rise],
+                vec![1.0, 2.0],
+                vec![0.0, 2.0],
+            ],
+        })];
+        let c = corners(&parts);
+        let face = [30f64.to_radians().cos(), -0.5, 0.0];
+        let foot = [0.95, -1.0 + 0.95 * rise, 0.0];
+        for phi in [0.05, 0.1, 0.1875] {
+            let at: [f64; 3] = std::array::from_fn(|a| foot[a] + phi * face[a]);
+            assert!(c.holds(at, phi, face, face), "distance {phi}");
+        }
+    }
+
+    #[test]
+    fn a_face_two_parts_share_and_a_face_on_the_grid_are_not_corners() {
+        // A pile: a thin base under a shaft, on the axis x = 0 of an axisymmetric grid.
+        let parts = vec![
+            part(Geometry::Polygon {
+                vertices: vec![
+                    vec![0.0, 0.0],
+                    vec![0.5, 0.0],
+                    vec![0.5, 0.0625],
+                    vec![0.0, 0.0625],
+                ],
+            }),
+            part(Geometry::Polygon {
+                vertices: vec![
+                    vec![0.0, 0.0625],
+                    vec![0.5, 0.0625],
+                    vec![0.5, 5.0],
+                    vec![0.0, 5.0],
+                ],
+            }),
+        ];
+        let c = CornerTest {
+            lo: [0.0, -10.0, 0.0],
+            ..corners(&parts)
+        };
+        let down = [0.0, -1.0, 0.0];
+        // Under the base's middle and on the axis, a cell down: held (the base part's top,
+        // the shaft's bottom and the axis are not faces the soil meets).
+        assert!(c.holds([0.25, -0.125, 0.0], 0.125, down, down));
+        assert!(c.holds([0.0, -0.125, 0.0], 0.125, down, down));
+        // Under the pile's edge: its side is a face.
+        assert!(!c.holds([0.5, -0.125, 0.0], 0.125, down, down));
+    }
+}
