@@ -484,8 +484,12 @@ fn describe_bodies(bodies: &[RigidBody]) -> Vec<String> {
                 ),
                 None => String::new(),
             };
+            let corners = match b.corners {
+                crate::rigid::Corners::Held => "",
+                crate::rigid::Corners::Released => ", corners released",
+            };
             format!(
-                "\"{}\": {} part(s), {samples} contact samples, {:?} interface, {control}{filters}{cpt}",
+                "\"{}\": {} part(s), {samples} contact samples, {:?} interface{corners}, {control}{filters}{cpt}",
                 b.name,
                 b.parts.len(),
                 b.interface
