@@ -26,6 +26,7 @@
 //! a cone's tip and shaft share) or on or beyond a face of the grid (the axis of an
 //! axisymmetric cone or pile, a wall's foot on the grid's base), where no soil flows round.
 
+use super::geometry::polygon_edges;
 use super::{Geometry, PartSpec};
 use serde::{Deserialize, Serialize};
 
@@ -48,19 +49,48 @@ pub enum Corners {
 #[derive(Clone, Copy, Debug)]
 pub struct CornerTest<'a> {
     /// The body's parts.
-    pub parts: &'a [PartSpec],
+    parts: &'a [PartSpec],
     /// Dimensions.
-    pub n: usize,
-    /// The grid's corners (m) in the body's starting frame (less its displacement): a
-    /// surface point on or beyond a face of the grid is not one the soil flows round.
-    pub lo: [f64; 3],
+    n: usize,
+    /// The body's displacement from its starting frame (m).
+    offset: [f64; 3],
+    /// The grid's corners (m) in the body's starting frame: a surface point on or beyond a
+    /// face of the grid is not one the soil flows round.
+    lo: [f64; 3],
     /// Upper corner, as `lo`.
-    pub hi: [f64; 3],
+    hi: [f64; 3],
     /// Distances below this (m) are on a face: 1e-9 cell.
-    pub tolerance: f64,
+    tolerance: f64,
 }
 
-impl CornerTest<'_> {
+impl<'a> CornerTest<'a> {
+    /// The test of a body of `parts` displaced by `offset` (m) in an `n`-dimensional grid
+    /// spanning `lo`..`hi` (m) in cells of `cell` m.
+    pub fn new(
+        parts: &'a [PartSpec],
+        n: usize,
+        offset: [f64; 3],
+        (lo, hi): ([f64; 3], [f64; 3]),
+        cell: f64,
+    ) -> Self {
+        CornerTest {
+            parts,
+            n,
+            offset,
+            lo: std::array::from_fn(|a| lo[a] - offset[a]),
+            hi: std::array::from_fn(|a| hi[a] - offset[a]),
+            tolerance: 1e-9 * cell,
+        }
+    }
+
+    /// Whether a sample with outward `normal` holds the node at `x` (m, in the grid's
+    /// frame): [`CornerTest::holds`] at the node's distance and nearest normal.
+    pub fn holds_node(&self, x: [f64; 3], normal: [f64; 3]) -> bool {
+        let at: [f64; 3] = std::array::from_fn(|a| x[a] - self.offset[a]);
+        let (phi, nearest, _) = super::distance(self.parts, at, self.n);
+        self.holds(at, phi, nearest, normal)
+    }
+
     /// Whether `x` (body frame) is a point of the body's surface the soil can meet: not
     /// inside a part other than `part`, nor on or beyond a face of the grid.
     fn open(&self, x: [f64; 3], part: usize) -> bool {
@@ -93,7 +123,7 @@ impl CornerTest<'_> {
             if let Geometry::Polygon { vertices } = &part.geometry {
                 // Each edge's nearest point: a polygon's nearest edge may be one it shares
                 // with another part, with a face of the body behind it.
-                if polygon_edges(vertices, q).any(|(p, m)| corner(p, m, k)) {
+                if polygon_edges(vertices, q).any(|(_, _, p, m)| corner(p, m, k)) {
                     return false;
                 }
             } else {
@@ -106,24 +136,6 @@ impl CornerTest<'_> {
         }
         true
     }
-}
-
-/// Each edge of a polygon: its nearest point to `x` and its outward normal.
-fn polygon_edges(v: &[Vec<f64>], x: [f64; 3]) -> impl Iterator<Item = ([f64; 3], [f64; 3])> + '_ {
-    let ccw = crate::polygon::signed_area(v) > 0.0;
-    (0..v.len()).filter_map(move |i| {
-        let (a, b) = (&v[i], &v[(i + 1) % v.len()]);
-        let e = [b[0] - a[0], b[1] - a[1]];
-        let len2 = e[0] * e[0] + e[1] * e[1];
-        if len2 <= 0.0 {
-            return None;
-        }
-        let t = (((x[0] - a[0]) * e[0] + (x[1] - a[1]) * e[1]) / len2).clamp(0.0, 1.0);
-        let l = len2.sqrt();
-        let out = [e[1] / l, -e[0] / l, 0.0];
-        let m = if ccw { out } else { out.map(|c| -c) };
-        Some(([a[0] + t * e[0], a[1] + t * e[1], 0.0], m))
-    })
 }
 
 #[cfg(test)]
@@ -140,13 +152,7 @@ mod tests {
     }
 
     fn corners(parts: &[PartSpec]) -> CornerTest<'_> {
-        CornerTest {
-            parts,
-            n: 2,
-            lo: [-10.0; 3],
-            hi: [10.0; 3],
-            tolerance: 1e-12,
-        }
+        CornerTest::new(parts, 2, [0.0; 3], ([-10.0; 3], [10.0; 3]), 1e-3)
     }
 
     /// A 2 m × 0.5 m block whose base lies on y = 0.
@@ -232,10 +238,7 @@ mod tests {
                 ],
             }),
         ];
-        let c = CornerTest {
-            lo: [0.0, -10.0, 0.0],
-            ..corners(&parts)
-        };
+        let c = CornerTest::new(&parts, 2, [0.0; 3], ([0.0, -10.0, 0.0], [10.0; 3]), 1e-3);
         let down = [0.0, -1.0, 0.0];
         // Under the base's middle and on the axis, a cell down: held (the base part's top,
         // the shaft's bottom and the axis are not faces the soil meets).

@@ -288,29 +288,48 @@ pub struct Sample {
     pub measure: f64,
 }
 
+/// Each edge of a polygon (vertices `v`, either way round) with a length: its ends, its
+/// nearest point to `x` and its outward unit normal.
+pub(crate) fn polygon_edges(
+    v: &[Vec<f64>],
+    x: [f64; 3],
+) -> impl Iterator<Item = ([f64; 2], [f64; 2], [f64; 3], [f64; 3])> + '_ {
+    let ccw = crate::polygon::signed_area(v) > 0.0;
+    (0..v.len()).filter_map(move |i| {
+        let (a, b) = (&v[i], &v[(i + 1) % v.len()]);
+        let e = [b[0] - a[0], b[1] - a[1]];
+        let len2 = e[0] * e[0] + e[1] * e[1];
+        if len2 <= 0.0 {
+            return None;
+        }
+        let t = (((x[0] - a[0]) * e[0] + (x[1] - a[1]) * e[1]) / len2).clamp(0.0, 1.0);
+        // Outward: to the right of the edge when the vertices run counter-clockwise.
+        let l = len2.sqrt();
+        let out = [e[1] / l, -e[0] / l, 0.0];
+        let normal = if ccw { out } else { scale(out, -1.0) };
+        Some((
+            [a[0], a[1]],
+            [b[0], b[1]],
+            [a[0] + t * e[0], a[1] + t * e[1], 0.0],
+            normal,
+        ))
+    })
+}
+
 /// Signed distance to a simple polygon: the nearest edge's distance, negative inside
 /// (crossing number); the normal points from the closest point to `x` outside, from `x` to
 /// it inside, and is the edge's outward normal on the surface itself.
 fn polygon(v: &[Vec<f64>], x: [f64; 3]) -> (f64, [f64; 3]) {
-    let ccw = crate::polygon::signed_area(v) > 0.0;
     let (mut best, mut closest, mut edge_normal) = (f64::INFINITY, [0.0; 3], [0.0; 3]);
     let mut inside = false;
-    for i in 0..v.len() {
-        let (a, b) = (&v[i], &v[(i + 1) % v.len()]);
-        let e = [b[0] - a[0], b[1] - a[1]];
-        let len2 = e[0] * e[0] + e[1] * e[1];
-        let t = (((x[0] - a[0]) * e[0] + (x[1] - a[1]) * e[1]) / len2).clamp(0.0, 1.0);
-        let c = [a[0] + t * e[0], a[1] + t * e[1], 0.0];
+    for (a, b, c, normal) in polygon_edges(v, x) {
         let d = norm(sub(x, c));
         if d < best {
             best = d;
             closest = c;
-            // Outward: to the right of the edge when the vertices run counter-clockwise.
-            let l = len2.sqrt();
-            let out = [e[1] / l, -e[0] / l, 0.0];
-            edge_normal = if ccw { out } else { scale(out, -1.0) };
+            edge_normal = normal;
         }
-        if (a[1] > x[1]) != (b[1] > x[1]) && x[0] < a[0] + (x[1] - a[1]) / (b[1] - a[1]) * e[0] {
+        if (a[1] > x[1]) != (b[1] > x[1]) && x[0] < a[0] + (x[1] - a[1]) / (b[1] - a[1]) * (b[0] - a[0]) {
             inside = !inside;
         }
     }

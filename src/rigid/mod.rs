@@ -256,6 +256,19 @@ pub fn check_friction_angle(angle: f64) -> Result<(), String> {
     }
 }
 
+/// [`RigidBodySpec::distance`] over `parts`: the nearest part's signed distance (m),
+/// outward normal and index.
+pub(crate) fn distance(parts: &[PartSpec], x: [f64; 3], n: usize) -> (f64, [f64; 3], usize) {
+    let mut best = (f64::INFINITY, [0.0; 3], 0);
+    for (k, p) in parts.iter().enumerate() {
+        let (phi, normal) = p.geometry.distance(x, n);
+        if phi < best.0 {
+            best = (phi, normal, k);
+        }
+    }
+    best
+}
+
 impl RigidBodySpec {
     /// The interface along part `k`: its own, or the body's.
     pub fn interface_of(&self, k: usize) -> Interface {
@@ -266,14 +279,7 @@ impl RigidBodySpec {
     /// the body, the unit outward normal there and the part it belongs to (the nearest
     /// surface; inside, the part that holds `x` deepest).
     pub fn distance(&self, x: [f64; 3], n: usize) -> (f64, [f64; 3], usize) {
-        let mut best = (f64::INFINITY, [0.0; 3], 0);
-        for (k, p) in self.parts.iter().enumerate() {
-            let (phi, normal) = p.geometry.distance(x, n);
-            if phi < best.0 {
-                best = (phi, normal, k);
-            }
-        }
-        best
+        distance(&self.parts, x, n)
     }
 
     /// Axis-aligned bounds (m) of the body at its starting position.

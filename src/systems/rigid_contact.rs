@@ -242,15 +242,9 @@ fn place<D: Dim, S: Shape>(ctx: &Context<D>, soil: &Soil<D>, slot_of: &mut Vec<u
                 impulse: [0.0; 3],
             });
         }
-        // The grid's corners in the body's starting frame.
-        let (lo, hi) = (D::vec_to3(grid.origin), D::vec_to3(grid.max_corner()));
-        let corners = (spec.corners == Corners::Released).then(|| CornerTest {
-            parts: &spec.parts,
-            n: D::N,
-            lo: std::array::from_fn(|a| lo[a] - state.offset[a]),
-            hi: std::array::from_fn(|a| hi[a] - state.offset[a]),
-            tolerance: 1e-9 * grid.cell_size,
-        });
+        let bounds = (D::vec_to3(grid.origin), D::vec_to3(grid.max_corner()));
+        let corners = (spec.corners == Corners::Released)
+            .then(|| CornerTest::new(&spec.parts, D::N, state.offset, bounds, grid.cell_size));
         for (index, (s, part)) in body.samples.iter().enumerate() {
             let x3: [f64; 3] = std::array::from_fn(|a| s.x[a] + state.offset[a]);
             let x = D::vec_from(x3);
@@ -267,13 +261,9 @@ fn place<D: Dim, S: Shape>(ctx: &Context<D>, soil: &Soil<D>, slot_of: &mut Vec<u
                 }
                 soil_weight += w;
                 // With `Released` corners, not a node beyond the body that faces a corner.
-                if let Some(test) = &corners {
-                    let xn = D::vec_to3(grid.node_position(grid.node_ijk(i)));
-                    let at: [f64; 3] = std::array::from_fn(|a| xn[a] - state.offset[a]);
-                    let (phi, n, _) = spec.distance(at, D::N);
-                    if !test.holds(at, phi, n, s.normal) {
-                        return;
-                    }
+                let node = || D::vec_to3(grid.node_position(grid.node_ijk(i)));
+                if corners.is_some_and(|c| !c.holds_node(node(), s.normal)) {
+                    return;
                 }
                 let k = slot(&mut set.slots, slot_of, i);
                 reach.push((k, w));
