@@ -37,7 +37,7 @@ use thiserror::Error;
 /// The first bytes of a checkpoint file.
 const MAGIC: &[u8; 8] = b"KDMPMCK\0";
 /// Format version; a file of another version is refused.
-const VERSION: u32 = 15;
+const VERSION: u32 = 14;
 /// The build that writes and reads checkpoints: the crate's version and a fingerprint of
 /// its sources (build.rs).
 pub const BUILD_ID: &str = concat!(env!("CARGO_PKG_VERSION"), "+", env!("KDMPM_SOURCE_HASH"));
@@ -652,10 +652,9 @@ fn encode_control(w: &mut Writer, c: &Control) {
         }
     }
     w.u64(contact_memory.len() as u64);
-    for m in contact_memory {
-        w.u64(m.key);
-        w.f64(m.normal);
-        m.tangential.iter().for_each(|&c| w.f64(c));
+    for &(k, lambda) in contact_memory {
+        w.u64(k);
+        w.f64(lambda);
     }
     w.u64(curve.len() as u64);
     for c in curve {
@@ -742,11 +741,7 @@ fn decode_control(r: &mut Reader) -> Result<Control, CheckpointError> {
         });
     }
     for _ in 0..r.u64()? {
-        c.contact_memory.push(crate::rigid::contact::Remembered {
-            key: r.u64()?,
-            normal: r.f64()?,
-            tangential: [r.f64()?, r.f64()?, r.f64()?],
-        });
+        c.contact_memory.push((r.u64()?, r.f64()?));
     }
     for _ in 0..r.u64()? {
         c.curve.push(CurvePoint {

@@ -11,12 +11,11 @@
 //! nodes as Δv_i = λ w_i n / m̃_i, with λ = −C / Σ w_i²/m̃_i for the violation C; the
 //! samples are visited in a fixed order until they agree (projected Gauss–Seidel, λ ≥ 0
 //! summed per sample), so that overlapping samples share their nodes' correction. Where the
-//! soil presses, the tangential slip is removed the same way per patch (the samples of a
-//! part nearest one node), by at most tan δ · N + a·A·Δt (Coulomb friction with an
-//! adhesion cap a on the patch's surface A, from the interface of its part; no cap when
-//! rough, nothing when smooth), N being the normal impulse its nodes took, from the
-//! samples and the inside nodes alike, shared among the patches that reach them
-//! ([`crate::rigid::contact`]).
+//! soil presses, the tangential slip at a sample is removed the same way, by at most
+//! tan δ · N_s + a·A_s·Δt (Coulomb friction with an adhesion cap a on the sample's surface
+//! A_s, from the interface of the sample's part; no cap when rough, nothing when smooth),
+//! N_s being the normal impulse its nodes took, from the samples and the inside nodes
+//! alike, shared among the samples that reach them ([`crate::rigid::contact`]).
 //!
 //! It runs before `boundary`, so that a `Friction` face and a motion's nodes feel the
 //! contact's force; the components they hold enter the contact as `boundary` will set
@@ -236,14 +235,11 @@ fn place<D: Dim, S: Shape>(ctx: &Context<D>, soil: &Soil<D>, slot_of: &mut Vec<u
                 normal,
                 friction: 0.0,
                 adhesion: 0.0,
-                area: 0.0,
                 surface: false,
-                patch: usize::MAX,
                 nodes: vec![(k, 1.0)],
                 weight: 1.0,
                 normal_impulse: 0.0,
                 impulse: [0.0; 3],
-                friction_impulse: [0.0; 3],
             });
         }
         let bounds = (D::vec_to3(grid.origin), D::vec_to3(grid.max_corner()));
@@ -289,14 +285,11 @@ fn place<D: Dim, S: Shape>(ctx: &Context<D>, soil: &Soil<D>, slot_of: &mut Vec<u
                 normal: s.normal,
                 friction: interfaces[*part].0,
                 adhesion: interfaces[*part].1 * area * st.dt,
-                area: area.max(MIN_AREA),
                 surface: true,
-                patch: nearest_node(grid, x),
                 nodes: reach,
                 weight,
                 normal_impulse: 0.0,
                 impulse: [0.0; 3],
-                friction_impulse: [0.0; 3],
             });
         }
     }
@@ -304,25 +297,6 @@ fn place<D: Dim, S: Shape>(ctx: &Context<D>, soil: &Soil<D>, slot_of: &mut Vec<u
         slot_of[s.node] = u32::MAX;
     }
     set
-}
-
-/// The least surface a sample stands for (m²): one on the axis of an axisymmetric scene
-/// has none, and a patch's friction row is weighted by its samples' surfaces.
-const MIN_AREA: f64 = 1e-12;
-
-/// The id of the node nearest `x` (inside the grid): the patch of the surface a sample
-/// belongs to.
-fn nearest_node<D: Dim>(grid: &crate::grid::Grid<D>, x: D::Vec) -> usize {
-    let last = grid.cells();
-    grid.node_id(std::array::from_fn(|a| {
-        if a < D::N {
-            (grid.grid_coordinate(x, a) + 0.5)
-                .floor()
-                .clamp(0.0, last[a] as f64) as usize
-        } else {
-            0
-        }
-    }))
 }
 
 impl<D: Dim, S: Shape> System<D> for RigidContact<D, S> {

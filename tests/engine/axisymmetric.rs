@@ -296,7 +296,7 @@ const SMOOTH_CONE_FIRST_N_KT: f64 = 8.04446256281579;
 /// The same first D/4 with the tip's part rough (`interface: Some(Rough)`) below the
 /// smooth shaft: the part's interface holds along the tip, which bears more than the
 /// smooth cone's, and the shaft still takes nothing but its shoulder's corner. N_kt =
-/// 12.02 here, pinned. (The excess comes through a face shear of several c_u, more than
+/// 12.60 here, pinned. (The excess comes through a face shear of several c_u, more than
 /// the clay can hold: the rough cone's figure is the adhesive tip's, below.)
 #[test]
 fn a_cone_with_a_rough_tip_bears_more_than_the_smooth_one() {
@@ -304,7 +304,7 @@ fn a_cone_with_a_rough_tip_bears_more_than_the_smooth_one() {
     let n_kt = factor_over_overburden(tip.pressure.unwrap());
     assert!(n_kt > 1.2 * SMOOTH_CONE_FIRST_N_KT, "{n_kt}");
     assert!(shaft.force[1].abs() < 0.05 * tip.force[1].abs(), "{shaft:?}");
-    assert_eq!(n_kt, 12.01857919490876);
+    assert_eq!(n_kt, 12.597187269817237);
 }
 
 /// The same first D/4 with an adhesion of c_u on the tip (`Frictional(angle: 0.0,
@@ -317,16 +317,16 @@ fn a_cone_with_an_adhesive_tip_bears_more_than_the_smooth_one() {
     let [_, tip, _] = cone_first_quarter(Some("Some(Frictional(angle: 0.0, adhesion: 10.0e3))"));
     let n_kt = factor_over_overburden(tip.pressure.unwrap());
     assert!(n_kt > SMOOTH_CONE_FIRST_N_KT, "{n_kt}");
-    assert_eq!(n_kt, 10.020879860542443);
+    assert_eq!(n_kt, 9.93308608841037);
 }
 
 /// `scenes/pile_jacking.ron` at h = D/4 over its first D/2: the base's N_c = (q_b − σ_v0)/c_u
-/// is well above a deep base's 9 (14.43, 14.26: at R = 2 cells the base's corner samples
-/// reach far beyond it) and the shaft's stress, its force per radian over R times its
-/// length in the clay, is above the interface's adhesion α c_u = 5 kPa (5.84, 5.61 kPa):
-/// the shaft's samples next to the base's corner take some of the base's bearing, a
-/// force that does not grow with the length, so the stress falls towards the cap as the
-/// pile goes in (docs/verification.md has the scene at h = D/8 to 10 D). Pinned.
+/// rises (14.43, 15.06: at R = 2 cells the base's corner samples reach far beyond it) and
+/// the shaft's stress, its force per radian over R times its length in the clay, is above
+/// the interface's adhesion α c_u = 5 kPa (5.76, 5.46 kPa): the shaft's samples next to the
+/// base's corner take some of the base's bearing, a force that does not grow with the
+/// length, so the stress falls towards the cap as the pile goes in (5.11 kPa over the first
+/// 2 D at h = D/8, 4.92–5.07 kPa deeper to 10 D, docs/verification.md). Pinned.
 #[test]
 fn a_jacked_pile_carries_its_base_bearing_and_its_shaft_adhesion() {
     let s = run("pile_jacking.ron", &at_d4("rigid_bodies[0].motion.travel=0.5"));
@@ -344,13 +344,13 @@ fn a_jacked_pile_carries_its_base_bearing_and_its_shaft_adhesion() {
         .iter()
         .map(|c| c.force[1] / (0.5 * (1.0 - 0.0625 + c.displacement)))
         .collect();
-    assert!(n_c.iter().all(|&n| n > 12.0), "{n_c:?}");
+    assert!(n_c[1] > n_c[0], "{n_c:?}");
     // The soil's drag on the shaft is upward: the force on the soil is downward; above the
     // cap by the corner's share, which the longer shaft spreads thinner.
     assert!(stress.iter().all(|&t| t < -5.0e3), "{stress:?}");
     assert!(stress[1] > stress[0], "{stress:?}");
-    assert_eq!(n_c[1], 14.259682634596471);
-    assert_eq!(stress[1], -5605.792206172307);
+    assert_eq!(n_c[1], 15.058008469258114);
+    assert_eq!(stress[1], -5458.765369236765);
 }
 
 /// `scenes/cpt_sand.ron` over its first D/4, and the same sand under twice the stress with
@@ -437,9 +437,9 @@ fn a_piezocone_in_undrained_cam_clay_reads_tip_sleeve_and_u2() {
         rows[0].pressure.expect("a pressure")
     };
     let (qt, fs, u2) = (reading("cone.tip"), reading("cone.sleeve"), reading("cone.u2"));
-    assert!((qt - 303_499.78).abs() < 0.01, "{qt}");
-    assert!((fs - 548.04).abs() < 0.01, "{fs}");
-    assert!((u2 - 109_249.83).abs() < 0.01, "{u2}");
+    assert!((qt - 301_738.75).abs() < 0.01, "{qt}");
+    assert!((fs - 558.31).abs() < 0.01, "{fs}");
+    assert!((u2 - 109_221.43).abs() < 0.01, "{u2}");
     // The filter's row carries no force.
     let filter = s.curve.iter().find(|c| c.name == "cone.u2").unwrap();
     assert_eq!(filter.force, [0.0; 3]);
