@@ -22,9 +22,10 @@
 //! point as far from the side as the node is, nearer than φ: not held either.
 //!
 //! The surface is each part's own (its exact geometry: the nearest point of each part to
-//! the mirror, of each edge of a polygon), less what is not the body's surface: a point inside another part (the face
-//! a cone's tip and shaft share) or on or beyond a face of the grid (the axis of an
-//! axisymmetric cone or pile, a wall's foot on the grid's base), where no soil flows round.
+//! the mirror, of each edge of a polygon), less what is not the body's surface: a point
+//! inside another part (the face a cone's tip and shaft share) or on or beyond a face of
+//! the grid (the axis of an axisymmetric cone or pile, a wall's foot on the grid's base),
+//! where no soil flows round.
 
 use super::geometry::polygon_edges;
 use super::{Geometry, PartSpec};
@@ -43,6 +44,17 @@ pub enum Corners {
     Held,
     /// A sample does not hold the nodes past a corner ([`CornerTest`]).
     Released,
+}
+
+/// A node's place against a body ([`CornerTest::locate`]).
+#[derive(Clone, Copy, Debug)]
+pub struct Located {
+    /// The node in the body's starting frame (m).
+    pub at: [f64; 3],
+    /// Its signed distance from the body (m, outside when positive).
+    pub phi: f64,
+    /// The outward unit normal at its nearest surface point.
+    pub nearest: [f64; 3],
 }
 
 /// A body's corner test in a grid (`systems::rigid_contact` places one per body a step).
@@ -83,12 +95,19 @@ impl<'a> CornerTest<'a> {
         }
     }
 
-    /// Whether a sample with outward `normal` holds the node at `x` (m, in the grid's
-    /// frame): [`CornerTest::holds`] at the node's distance and nearest normal.
-    pub fn holds_node(&self, x: [f64; 3], normal: [f64; 3]) -> bool {
+    /// Where the node at `x` (m, in the grid's frame) stands to the body: its place in the
+    /// body's frame, its distance (m, outside when positive) and the outward normal at its
+    /// nearest surface point, the arguments of [`CornerTest::holds`] that do not depend on
+    /// the sample (found once a node and step by `systems::rigid_contact`).
+    pub fn locate(&self, x: [f64; 3]) -> Located {
         let at: [f64; 3] = std::array::from_fn(|a| x[a] - self.offset[a]);
         let (phi, nearest, _) = super::distance(self.parts, at, self.n);
-        self.holds(at, phi, nearest, normal)
+        Located { at, phi, nearest }
+    }
+
+    /// Whether a sample with outward `normal` holds the node `node` ([`CornerTest::locate`]).
+    pub fn holds_node(&self, node: &Located, normal: [f64; 3]) -> bool {
+        self.holds(node.at, node.phi, node.nearest, normal)
     }
 
     /// Whether `x` (body frame) is a point of the body's surface the soil can meet: not
@@ -155,11 +174,21 @@ mod tests {
         CornerTest::new(parts, 2, [0.0; 3], ([-10.0; 3], [10.0; 3]), 1e-3)
     }
 
+    /// The axis-aligned rectangle from `lo` to `hi` (m), a part of its own.
+    fn rectangle(lo: [f64; 2], hi: [f64; 2]) -> PartSpec {
+        part(Geometry::Polygon {
+            vertices: vec![
+                vec![lo[0], lo[1]],
+                vec![hi[0], lo[1]],
+                vec![hi[0], hi[1]],
+                vec![lo[0], hi[1]],
+            ],
+        })
+    }
+
     /// A 2 m × 0.5 m block whose base lies on y = 0.
     fn block() -> Vec<PartSpec> {
-        vec![part(Geometry::Polygon {
-            vertices: vec![vec![-1.0, 0.0], vec![1.0, 0.0], vec![1.0, 0.5], vec![-1.0, 0.5]],
-        })]
+        vec![rectangle([-1.0, 0.0], [1.0, 0.5])]
     }
 
     #[test]
@@ -221,22 +250,8 @@ mod tests {
     fn a_face_two_parts_share_and_a_face_on_the_grid_are_not_corners() {
         // A pile: a thin base under a shaft, on the axis x = 0 of an axisymmetric grid.
         let parts = vec![
-            part(Geometry::Polygon {
-                vertices: vec![
-                    vec![0.0, 0.0],
-                    vec![0.5, 0.0],
-                    vec![0.5, 0.0625],
-                    vec![0.0, 0.0625],
-                ],
-            }),
-            part(Geometry::Polygon {
-                vertices: vec![
-                    vec![0.0, 0.0625],
-                    vec![0.5, 0.0625],
-                    vec![0.5, 5.0],
-                    vec![0.0, 5.0],
-                ],
-            }),
+            rectangle([0.0, 0.0], [0.5, 0.0625]),
+            rectangle([0.0, 0.0625], [0.5, 5.0]),
         ];
         let c = CornerTest::new(&parts, 2, [0.0; 3], ([0.0, -10.0, 0.0], [10.0; 3]), 1e-3);
         let down = [0.0, -1.0, 0.0];

@@ -25,7 +25,7 @@ pub mod sampling;
 pub mod stl;
 
 pub use contact::Contact;
-pub use corners::{CornerTest, Corners};
+pub use corners::{CornerTest, Corners, Located};
 pub use cpt::{Cpt, CptSpec, InSitu};
 pub use filter::FilterSpec;
 pub use geometry::{Geometry, Sample};

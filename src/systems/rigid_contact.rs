@@ -38,7 +38,7 @@ use crate::error::StepError;
 use crate::grid::NodeBox;
 use crate::infra::columns::{col, col_mut, nodes};
 use crate::rigid::contact::{key, remember, solve, Contact, Contacts, Memory, Slot};
-use crate::rigid::{CornerTest, Corners};
+use crate::rigid::{CornerTest, Corners, Located};
 use crate::schedule::System;
 use crate::shape::{for_each_node, Shape};
 use crate::systems::exchange::{exchange, EXTERNAL, FORCE, MASS, MOMENTUM};
@@ -245,6 +245,7 @@ fn place<D: Dim, S: Shape>(ctx: &Context<D>, soil: &Soil<D>, slot_of: &mut Vec<u
         let bounds = (D::vec_to3(grid.origin), D::vec_to3(grid.max_corner()));
         let corners = (spec.corners == Corners::Released)
             .then(|| CornerTest::new(&spec.parts, D::N, state.offset, bounds, grid.cell_size));
+        let mut located: std::collections::HashMap<usize, Located> = Default::default();
         for (index, (s, part)) in body.samples.iter().enumerate() {
             let x3: [f64; 3] = std::array::from_fn(|a| s.x[a] + state.offset[a]);
             let x = D::vec_from(x3);
@@ -260,10 +261,16 @@ fn place<D: Dim, S: Shape>(ctx: &Context<D>, soil: &Soil<D>, slot_of: &mut Vec<u
                     return;
                 }
                 soil_weight += w;
-                // With `Released` corners, not a node beyond the body that faces a corner.
-                let node = || D::vec_to3(grid.node_position(grid.node_ijk(i)));
-                if corners.is_some_and(|c| !c.holds_node(node(), s.normal)) {
-                    return;
+                // With `Released` corners, not a node beyond the body that faces a corner
+                // (where a node stands to the body is found once a step, for every sample
+                // that reaches it).
+                if let Some(c) = &corners {
+                    let node = located
+                        .entry(i)
+                        .or_insert_with(|| c.locate(D::vec_to3(grid.node_position(grid.node_ijk(i)))));
+                    if !c.holds_node(node, s.normal) {
+                        return;
+                    }
                 }
                 let k = slot(&mut set.slots, slot_of, i);
                 reach.push((k, w));
