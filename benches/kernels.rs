@@ -39,7 +39,7 @@ fn kernels(c: &mut Criterion) {
     let mut p2g = P2g::<Dim2, QuadraticBSpline>::new(P2gPart::All);
     c.bench_function("p2g (2D slope, B-spline, 23k points)", |b| {
         b.iter(|| {
-            GridReset.run(&mut sim.ctx).unwrap();
+            GridReset::default().run(&mut sim.ctx).unwrap();
             p2g.run(&mut sim.ctx).unwrap();
         })
     });
@@ -109,14 +109,14 @@ fn water(c: &mut Criterion) {
     let water = sim.ctx.model.water.clone();
     c.bench_function("p2g (slope_water, with its water)", |b| {
         b.iter(|| {
-            GridReset.run(&mut sim.ctx).unwrap();
+            GridReset::default().run(&mut sim.ctx).unwrap();
             p2g.run(&mut sim.ctx).unwrap();
         })
     });
     sim.ctx.model.water = None;
     c.bench_function("p2g (slope_water, the same points dry)", |b| {
         b.iter(|| {
-            GridReset.run(&mut sim.ctx).unwrap();
+            GridReset::default().run(&mut sim.ctx).unwrap();
             p2g.run(&mut sim.ctx).unwrap();
         })
     });

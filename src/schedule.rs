@@ -6,6 +6,7 @@
 use crate::context::Context;
 use crate::dim::Dim;
 use crate::error::StepError;
+use crate::infra::traffic::Traffic;
 use std::time::{Duration, Instant};
 
 /// One stage of the explicit step.
@@ -31,6 +32,14 @@ pub trait System<D: Dim>: Send {
     /// system they all run, or at the end of the step.
     fn on_every_rank(&self) -> bool {
         true
+    }
+    /// The bytes of point and node columns that the call which just ran read and wrote
+    /// ([`Traffic`]), for the profile's byte budget; `None` (the default) where the system
+    /// does not count them. Called after every call, so it must be cheap: counts from the
+    /// columns' lengths and the box of nodes, not a pass over them.
+    fn traffic(&self, ctx: &Context<D>) -> Option<Traffic> {
+        let _ = ctx;
+        None
     }
 }
 
@@ -68,6 +77,10 @@ pub struct Timing {
     pub calls: u64,
     /// Total wall time (s).
     pub seconds: f64,
+    /// Bytes of point and node columns read and written over all calls, where the system
+    /// counts them ([`System::traffic`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub bytes: Option<Traffic>,
 }
 
 /// An ordered list of systems.
@@ -75,6 +88,8 @@ pub struct Schedule<D: Dim> {
     systems: Vec<Box<dyn System<D>>>,
     time: Vec<Duration>,
     calls: Vec<u64>,
+    /// Bytes moved by each system so far; `None` once a call did not count them.
+    bytes: Vec<Option<Traffic>>,
     /// Every system's `prepare` ran since the list last changed.
     prepared: bool,
 }
@@ -85,6 +100,7 @@ impl<D: Dim> Default for Schedule<D> {
             systems: Vec::new(),
             time: Vec::new(),
             calls: Vec::new(),
+            bytes: Vec::new(),
             prepared: false,
         }
     }
@@ -107,6 +123,7 @@ impl<D: Dim> Schedule<D> {
         self.prepared = false;
         self.time.push(Duration::ZERO);
         self.calls.push(0);
+        self.bytes.push(Some(Traffic::NONE));
         self
     }
 
@@ -118,6 +135,7 @@ impl<D: Dim> Schedule<D> {
                 self.prepared = false;
                 self.time.insert(i + 1, Duration::ZERO);
                 self.calls.insert(i + 1, 0);
+                self.bytes.insert(i + 1, Some(Traffic::NONE));
                 true
             }
             None => false,
@@ -132,6 +150,7 @@ impl<D: Dim> Schedule<D> {
                 self.prepared = false;
                 self.time.insert(i, Duration::ZERO);
                 self.calls.insert(i, 0);
+                self.bytes.insert(i, Some(Traffic::NONE));
                 true
             }
             None => false,
@@ -167,6 +186,12 @@ impl<D: Dim> Schedule<D> {
             let result = system.run(ctx);
             self.time[i] += start.elapsed();
             self.calls[i] += 1;
+            if result.is_ok() {
+                self.bytes[i] = self.bytes[i].zip(system.traffic(ctx)).map(|(mut a, t)| {
+                    a += t;
+                    a
+                });
+            }
             every_rank(ctx, system.on_every_rank(), result, &mut held)?;
         }
         every_rank(ctx, true, Ok(()), &mut held)
@@ -176,11 +201,12 @@ impl<D: Dim> Schedule<D> {
     pub fn timings(&self) -> Vec<Timing> {
         self.systems
             .iter()
-            .zip(self.time.iter().zip(&self.calls))
-            .map(|(s, (t, &calls))| Timing {
+            .zip(self.time.iter().zip(&self.calls).zip(&self.bytes))
+            .map(|(s, ((t, &calls), &bytes))| Timing {
                 name: s.name().to_string(),
                 calls,
                 seconds: t.as_secs_f64(),
+                bytes,
             })
             .collect()
     }

@@ -199,7 +199,9 @@ fn ratio<S: serde::Serializer>(r: &f64, s: S) -> Result<S::Ok, S::Error> {
 
 impl Summary {
     /// The per-system timing table (`kdmpm run --profile`): calls, total and mean time and
-    /// share of each system, in schedule order.
+    /// share of each system, in schedule order, and the byte budget where a system counts
+    /// its bytes ([`crate::infra::traffic`]): bytes a point a call (on one rank) and the rate
+    /// they moved at. A last row sums the systems that count their bytes.
     pub fn profile_table(&self) -> String {
         let total: f64 = self.systems.iter().map(|t| t.seconds).sum();
         // The name column as wide as the longest name (`volumetric_smoothing`: 20).
@@ -208,26 +210,42 @@ impl Summary {
             .iter()
             .map(|t| t.name.chars().count())
             .fold(18, usize::max);
+        // Bytes a point are the rank's bytes over every rank's points: shown on one rank.
+        let points = (self.ranks.is_none() && self.particles > 0).then_some(self.particles as f64);
         let mut text = format!(
-            "{:<w$} {:>10} {:>12} {:>12} {:>7}\n",
-            "system", "calls", "total (s)", "mean (µs)", "share"
+            "{:<w$} {:>10} {:>12} {:>12} {:>7} {:>9} {:>7}\n",
+            "system", "calls", "total (s)", "mean (µs)", "share", "B/point", "GB/s"
         );
-        for t in &self.systems {
-            let mean = if t.calls > 0 {
-                1e6 * t.seconds / t.calls as f64
+        let mut row = |name: &str, calls: u64, seconds: f64, bytes: Option<u64>| {
+            let mean = if calls > 0 {
+                1e6 * seconds / calls as f64
             } else {
                 0.0
             };
-            let share = if total > 0.0 {
-                100.0 * t.seconds / total
-            } else {
-                0.0
+            let share = if total > 0.0 { 100.0 * seconds / total } else { 0.0 };
+            let per_point = match (bytes, points) {
+                (Some(b), Some(n)) if calls > 0 => format!("{:.0}", b as f64 / calls as f64 / n),
+                _ => "-".into(),
+            };
+            let rate = match bytes {
+                Some(b) if seconds > 0.0 => format!("{:.1}", b as f64 / seconds / 1e9),
+                _ => "-".into(),
             };
             text += &format!(
-                "{:<w$} {:>10} {:>12.4} {:>12.2} {:>6.1}%\n",
-                t.name, t.calls, t.seconds, mean, share
+                "{name:<w$} {calls:>10} {seconds:>12.4} {mean:>12.2} {share:>6.1}% {per_point:>9} {rate:>7}\n"
             );
+        };
+        for t in &self.systems {
+            row(&t.name, t.calls, t.seconds, t.bytes.map(|b| b.total()));
         }
+        // The step's counted part: the systems that count their bytes, their time and bytes.
+        let steps = self.systems.iter().map(|t| t.calls).max().unwrap_or(0);
+        let counted = self
+            .systems
+            .iter()
+            .filter_map(|t| t.bytes.map(|b| (t.seconds, b.total())));
+        let (seconds, bytes) = counted.fold((0.0, 0), |(s, b), (ts, tb)| (s + ts, b + tb));
+        row("counted", steps, seconds, Some(bytes));
         text
     }
 

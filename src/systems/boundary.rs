@@ -6,6 +6,7 @@ use crate::context::Context;
 use crate::dim::{Dim, Vector};
 use crate::error::StepError;
 use crate::infra::columns::{col, col_mut, nodes};
+use crate::infra::traffic::Traffic;
 use crate::model::Drive;
 use crate::parallel::{grid_pass, Disjoint};
 use crate::schedule::System;
@@ -20,7 +21,10 @@ use crate::systems::shared::{hold, Hold};
 /// count) into [`Drive::reaction`] and added to the node's external force, so that K_F
 /// counts the motion's load as applied load and W_ext its work.
 #[derive(Debug, Default)]
-pub struct Boundary;
+pub struct Boundary {
+    /// Nodes with a held component in the last call (for the byte budget).
+    held: usize,
+}
 
 impl<D: Dim> System<D> for Boundary {
     fn name(&self) -> &str {
@@ -58,11 +62,13 @@ impl<D: Dim> System<D> for Boundary {
         let owned = owned.as_ref();
         let parts = grid_pass(grid, ctx.state.active_nodes, &target, |b, (np, nf, ne), first| {
             let mut reactions = vec![[0.0; 3]; velocities.len()];
+            let mut held = 0;
             for i in b.rows(grid).flatten() {
                 let f = fix[i];
                 if f.0 == 0 {
                     continue;
                 }
+                held += 1;
                 let k = i - first;
                 if f.0 & NodeFixity::FRICTION != 0 {
                     friction.apply(grid, i, nm[i].0, &np[k].0, &mut nf[k].0, f);
@@ -83,13 +89,14 @@ impl<D: Dim> System<D> for Boundary {
                     nf[k].0.set(a, 0.0);
                 }
             }
-            reactions
+            (reactions, held)
         });
+        self.held = parts.iter().map(|(_, held)| held).sum();
         let mut reactions: Vec<f64> = (0..velocities.len())
             .flat_map(|d| {
                 parts
                     .iter()
-                    .fold([0.0; 3], |s, p| std::array::from_fn(|a| s[a] + p[d][a]))
+                    .fold([0.0; 3], |s, (p, _)| std::array::from_fn(|a| s[a] + p[d][a]))
             })
             .collect();
         // Each rank's owned nodes' part, added in rank order (no collective in a run
@@ -101,6 +108,18 @@ impl<D: Dim> System<D> for Boundary {
             drive.reaction = [r[0], r[1], r[2]];
         }
         Ok(())
+    }
+    fn traffic(&self, ctx: &Context<D>) -> Option<Traffic> {
+        // Every node's fixity is read; a held node's mass, momentum and forces too.
+        let held = self.held;
+        Some(
+            Traffic::NONE
+                .read_nodes::<NodeFixity>(ctx.state.active_nodes.len())
+                .read_nodes::<NodeMass>(held)
+                .update_nodes::<NodeMomentum<D::Vec>>(held)
+                .update_nodes::<NodeForce<D::Vec>>(held)
+                .update_nodes::<NodeExternalForce<D::Vec>>(held),
+        )
     }
 }
 

@@ -6,6 +6,7 @@ use crate::context::Context;
 use crate::dim::{Dim, Vector};
 use crate::error::StepError;
 use crate::infra::columns::{col, nodes};
+use crate::infra::traffic::Traffic;
 use crate::measure::{max_movement, positions};
 use crate::parallel::grid_pass;
 use crate::schedule::System;
@@ -191,6 +192,18 @@ impl Convergence {
 impl<D: Dim> System<D> for Convergence {
     fn name(&self) -> &str {
         "convergence"
+    }
+    fn traffic(&self, ctx: &Context<D>) -> Option<Traffic> {
+        // The force norms' pass (a static check's occasional look at the positions is not
+        // counted).
+        let n = ctx.state.active_nodes.len();
+        Some(
+            Traffic::NONE
+                .read_nodes::<NodeMass>(n)
+                .read_nodes::<NodeForce<D::Vec>>(n)
+                .read_nodes::<NodeExternalForce<D::Vec>>(n)
+                .read_nodes::<NodeFixity>(n),
+        )
     }
     fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
         let norms = force_norms(ctx);

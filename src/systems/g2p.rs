@@ -5,6 +5,7 @@ use crate::context::Context;
 use crate::dim::{Dim, Vector};
 use crate::error::StepError;
 use crate::infra::columns::{col, col_mut, nodes, points_with};
+use crate::infra::traffic::Traffic;
 use crate::parallel::CHUNK;
 use crate::schedule::System;
 use crate::shape::{for_each_node, Shape};
@@ -100,5 +101,19 @@ impl<D: Dim, S: Shape> System<D> for G2p<D, S> {
         }
         ctx.state.energy.set(0.5 * twice_ek);
         Ok(())
+    }
+    fn traffic(&self, ctx: &Context<D>) -> Option<Traffic> {
+        let (w, n) = (&ctx.world, ctx.state.active_nodes.len());
+        let t = Traffic::NONE
+            .read_points::<Position<D::Vec>>(w)
+            .read_points::<Mass>(w)
+            .update_points::<Velocity<D::Vec>>(w)
+            .read_nodes::<NodeAcceleration<D::Vec>>(n);
+        // PIC's share reads the nodal velocity too.
+        Some(if ctx.numerics.flip < 1.0 {
+            t.read_nodes::<NodeVelocity<D::Vec>>(n)
+        } else {
+            t
+        })
     }
 }

@@ -5,6 +5,7 @@ use crate::context::Context;
 use crate::dim::Dim;
 use crate::error::StepError;
 use crate::infra::columns::{col, col_mut, nodes};
+use crate::infra::traffic::Traffic;
 use crate::parallel::{for_each_box_node, Disjoint};
 use crate::schedule::System;
 /// Adds m_i·g to every node, g from `Settings::gravity` (which a loading stage may change).
@@ -42,5 +43,18 @@ impl<D: Dim> System<D> for Gravity {
             }
         });
         Ok(())
+    }
+    fn traffic(&self, ctx: &Context<D>) -> Option<Traffic> {
+        let n = if ctx.model.gravity.is_some() {
+            ctx.state.active_nodes.len()
+        } else {
+            0
+        };
+        Some(
+            Traffic::NONE
+                .read_nodes::<NodeMass>(n)
+                .update_nodes::<NodeForce<D::Vec>>(n)
+                .update_nodes::<NodeExternalForce<D::Vec>>(n),
+        )
     }
 }

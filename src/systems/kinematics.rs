@@ -6,6 +6,7 @@ use crate::context::Context;
 use crate::dim::{Dim, Vector};
 use crate::error::StepError;
 use crate::infra::columns::{col, col_mut, nodes, points_with};
+use crate::infra::traffic::Traffic;
 use crate::parallel::CHUNK;
 use crate::schedule::System;
 use crate::shape::{for_each_node, Shape};
@@ -142,6 +143,22 @@ impl<D: Dim, S: Shape> System<D> for Kinematics<D, S> {
             }
         }
         Ok(())
+    }
+    fn traffic(&self, ctx: &Context<D>) -> Option<Traffic> {
+        if ctx.motion_dt().is_none() {
+            return Some(Traffic::NONE);
+        }
+        let w = &ctx.world;
+        let mut t = Traffic::NONE.read_nodes::<NodeVelocity<D::Vec>>(ctx.state.active_nodes.len());
+        if self.gradient {
+            t = t.write_points::<VelocityGradient<D::Mat>>(w);
+        }
+        Some(if self.motion {
+            t.update_points::<Position<D::Vec>>(w)
+                .update_points::<Displacement<D::Vec>>(w)
+        } else {
+            t.read_points::<Position<D::Vec>>(w)
+        })
     }
 }
 

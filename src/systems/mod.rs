@@ -259,7 +259,7 @@ fn mapping<D: Dim, S: Shape>() -> Vec<Entry<D>> {
             Always,
             &[],
             "empty, undeformed grid",
-            |_, _| Box::new(GridReset),
+            |_, _| Box::new(GridReset::default()),
         ),
         e(
             "spatial_sort",
@@ -462,7 +462,7 @@ fn loading<D: Dim, S: Shape>() -> Vec<Entry<D>> {
                 ),
             ],
             "held components: fixed at zero, or at a motion's velocity",
-            |_, _| Box::new(Boundary),
+            |_, _| Box::new(Boundary::default()),
         ),
         e(
             "integrate",

@@ -6,6 +6,7 @@ use crate::context::Context;
 use crate::dim::{Dim, Vector};
 use crate::error::StepError;
 use crate::infra::columns::{col, col_mut, nodes};
+use crate::infra::traffic::Traffic;
 use crate::parallel::{for_each_box_node, Disjoint};
 use crate::schedule::System;
 
@@ -48,5 +49,15 @@ impl<D: Dim> System<D> for NodalVelocity {
     fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
         velocity_from_momentum(ctx);
         Ok(())
+    }
+    fn traffic(&self, ctx: &Context<D>) -> Option<Traffic> {
+        let n = ctx.state.active_nodes.len();
+        Some(
+            Traffic::NONE
+                .read_nodes::<NodeMass>(n)
+                .read_nodes::<NodeMomentum<D::Vec>>(n)
+                .read_nodes::<NodeFixity>(n)
+                .write_nodes::<NodeVelocity<D::Vec>>(n),
+        )
     }
 }

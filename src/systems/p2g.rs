@@ -6,6 +6,7 @@ use crate::dim::{Dim, Vector};
 use crate::error::StepError;
 use crate::infra::columns::{col, col_mut, nodes, points_with};
 use crate::infra::lanes::F64x4;
+use crate::infra::traffic::Traffic;
 use crate::parallel::{scatter, Disjoint};
 use crate::schedule::System;
 use crate::shape::{for_each_node, from_lanes, Shape, StressColumns};
@@ -79,6 +80,39 @@ impl<D: Dim, S: Shape> System<D> for P2g<D, S> {
             exchange(ctx, MASS | MOMENTUM);
         }
         Ok(())
+    }
+    fn traffic(&self, ctx: &Context<D>) -> Option<Traffic> {
+        let (w, n) = (&ctx.world, ctx.state.active_nodes.len());
+        let (mass_momentum, force) = self.part.maps();
+        let mut t = Traffic::NONE
+            .read_order::<Position<D::Vec>>(w)
+            .read_points::<Position<D::Vec>>(w);
+        if mass_momentum {
+            t = t
+                .read_points::<Mass>(w)
+                .read_points::<Velocity<D::Vec>>(w)
+                .update_nodes::<NodeMass>(n)
+                .update_nodes::<NodeMomentum<D::Vec>>(n);
+        }
+        if force {
+            t = t
+                .read_points::<Stress<D::Stress>>(w)
+                .read_points::<Volume>(w)
+                .update_nodes::<NodeForce<D::Vec>>(n);
+            // The point forces besides the stress (`PointForces`): the water reads the
+            // points' materials; both read the mass and add to the external force.
+            let water = ctx.model.water.is_some();
+            if water || D::AXISYMMETRIC {
+                t = t.update_nodes::<NodeExternalForce<D::Vec>>(n);
+                if !mass_momentum {
+                    t = t.read_points::<Mass>(w);
+                }
+            }
+            if water {
+                t = t.read_points::<MaterialId>(w);
+            }
+        }
+        Some(t)
     }
 }
 
@@ -264,7 +298,7 @@ mod tests {
                 mom += v[p].0 * m[p].0;
             }
         }
-        GridReset.run(&mut sim.ctx).unwrap();
+        GridReset::default().run(&mut sim.ctx).unwrap();
         P2g::<D, S>::new(P2gPart::All).run(&mut sim.ctx).unwrap();
         let n = nodes(&sim.ctx.world);
         let grid_mass: f64 = col::<NodeMass>(n).iter().map(|m| m.0).sum();

@@ -6,6 +6,7 @@ use crate::context::Context;
 use crate::dim::{Dim, Vector};
 use crate::error::StepError;
 use crate::infra::columns::{col_mut, points_with};
+use crate::infra::traffic::Traffic;
 use crate::schedule::System;
 use crate::state::Peak;
 
@@ -57,5 +58,13 @@ impl<D: Dim> System<D> for PeakWatch {
             s.energy.push();
         }
         Ok(())
+    }
+    fn traffic(&self, ctx: &Context<D>) -> Option<Traffic> {
+        // A reset zeroes every point's velocity.
+        Some(if ctx.state.resets.this_step {
+            Traffic::NONE.write_points::<Velocity<D::Vec>>(&ctx.world)
+        } else {
+            Traffic::NONE
+        })
     }
 }

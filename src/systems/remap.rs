@@ -6,6 +6,7 @@ use crate::context::Context;
 use crate::dim::{Dim, Vector};
 use crate::error::StepError;
 use crate::infra::columns::{col, col_mut, nodes, points_with};
+use crate::infra::traffic::Traffic;
 use crate::parallel::{fill_box, scatter, Disjoint};
 use crate::schedule::System;
 use crate::shape::{for_each_node, Shape};
@@ -77,5 +78,30 @@ impl<D: Dim, S: Shape> System<D> for Remap<D, S> {
         velocity_from_momentum(ctx);
         super::rigid_contact::project(ctx);
         Ok(())
+    }
+    fn traffic(&self, ctx: &Context<D>) -> Option<Traffic> {
+        let (w, n) = (&ctx.world, ctx.state.active_nodes.len());
+        if ctx.state.resets.this_step {
+            return Some(Traffic::NONE.write_nodes::<NodeVelocity<D::Vec>>(n));
+        }
+        // The rigid bodies' second contact pass is not counted.
+        if !ctx.state.control.contacts.contacts.is_empty() {
+            return None;
+        }
+        Some(
+            Traffic::NONE
+                // Zeroed, then the scatter's sums.
+                .write_nodes::<NodeMomentum<D::Vec>>(n)
+                .update_nodes::<NodeMomentum<D::Vec>>(n)
+                .read_order::<Velocity<D::Vec>>(w)
+                .read_points::<Position<D::Vec>>(w)
+                .read_points::<Mass>(w)
+                .read_points::<Velocity<D::Vec>>(w)
+                // v_i = p_i / m_i.
+                .read_nodes::<NodeMass>(n)
+                .read_nodes::<NodeMomentum<D::Vec>>(n)
+                .read_nodes::<NodeFixity>(n)
+                .write_nodes::<NodeVelocity<D::Vec>>(n),
+        )
     }
 }

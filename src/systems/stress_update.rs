@@ -6,6 +6,7 @@ use crate::dim::Dim;
 use crate::error::StepError;
 use crate::infra::columns::{col, col_mut, points_with};
 use crate::infra::lanes::{gather, F64x4, LANES};
+use crate::infra::traffic::Traffic;
 use crate::materials::{update_lane_by_lane, visit_states, MaterialModel, MaterialState, StateVisitor};
 use crate::parallel::CHUNK;
 use crate::schedule::System;
@@ -46,6 +47,35 @@ impl<D: Dim> System<D> for StressUpdate {
             }
         }
         Ok(())
+    }
+    fn traffic(&self, ctx: &Context<D>) -> Option<Traffic> {
+        if ctx.motion_dt().is_none() {
+            return Some(Traffic::NONE);
+        }
+        let w = &ctx.world;
+        let mut states = StateBytes { world: w, bytes: 0 };
+        visit_states(&mut states);
+        let mut t = Traffic::NONE
+            .read_points::<VelocityGradient<D::Mat>>(w)
+            .read_points::<MaterialId>(w)
+            .update_points::<Stress<D::Stress>>(w);
+        t.read += states.bytes;
+        t.written += states.bytes;
+        Some(t)
+    }
+}
+
+/// The bytes of the material state columns of every point archetype (each carries one).
+struct StateBytes<'a> {
+    world: &'a hecs::World,
+    bytes: u64,
+}
+
+impl StateVisitor for StateBytes<'_> {
+    fn visit<S: MaterialState>(&mut self) {
+        if std::mem::size_of::<S>() > 0 {
+            self.bytes += Traffic::NONE.read_points::<S>(self.world).read;
+        }
     }
 }
 

@@ -5,6 +5,7 @@ use crate::context::Context;
 use crate::dim::Dim;
 use crate::error::StepError;
 use crate::infra::columns::{col, col_mut, points_with};
+use crate::infra::traffic::Traffic;
 use crate::parallel::CHUNK;
 use crate::schedule::System;
 use rayon::prelude::*;
@@ -33,6 +34,17 @@ impl<D: Dim> System<D> for VolumeUpdate {
                 });
         }
         Ok(())
+    }
+    fn traffic(&self, ctx: &Context<D>) -> Option<Traffic> {
+        if ctx.motion_dt().is_none() {
+            return Some(Traffic::NONE);
+        }
+        let w = &ctx.world;
+        Some(
+            Traffic::NONE
+                .read_points::<VelocityGradient<D::Mat>>(w)
+                .update_points::<Volume>(w),
+        )
     }
 }
 

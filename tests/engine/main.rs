@@ -10,6 +10,7 @@ mod anti_locking;
 
 mod axisymmetric;
 mod bar;
+mod byte_budget;
 mod cam_clay;
 mod checkpoint_integrity;
 mod checkpoint_resume;
