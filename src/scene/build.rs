@@ -382,6 +382,7 @@ fn build_dim<D: Dim>(
         comm: Default::default(),
         decomposition,
         exchanged: 0,
+        momentum_mapped: false,
     };
     Ok((
         Simulation {

@@ -61,3 +61,44 @@ fn the_block_moves_its_columns_bytes_a_musl_step() {
     let volume = bytes("volume_update");
     assert_eq!((volume.read, volume.written), (points * (72 + 8), points * 8));
 }
+
+#[test]
+fn musl_g2p_maps_the_remaps_momentum_to_the_bit() {
+    // A system between g2p and the remap that may change the points' motion (the default
+    // of `changes_point_motion`) makes the remap map the momentum itself.
+    let mut fused = block("Musl");
+    let mut own = block("Musl");
+    let probe = kdmpm::FnSystem::new("probe", |_: &mut kdmpm::Context<kdmpm::Dim3>| Ok(()));
+    assert!(own.schedule.insert_after("g2p", probe));
+    for _ in 0..60 {
+        fused.step().unwrap();
+        own.step().unwrap();
+    }
+    let remap = |sim: &kdmpm::Simulation<kdmpm::Dim3>| {
+        let t = sim
+            .schedule
+            .timings()
+            .into_iter()
+            .find(|t| t.name == "remap")
+            .unwrap();
+        t.bytes.unwrap().read
+    };
+    // The remap read the points' columns in one run only.
+    assert!(
+        remap(&own) > remap(&fused) + 60 * 10_648 * 56,
+        "{} {}",
+        remap(&own),
+        remap(&fused)
+    );
+    assert!(fused.ctx.state.resets.count > 0, "a reset within the steps");
+    let positions = |sim: &kdmpm::Simulation<kdmpm::Dim3>| {
+        let mut x = Vec::new();
+        kdmpm::measure::positions::<kdmpm::Dim3>(&sim.ctx.world, &mut x);
+        x
+    };
+    assert_eq!(positions(&fused), positions(&own));
+    assert_eq!(
+        fused.ctx.state.energy.current().to_bits(),
+        own.ctx.state.energy.current().to_bits()
+    );
+}
