@@ -36,11 +36,6 @@ pub struct Context<D: Dim> {
     /// Node columns already summed over the ranks this step (bits of
     /// [`crate::systems::exchange`]); cleared by the grid reset.
     pub exchanged: u8,
-    /// The nodal momentum is the points' present momentum, mapped by MUSL's g2p with the
-    /// velocities it made ([`crate::systems::G2p`]), so that the remap need not map it
-    /// again. The schedule clears it after every system that may change the points' motion
-    /// ([`crate::System::changes_point_motion`]).
-    pub momentum_mapped: bool,
 }
 
 impl<D: Dim> Context<D> {

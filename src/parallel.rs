@@ -155,43 +155,6 @@ pub trait NodeTarget: Sync {
     unsafe fn part<'p>(&self, nodes: Range<usize>) -> Self::Part<'p>;
 }
 
-/// A point column lent to a scatter's slabs, each slab writing the rows of its own points
-/// (every point is in exactly one slab).
-pub struct ByPoint<'a, T> {
-    ptr: *mut T,
-    len: usize,
-    _column: PhantomData<&'a mut [T]>,
-}
-
-impl<'a, T> ByPoint<'a, T> {
-    /// Lends `column` for the duration of one scatter.
-    pub fn new(column: &'a mut [T]) -> Self {
-        ByPoint {
-            ptr: column.as_mut_ptr(),
-            len: column.len(),
-            _column: PhantomData,
-        }
-    }
-
-    /// Row `p` of the column.
-    ///
-    /// # Safety
-    /// No other reference to row `p` is alive: the kernel of the slab holding point `p`
-    /// takes it, for no longer than that kernel call, and nothing else does meanwhile.
-    #[allow(clippy::mut_from_ref)]
-    #[inline(always)]
-    pub unsafe fn row(&self, p: usize) -> &mut T {
-        assert!(p < self.len);
-        // SAFETY: in bounds (checked above); unaliased by contract.
-        unsafe { &mut *self.ptr.add(p) }
-    }
-}
-
-// SAFETY: rows are reached only through `ByPoint::row`, whose contract gives each row to
-// one kernel call at a time, so it behaves as `&mut [T]` split among threads.
-unsafe impl<T: Send> Sync for ByPoint<'_, T> {}
-unsafe impl<T: Send> Send for ByPoint<'_, T> {}
-
 /// A node column lent to slabs that write to disjoint node ranges at the same time.
 pub struct Disjoint<'a, T> {
     ptr: *mut T,

@@ -41,15 +41,6 @@ pub trait System<D: Dim>: Send {
         let _ = ctx;
         None
     }
-    /// Whether a call may change the points' velocities, masses or positions other than by
-    /// a kinetic-damping reset; true (the default) unless the system says otherwise. Under
-    /// MUSL, g2p maps the momentum of the velocities it makes for the remap in the same
-    /// pass ([`Context::momentum_mapped`]); after a system that says true here, the remap
-    /// maps it again itself. A system that only reads the points keeps the default or says
-    /// false to keep the one pass.
-    fn changes_point_motion(&self) -> bool {
-        true
-    }
 }
 
 /// A system made from a closure, for user code (see `examples/custom_system.rs`).
@@ -200,9 +191,6 @@ impl<D: Dim> Schedule<D> {
                     a += t;
                     a
                 });
-            }
-            if system.changes_point_motion() {
-                ctx.momentum_mapped = false;
             }
             every_rank(ctx, system.on_every_rank(), result, &mut held)?;
         }

@@ -84,17 +84,6 @@ impl Traffic {
         self.read_nodes::<T>(nodes).write_nodes::<T>(nodes)
     }
 
-    /// A scratch array of `bytes` a point over the points that have column `T`, written and
-    /// read back.
-    pub fn update_scratch<T: Component>(mut self, world: &World, bytes: u64) -> Self {
-        let rows: usize = crate::infra::columns::points_with::<T>(world)
-            .map(|a| a.len() as usize)
-            .sum();
-        self.read += rows as u64 * bytes;
-        self.written += rows as u64 * bytes;
-        self
-    }
-
     /// The scatters' order of the points that have column `T`: a `u32` row index a point
     /// ([`crate::SlabCache`]), read.
     pub fn read_order<T: Component>(mut self, world: &World) -> Self {

@@ -382,7 +382,6 @@ fn build_dim<D: Dim>(
         comm: Default::default(),
         decomposition,
         exchanged: 0,
-        momentum_mapped: false,
     };
     Ok((
         Simulation {

@@ -488,8 +488,8 @@ fn loading<D: Dim, S: Shape>() -> Vec<Entry<D>> {
                 ("integrate", "g2p interpolates the nodal accelerations"),
                 ("mass_scaling", "g2p interpolates the rescaled accelerations"),
             ],
-            "point velocities, kinetic energy (MUSL: and the remap's momentum)",
-            |n, _| Box::new(G2p::<D, S>::new(n.scheme == Scheme::Musl)),
+            "point velocities, kinetic energy",
+            |_, _| Box::new(G2p::<D, S>::default()),
         ),
     ]
 }

@@ -59,10 +59,6 @@ impl<D: Dim> System<D> for PeakWatch {
         }
         Ok(())
     }
-    fn changes_point_motion(&self) -> bool {
-        // Only in a reset, when the remap maps nothing.
-        false
-    }
     fn traffic(&self, ctx: &Context<D>) -> Option<Traffic> {
         // A reset zeroes every point's velocity.
         Some(if ctx.state.resets.this_step {

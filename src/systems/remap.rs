@@ -42,8 +42,7 @@ impl<D: Dim, S: Shape> System<D> for Remap<D, S> {
             );
             return Ok(());
         }
-        // MUSL's g2p mapped the momentum of the velocities it made, and nothing changed them.
-        if !ctx.momentum_mapped {
+        {
             let grid = &ctx.grid;
             let mut np = col_mut::<NodeMomentum<D::Vec>>(n);
             fill_box(grid, ctx.state.active_nodes, &mut np, NodeMomentum(D::Vec::ZERO));
@@ -89,9 +88,7 @@ impl<D: Dim, S: Shape> System<D> for Remap<D, S> {
         if !ctx.state.control.contacts.contacts.is_empty() {
             return None;
         }
-        let t = if ctx.momentum_mapped {
-            Traffic::NONE
-        } else {
+        Some(
             Traffic::NONE
                 // Zeroed, then the scatter's sums.
                 .write_nodes::<NodeMomentum<D::Vec>>(n)
@@ -100,10 +97,8 @@ impl<D: Dim, S: Shape> System<D> for Remap<D, S> {
                 .read_points::<Position<D::Vec>>(w)
                 .read_points::<Mass>(w)
                 .read_points::<Velocity<D::Vec>>(w)
-        };
-        Some(
-            // v_i = p_i / m_i.
-            t.read_nodes::<NodeMass>(n)
+                // v_i = p_i / m_i.
+                .read_nodes::<NodeMass>(n)
                 .read_nodes::<NodeMomentum<D::Vec>>(n)
                 .read_nodes::<NodeFixity>(n)
                 .write_nodes::<NodeVelocity<D::Vec>>(n),
