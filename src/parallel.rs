@@ -374,6 +374,9 @@ fn balanced_cuts(sizes: &[usize], threads: usize) -> Vec<usize> {
     cuts
 }
 
+/// Runs of slabs a scatter's phase is cut into, per thread of the pool.
+pub const RUNS_PER_THREAD: usize = 4;
+
 /// A deterministic parallel scatter from points to nodes, straight into the node columns:
 /// runs `kernel(points, part, first_node)` for every non-empty slab of `slabs`, where `part`
 /// is the slab's range of `target` starting at node id `first_node` and `points` are point
@@ -385,11 +388,15 @@ fn balanced_cuts(sizes: &[usize], threads: usize) -> Vec<usize> {
 /// in phase order, and within a slab in point order, whatever the number of threads. No
 /// per-thread buffers, no reduction pass.
 ///
-/// Which thread runs which slab changes no sum, so each phase is split statically: thread
-/// t takes the t-th of as many contiguous runs of slabs, cut so that each holds about as
-/// many points (`balanced_cuts`). Slabs differ in size wherever a body is not a box (the
-/// 2D slope's from 270 points to 891), which rayon's split by slab count left unbalanced;
-/// and a thread keeps the same part of the grid from phase to phase.
+/// Which thread runs which slab changes no sum, so each phase is cut into
+/// [`RUNS_PER_THREAD`] contiguous runs of slabs a thread, each holding about as many points
+/// (`balanced_cuts`: slabs differ in size wherever a body is not a box, the 2D slope's from
+/// 270 points to 891, which a split by slab count left unbalanced), and the runs are handed
+/// out as threads come free. A thread that the operating system has taken off its core
+/// (another process on a shared machine) then holds a phase up for the run it is in only:
+/// given a fixed run each, every phase waited for every thread to be scheduled, and a
+/// scatter of a small scene took 5.9 ms instead of 30 µs beside a compile
+/// (docs/performance.md, "Scatters on a busy machine").
 ///
 /// The kernel takes each part for the length of one call (it is generic over the part's
 /// lifetime), so no part can outlive its phase and meet a part of the next one.
@@ -423,11 +430,12 @@ pub fn scatter<D: Dim, T: NodeTarget>(
             kernel(slabs.points(s), part, first);
         };
         let sizes: Vec<usize> = members.iter().map(|&s| slabs.points(s).len()).collect();
-        let cuts = balanced_cuts(&sizes, rayon::current_num_threads());
-        rayon::broadcast(|thread| {
-            let i = thread.index();
-            members[cuts[i]..cuts[i + 1]].iter().for_each(|&s| run(s));
-        });
+        let runs = RUNS_PER_THREAD * rayon::current_num_threads();
+        let cuts = balanced_cuts(&sizes, runs);
+        (0..runs)
+            .into_par_iter()
+            .with_max_len(1)
+            .for_each(|k| members[cuts[k]..cuts[k + 1]].iter().for_each(|&s| run(s)));
     }
     slabs.reach(grid, support)
 }
