@@ -200,7 +200,7 @@ fn ratio<S: serde::Serializer>(r: &f64, s: S) -> Result<S::Ok, S::Error> {
 impl Summary {
     /// The per-system timing table (`kdmpm run --profile`): calls, total and mean time and
     /// share of each system, in schedule order, and the byte budget where a system counts
-    /// its bytes ([`crate::infra::traffic`]): bytes a point a call (on one rank) and the rate
+    /// its bytes ([`crate::infra::traffic`]): bytes a point a call (over ranks, rank 0's) and the rate
     /// they moved at. A last row sums the systems that count their bytes.
     pub fn profile_table(&self) -> String {
         let total: f64 = self.systems.iter().map(|t| t.seconds).sum();
@@ -210,8 +210,12 @@ impl Summary {
             .iter()
             .map(|t| t.name.chars().count())
             .fold(18, usize::max);
-        // Bytes a point are the rank's bytes over every rank's points: shown on one rank.
-        let points = (self.ranks.is_none() && self.particles > 0).then_some(self.particles as f64);
+        // Over ranks the timings and bytes are rank 0's: per point of rank 0 (at the end).
+        let points = match &self.ranks {
+            None => self.particles as u64,
+            Some(r) => r.points.first().copied().unwrap_or(0),
+        };
+        let points = (points > 0).then_some(points as f64);
         let mut text = format!(
             "{:<w$} {:>10} {:>12} {:>12} {:>7} {:>9} {:>7}\n",
             "system", "calls", "total (s)", "mean (µs)", "share", "B/point", "GB/s"
