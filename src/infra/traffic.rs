@@ -28,12 +28,16 @@ impl AddAssign for Traffic {
     }
 }
 
+/// The points that have column `T`.
+fn point_rows<T: Component>(world: &World) -> u64 {
+    crate::infra::columns::points_with::<T>(world)
+        .map(|a| u64::from(a.len()))
+        .sum()
+}
+
 /// Bytes of column `T` over the points that have it.
 fn point_bytes<T: Component>(world: &World) -> u64 {
-    let rows: usize = crate::infra::columns::points_with::<T>(world)
-        .map(|a| a.len() as usize)
-        .sum();
-    (rows * std::mem::size_of::<T>()) as u64
+    point_rows::<T>(world) * std::mem::size_of::<T>() as u64
 }
 
 /// Bytes of column `T` over `nodes` nodes.
@@ -87,10 +91,7 @@ impl Traffic {
     /// The scatters' order of the points that have column `T`: a `u32` row index a point
     /// ([`crate::SlabCache`]), read.
     pub fn read_order<T: Component>(mut self, world: &World) -> Self {
-        let rows: usize = crate::infra::columns::points_with::<T>(world)
-            .map(|a| a.len() as usize)
-            .sum();
-        self.read += (rows * std::mem::size_of::<u32>()) as u64;
+        self.read += point_rows::<T>(world) * std::mem::size_of::<u32>() as u64;
         self
     }
 }

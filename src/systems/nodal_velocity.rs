@@ -38,6 +38,15 @@ pub fn velocity_from_momentum<D: Dim>(ctx: &Context<D>) {
     );
 }
 
+/// The bytes [`velocity_from_momentum`] moves over `nodes` nodes.
+pub fn velocity_from_momentum_traffic<D: Dim>(nodes: usize) -> Traffic {
+    Traffic::NONE
+        .read_nodes::<NodeMass>(nodes)
+        .read_nodes::<NodeMomentum<D::Vec>>(nodes)
+        .read_nodes::<NodeFixity>(nodes)
+        .write_nodes::<NodeVelocity<D::Vec>>(nodes)
+}
+
 /// USF's nodal velocity at the start of the step.
 #[derive(Debug, Default)]
 pub struct NodalVelocity;
@@ -51,13 +60,6 @@ impl<D: Dim> System<D> for NodalVelocity {
         Ok(())
     }
     fn traffic(&self, ctx: &Context<D>) -> Option<Traffic> {
-        let n = ctx.state.active_nodes.len();
-        Some(
-            Traffic::NONE
-                .read_nodes::<NodeMass>(n)
-                .read_nodes::<NodeMomentum<D::Vec>>(n)
-                .read_nodes::<NodeFixity>(n)
-                .write_nodes::<NodeVelocity<D::Vec>>(n),
-        )
+        Some(velocity_from_momentum_traffic::<D>(ctx.state.active_nodes.len()))
     }
 }

@@ -1,6 +1,6 @@
 //! MUSL remap: the updated point velocities mapped back to the grid (paper step 6).
 
-use super::nodal_velocity::velocity_from_momentum;
+use super::nodal_velocity::{velocity_from_momentum, velocity_from_momentum_traffic};
 use crate::components::*;
 use crate::context::Context;
 use crate::dim::{Dim, Vector};
@@ -88,20 +88,16 @@ impl<D: Dim, S: Shape> System<D> for Remap<D, S> {
         if !ctx.state.control.contacts.contacts.is_empty() {
             return None;
         }
-        Some(
-            Traffic::NONE
-                // Zeroed, then the scatter's sums.
-                .write_nodes::<NodeMomentum<D::Vec>>(n)
-                .update_nodes::<NodeMomentum<D::Vec>>(n)
-                .read_order::<Velocity<D::Vec>>(w)
-                .read_points::<Position<D::Vec>>(w)
-                .read_points::<Mass>(w)
-                .read_points::<Velocity<D::Vec>>(w)
-                // v_i = p_i / m_i.
-                .read_nodes::<NodeMass>(n)
-                .read_nodes::<NodeMomentum<D::Vec>>(n)
-                .read_nodes::<NodeFixity>(n)
-                .write_nodes::<NodeVelocity<D::Vec>>(n),
-        )
+        let mut t = Traffic::NONE
+            // Zeroed, then the scatter's sums.
+            .write_nodes::<NodeMomentum<D::Vec>>(n)
+            .update_nodes::<NodeMomentum<D::Vec>>(n)
+            .read_order::<Velocity<D::Vec>>(w)
+            .read_points::<Position<D::Vec>>(w)
+            .read_points::<Mass>(w)
+            .read_points::<Velocity<D::Vec>>(w);
+        // v_i = p_i / m_i.
+        t += velocity_from_momentum_traffic::<D>(n);
+        Some(t)
     }
 }

@@ -53,28 +53,27 @@ impl<D: Dim> System<D> for StressUpdate {
             return Some(Traffic::NONE);
         }
         let w = &ctx.world;
-        let mut states = StateBytes { world: w, bytes: 0 };
-        visit_states(&mut states);
-        let mut t = Traffic::NONE
+        let traffic = Traffic::NONE
             .read_points::<VelocityGradient<D::Mat>>(w)
             .read_points::<MaterialId>(w)
             .update_points::<Stress<D::Stress>>(w);
-        t.read += states.bytes;
-        t.written += states.bytes;
-        Some(t)
+        // Each archetype's material state column, read and written.
+        let mut states = StateTraffic { world: w, traffic };
+        visit_states(&mut states);
+        Some(states.traffic)
     }
 }
 
-/// The bytes of the material state columns of every point archetype (each carries one).
-struct StateBytes<'a> {
+/// Adds the material state columns of every point archetype to `traffic`.
+struct StateTraffic<'a> {
     world: &'a hecs::World,
-    bytes: u64,
+    traffic: Traffic,
 }
 
-impl StateVisitor for StateBytes<'_> {
+impl StateVisitor for StateTraffic<'_> {
     fn visit<S: MaterialState>(&mut self) {
         if std::mem::size_of::<S>() > 0 {
-            self.bytes += Traffic::NONE.read_points::<S>(self.world).read;
+            self.traffic = self.traffic.update_points::<S>(self.world);
         }
     }
 }
