@@ -138,18 +138,51 @@ fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
-/// How a change of the soil's velocity at the sample along the unit `dir` spreads over its
-/// nodes: Δv_i = δ (w_i/W) dir / s² on the free axes, s² = Σ (w_i/W)² (dir on free axes)²,
-/// which moves v(x_s) by δ. Returns (s², the impulse per unit δ, Σ m̃_i (w_i/W) dir² / s²).
-fn spread(p: &Contact, slots: &[Slot], dir: [f64; 3]) -> (f64, f64) {
+/// One node of a constraint as a solve uses it: its slot, its share w_i/W of the
+/// constraint's velocity and its coefficient (w_i/W)/m̃_i, fixed for the solve (the
+/// weights and inertias do not change within it).
+#[derive(Clone, Copy, Debug)]
+struct Term {
+    /// Index in [`Contacts::slots`].
+    slot: usize,
+    /// w_i/W.
+    share: f64,
+    /// (w_i/W)/m̃_i: the node's part of a change at the constraint, the least change of
+    /// kinetic energy that makes it.
+    coefficient: f64,
+}
+
+/// Each constraint's [`Term`]s, laid end to end in constraint order, and where each
+/// constraint's run of them starts (one entry more than there are constraints).
+fn terms(contacts: &[Contact], slots: &[Slot]) -> (Vec<Term>, Vec<usize>) {
+    let mut terms = Vec::with_capacity(contacts.iter().map(|p| p.nodes.len()).sum());
+    let mut starts = Vec::with_capacity(contacts.len() + 1);
+    starts.push(0);
+    for p in contacts {
+        terms.extend(p.nodes.iter().map(|&(k, w)| {
+            let share = w / p.weight;
+            Term {
+                slot: k,
+                share,
+                coefficient: share / slots[k].inertia,
+            }
+        }));
+        starts.push(terms.len());
+    }
+    (terms, starts)
+}
+
+/// How a change of the soil's velocity at the constraint along the unit `dir` spreads over
+/// its nodes: Δv_i = δ (w_i/W) dir / (m̃_i s²) on the free axes, s² = Σ (w_i/W)²/m̃_i
+/// (dir on free axes)², which moves v(x_s) by δ. Returns (s², the impulse per unit δ,
+/// Σ m̃_i (w_i/W)/m̃_i dir² / s²).
+fn spread(terms: &[Term], slots: &[Slot], dir: [f64; 3]) -> (f64, f64) {
     let (mut s2, mut m) = (0.0, 0.0);
-    for &(k, w) in &p.nodes {
-        let s = &slots[k];
-        let share = w / p.weight;
-        let c = coefficient(share, s.inertia);
+    for t in terms {
+        let s = &slots[t.slot];
         let d2: f64 = (0..3).filter(|&a| s.free[a]).map(|a| dir[a] * dir[a]).sum();
-        s2 += share * c * d2;
-        m += s.inertia * c * d2;
+        s2 += t.share * t.coefficient * d2;
+        m += s.inertia * t.coefficient * d2;
     }
     if s2 > 0.0 {
         (s2, m / s2)
@@ -158,19 +191,13 @@ fn spread(p: &Contact, slots: &[Slot], dir: [f64; 3]) -> (f64, f64) {
     }
 }
 
-/// A node's part of a change at the sample: its weight over its inertia, the least change
-/// of kinetic energy that makes it.
-fn coefficient(share: f64, inertia: f64) -> f64 {
-    share / inertia
-}
-
-/// Changes the soil's velocity at the sample by `delta` (m/s) along the unit `dir`, spread
-/// as [`spread`] says; returns the impulse the soil took (N s, x y z).
-fn push(p: &Contact, slots: &mut [Slot], dir: [f64; 3], delta: f64, s2: f64, normal: bool) -> [f64; 3] {
+/// Changes the soil's velocity at the constraint by `delta` (m/s) along the unit `dir`,
+/// spread as [`spread`] says; returns the impulse the soil took (N s, x y z).
+fn push(terms: &[Term], slots: &mut [Slot], dir: [f64; 3], delta: f64, s2: f64, normal: bool) -> [f64; 3] {
     let mut took = [0.0; 3];
-    for &(k, w) in &p.nodes {
-        let s = &mut slots[k];
-        let dv = delta * coefficient(w / p.weight, s.inertia) / s2;
+    for t in terms {
+        let s = &mut slots[t.slot];
+        let dv = delta * t.coefficient / s2;
         for a in 0..3 {
             if s.free[a] {
                 s.v[a] += dv * dir[a];
@@ -185,15 +212,15 @@ fn push(p: &Contact, slots: &mut [Slot], dir: [f64; 3], delta: f64, s2: f64, nor
 }
 
 /// The normal impulse a surface sample's friction may lean on: its nodes' pressed impulse
-/// along the sample's normal, each node's shared among the samples that reach it by their
+/// along the sample's `normal`, each node's shared among the samples that reach it by their
 /// weights (so the caps sum to the whole normal impulse, the inside nodes' included).
-fn leaning(p: &Contact, slots: &[Slot]) -> f64 {
-    p.nodes
+fn leaning(terms: &[Term], slots: &[Slot], normal: [f64; 3]) -> f64 {
+    terms
         .iter()
-        .map(|&(k, w)| {
-            let s = &slots[k];
+        .map(|t| {
+            let s = &slots[t.slot];
             if s.share > 0.0 {
-                dot(s.pressed, p.normal).max(0.0) * (w / p.weight) / s.share
+                dot(s.pressed, normal).max(0.0) * t.share / s.share
             } else {
                 0.0
             }
@@ -201,12 +228,12 @@ fn leaning(p: &Contact, slots: &[Slot]) -> f64 {
         .sum()
 }
 
-/// The soil's velocity at the sample (m/s).
-fn velocity(p: &Contact, slots: &[Slot]) -> [f64; 3] {
+/// The soil's velocity at the constraint (m/s).
+fn velocity(terms: &[Term], slots: &[Slot]) -> [f64; 3] {
     let mut v = [0.0; 3];
-    for &(k, w) in &p.nodes {
+    for t in terms {
         for (a, c) in v.iter_mut().enumerate() {
-            *c += w / p.weight * slots[k].v[a];
+            *c += t.share * slots[t.slot].v[a];
         }
     }
     v
@@ -231,13 +258,17 @@ pub fn solve(set: &mut Contacts, body_velocity: &[[f64; 3]], memory: &Memory) {
             }
         }
     }
-    // How each constraint's normal change spreads: the weights, inertias and free axes do
-    // not change during the solve.
-    let normal_spread: Vec<(f64, f64)> = set.contacts.iter().map(|p| spread(p, slots, p.normal)).collect();
+    // Each constraint's nodes as the sweeps use them, and how its normal change spreads:
+    // the weights, inertias and free axes do not change during the solve.
+    let (terms, starts) = terms(&set.contacts, slots);
+    let of = |c: usize| &terms[starts[c]..starts[c + 1]];
+    let normal_spread: Vec<(f64, f64)> = (set.contacts.iter().enumerate())
+        .map(|(c, p)| spread(of(c), slots, p.normal))
+        .collect();
     // The scale of the solve: the fastest entry into a body before any impulse.
     let mut reference: f64 = 0.0;
-    for p in &set.contacts {
-        let v = velocity(p, slots);
+    for (c, p) in set.contacts.iter().enumerate() {
+        let v = velocity(of(c), slots);
         let vb = body_velocity[p.body];
         let rel: [f64; 3] = std::array::from_fn(|a| v[a] - vb[a]);
         reference = reference.max(-dot(rel, p.normal));
@@ -245,7 +276,7 @@ pub fn solve(set: &mut Contacts, body_velocity: &[[f64; 3]], memory: &Memory) {
     let mut first = None;
     // Warm start: each contact's normal impulse of the last solve, applied at once.
     if !memory.is_empty() {
-        for (p, &(s2, mass)) in set.contacts.iter_mut().zip(&normal_spread) {
+        for (c, (p, &(s2, mass))) in set.contacts.iter_mut().zip(&normal_spread).enumerate() {
             if s2 <= 0.0 || mass <= 0.0 {
                 continue;
             }
@@ -253,7 +284,7 @@ pub fn solve(set: &mut Contacts, body_velocity: &[[f64; 3]], memory: &Memory) {
                 let lambda = memory[j].1;
                 if lambda > 0.0 {
                     p.normal_impulse = lambda;
-                    let took = push(p, slots, p.normal, lambda / mass, s2, true);
+                    let took = push(of(c), slots, p.normal, lambda / mass, s2, true);
                     (0..3).for_each(|a| p.impulse[a] += took[a]);
                 }
             }
@@ -261,27 +292,28 @@ pub fn solve(set: &mut Contacts, body_velocity: &[[f64; 3]], memory: &Memory) {
     }
     for _ in 0..MAX_SWEEPS {
         let mut largest: f64 = 0.0;
-        for (p, &(s2, mass)) in set.contacts.iter_mut().zip(&normal_spread) {
+        for (c, (p, &(s2, mass))) in set.contacts.iter_mut().zip(&normal_spread).enumerate() {
+            let terms = of(c);
             let vb = body_velocity[p.body];
             let n = p.normal;
             if s2 <= 0.0 || mass <= 0.0 {
                 continue;
             }
-            let v = velocity(p, slots);
+            let v = velocity(terms, slots);
             let rel: [f64; 3] = std::array::from_fn(|a| v[a] - vb[a]);
             // The normal impulse stays ≥ 0 in total: a sample only pushes.
             let delta = (-dot(rel, n)).max(-p.normal_impulse / mass);
             largest = largest.max(delta.abs());
             if delta != 0.0 {
                 p.normal_impulse += delta * mass;
-                let took = push(p, slots, n, delta, s2, true);
+                let took = push(terms, slots, n, delta, s2, true);
                 (0..3).for_each(|a| p.impulse[a] += took[a]);
             }
             let m = p.friction;
             if !p.surface || (m == 0.0 && p.adhesion == 0.0) {
                 continue;
             }
-            let v = velocity(p, slots);
+            let v = velocity(terms, slots);
             let rel: [f64; 3] = std::array::from_fn(|a| v[a] - vb[a]);
             let slip: [f64; 3] = std::array::from_fn(|a| rel[a] - dot(rel, n) * n[a]);
             let speed = dot(slip, slip).sqrt();
@@ -291,13 +323,13 @@ pub fn solve(set: &mut Contacts, body_velocity: &[[f64; 3]], memory: &Memory) {
             // Friction acts where the soil is in contact: the sample presses, or its nodes
             // were pressed and the soil does not leave (a separation slower than a tenth
             // of the slip). Its cap leans on its nodes' normal impulse.
-            let lean = leaning(p, slots);
+            let lean = leaning(terms, slots, n);
             let touching = p.normal_impulse > 0.0 || (lean > 0.0 && dot(rel, n) <= 0.1 * speed);
             if !touching {
                 continue;
             }
             let t: [f64; 3] = slip.map(|c| -c / speed);
-            let (s2, mass) = spread(p, slots, t);
+            let (s2, mass) = spread(terms, slots, t);
             if s2 <= 0.0 || mass <= 0.0 {
                 continue;
             }
@@ -311,7 +343,7 @@ pub fn solve(set: &mut Contacts, body_velocity: &[[f64; 3]], memory: &Memory) {
             let delta = speed.min((cap - sofar).max(0.0) / mass);
             largest = largest.max(delta);
             if delta > 0.0 {
-                let took = push(p, slots, t, delta, s2, false);
+                let took = push(terms, slots, t, delta, s2, false);
                 (0..3).for_each(|a| p.impulse[a] += took[a]);
             }
         }

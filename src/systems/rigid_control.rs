@@ -75,30 +75,55 @@ fn driven(first: Option<usize>, k: usize) -> bool {
 /// normal), moving its displacement with it. Returns (points moved, deepest entry in m)
 /// per body.
 fn push_out<D: Dim>(ctx: &mut Context<D>, bodies: &[RigidBodySpec]) -> Vec<(u64, f64)> {
+    use rayon::prelude::*;
+    /// Points a task: a chunk's bounds tests are cheap, so chunks are long.
+    const CHUNK: usize = 4096;
     let mut out = vec![(0, 0.0); bodies.len()];
     for (b, body) in bodies.iter().enumerate() {
         let offset = ctx.state.control.bodies[b].offset;
         let (lo, hi) = body.bounds(D::N);
+        // Moves a point inside the body to its surface: its shift (m), and its depth (m).
+        let shift = |xp: &Position<D::Vec>| -> Option<(D::Vec, f64)> {
+            let at: [f64; 3] = std::array::from_fn(|a| D::vec_to3(xp.0)[a] - offset[a]);
+            if (0..D::N).any(|a| at[a] < lo[a] || at[a] > hi[a]) {
+                return None;
+            }
+            let (phi, normal, _) = body.distance(at, D::N);
+            (phi < 0.0).then(|| (D::vec_from(normal.map(|c| -phi * c)), -phi))
+        };
+        // Each point is moved on its own; the count and the deepest entry come out the
+        // same in any order (a sum of integers, a maximum), so on any thread count.
+        let add = |a: (u64, f64), b: (u64, f64)| (a.0 + b.0, a.1.max(b.1));
         for arch in points_with::<Position<D::Vec>>(&ctx.world) {
             let mut x = col_mut::<Position<D::Vec>>(arch);
-            let mut u = arch.get::<&mut Displacement<D::Vec>>();
-            for (p, xp) in x.iter_mut().enumerate() {
-                let at: [f64; 3] = std::array::from_fn(|a| D::vec_to3(xp.0)[a] - offset[a]);
-                if (0..D::N).any(|a| at[a] < lo[a] || at[a] > hi[a]) {
-                    continue;
-                }
-                let (phi, normal, _) = body.distance(at, D::N);
-                if phi >= 0.0 {
-                    continue;
-                }
-                let shift = D::vec_from(normal.map(|c| -phi * c));
-                xp.0 += shift;
-                if let Some(u) = u.as_mut() {
-                    u[p].0 += shift;
-                }
-                out[b].0 += 1;
-                out[b].1 = f64::max(out[b].1, -phi);
-            }
+            let moved = match arch.get::<&mut Displacement<D::Vec>>() {
+                Some(mut u) => (x.par_chunks_mut(CHUNK).zip(u.par_chunks_mut(CHUNK)))
+                    .map(|(x, u)| {
+                        let mut n = (0, 0.0);
+                        for (xp, up) in x.iter_mut().zip(u) {
+                            if let Some((s, depth)) = shift(xp) {
+                                xp.0 += s;
+                                up.0 += s;
+                                n = add(n, (1, depth));
+                            }
+                        }
+                        n
+                    })
+                    .reduce(|| (0, 0.0), add),
+                None => (x.par_chunks_mut(CHUNK))
+                    .map(|x| {
+                        let mut n = (0, 0.0);
+                        for xp in x {
+                            if let Some((s, depth)) = shift(xp) {
+                                xp.0 += s;
+                                n = add(n, (1, depth));
+                            }
+                        }
+                        n
+                    })
+                    .reduce(|| (0, 0.0), add),
+            };
+            out[b] = add(out[b], moved);
         }
     }
     out
