@@ -385,7 +385,7 @@ fn a_strip_footing_pushed_below_the_surface_meets_more_resistance() {
 
 /// `scenes/passive_wall.ron` (coarse, 3 % of H) after a geostatic stage: the wall holds
 /// its place through the first stage (`motion.stage`), where the sand comes to rest
-/// against it at K0 = ν/(1 − ν) = 0.43, ½ K0 γ H² = 15.13 kN/m (14.73, −2.7 %), and sets
+/// against it at K0 = ν/(1 − ν) = 0.43, ½ K0 γ H² = 15.13 kN/m (14.62, −3.4 %), and sets
 /// off with the second.
 #[test]
 fn a_wall_holds_through_a_geostatic_stage_then_is_pushed() {
@@ -411,13 +411,13 @@ fn a_wall_holds_through_a_geostatic_stage_then_is_pushed() {
     );
     assert!((s.curve[3].displacement - 0.06).abs() < 1e-12);
     assert!(thrust[3] > 6.0 * thrust[0], "{thrust:?}");
-    assert_eq!(thrust[3], 103970.57538605074);
+    assert_eq!(thrust[3], 100891.15587667911);
 }
 
 /// `scenes/passive_wall.ron`, coarser and shorter (h = H/10, 3 % of H): a smooth wall pushed
 /// into dry sand (φ = 30°). Rankine's passive thrust ½ K_p γ H² with K_p = 3 is
-/// 105.9 kN/m; the static thrusts 99.2, 102.6 and 105.1 kN/m rise to it (the last −0.8 %,
-/// pinned).
+/// 105.9 kN/m; the static thrusts 98.0, 99.3 and 101.3 kN/m rise towards it (the last
+/// −4.4 %, pinned; the scene's wall peaks at 10 % of H).
 #[test]
 fn a_smooth_wall_pushed_into_sand_meets_rankines_passive_thrust() {
     let coarse = [
@@ -433,17 +433,17 @@ fn a_smooth_wall_pushed_into_sand_meets_rankines_passive_thrust() {
         rel(thrust[2], rankine).abs() < 0.1,
         "{thrust:?} against {rankine}"
     );
-    assert_eq!(thrust[2], 105109.39838322405);
+    assert_eq!(thrust[2], 101263.76280602142);
 }
 
 /// `scenes/passive_wall_rough.ron`, coarser and shorter (h = H/10, 3 % of H): a rough wall
 /// (δ = φ = 30°) pushed into sand that goes on below its toe. Lancellotta's lower bound
 /// (2002, Géotechnique 52(8), eq. 1) for the wall's normal stress, K_p = 5.03, gives
-/// 177.5 kN/m; Coulomb's planar wedge 308.8 kN/m. The rough wall's static thrusts 120.1,
-/// 150.2 and 170.4 kN/m (the last −4.0 %, pinned) rise above the same wall's smooth ones
-/// (116.4, 127.8, 129.3 kN/m, pinned: at this cell the smooth wall reads 22 % over
-/// Rankine's 105.9, its contact reaching a cell below the toe; 7 % at h = H/40), its shear
-/// held under tan δ times the thrust.
+/// 177.5 kN/m; Coulomb's planar wedge 308.8 kN/m. The rough wall's static thrusts 115.1,
+/// 143.6 and 166.3 kN/m (the last −6.3 %, pinned, still rising: the scene's wall peaks at
+/// 10 % of H) rise above the same wall's smooth ones (112.1, 119.2, 123.6 kN/m, pinned: at
+/// this cell the smooth wall reads 17 % over Rankine's 105.9, its contact reaching a cell
+/// below the toe), its shear held under tan δ times the thrust.
 #[test]
 fn a_rough_wall_pushed_into_sand_carries_more_than_the_smooth_one() {
     let coarse = [
@@ -472,11 +472,11 @@ fn a_rough_wall_pushed_into_sand_carries_more_than_the_smooth_one() {
         "{kp} {coulomb}"
     );
     assert!(r[2] > 1.2 * sm[2] && r[2] < coulomb, "{r:?} {sm:?}");
-    assert!(rel(r[2], lancellotta).abs() < 0.05, "{r:?} against {lancellotta}");
+    assert!(rel(r[2], lancellotta).abs() < 0.08, "{r:?} against {lancellotta}");
     let shear = rough.curve[2].force[1].abs();
     assert!(shear > 0.1 * r[2] && shear <= delta.tan() * r[2], "{shear} {r:?}");
-    assert_eq!(r[2], 170434.49179852247);
-    assert_eq!(sm[2], 129290.75556154626);
+    assert_eq!(r[2], 166314.31130996777);
+    assert_eq!(sm[2], 123581.23461490122);
 }
 
 /// The same block on a rigid base with adhesion alone (`Frictional(angle: 0.0, adhesion:
