@@ -127,6 +127,9 @@ pub struct Numerics {
     /// Smallest mass that accelerates an interior node (kg): a_i = f_i / max(m_i, floor),
     /// scaled on the grid's faces by the node's share ([`crate::grid::Grid::inertia`]).
     pub virtual_mass_floor: f64,
+    /// A rigid-body contact solve stops when no sweep changes a contact's velocity by more
+    /// than this fraction of its scale ([`crate::rigid::contact::solve`]).
+    pub contact_tolerance: f64,
     /// Interior nodes lighter than this carry no degrees of freedom (kg); scaled on the
     /// grid's faces by the node's share ([`crate::grid::Grid::carries`]).
     ///

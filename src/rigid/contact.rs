@@ -10,9 +10,9 @@
 //! fixed order (projected Gauss–Seidel: the normal impulse summed per constraint stays
 //! ≥ 0, a surface sample's tangential one within tan δ times the normal impulse it leans
 //! on plus the adhesion cap) until no sweep changes a contact's velocity by more than
-//! `TOLERANCE` (1e-5) of the fastest entry before the solve (or of the first sweep's
-//! largest change, when that is larger). The order is fixed, so the result is the same on
-//! any thread count.
+//! `solver.contact_tolerance` ([`TOLERANCE`], 1e-5, by default) of the fastest entry
+//! before the solve (or of the first sweep's largest change, when that is larger). The
+//! order is fixed, so the result is the same on any thread count.
 //!
 //! Each solve starts from the normal impulses the last step's ended with ([`Memory`],
 //! kept in checkpoints): the overlapping samples of a curved surface and the inside nodes
@@ -34,10 +34,11 @@
 /// Most Gauss–Seidel sweeps over the samples per solve.
 const MAX_SWEEPS: usize = 200;
 
-/// A solve ends when no sweep changes a contact's velocity by more than this fraction of
-/// the fastest entry into a body before the solve, or of the first sweep's largest change
-/// when that is larger (soil at rest against a held body enters it at no speed).
-const TOLERANCE: f64 = 1e-5;
+/// The default of `solver.contact_tolerance`: a solve ends when no sweep changes a
+/// contact's velocity by more than this fraction of the fastest entry into a body before
+/// the solve, or of the first sweep's largest change when that is larger (soil at rest
+/// against a held body enters it at no speed).
+pub const TOLERANCE: f64 = 1e-5;
 
 /// A surface sample that meets soil this step: its nodes (slots of [`Contacts::slots`])
 /// and weights, and what it has pushed.
@@ -242,8 +243,10 @@ fn velocity(terms: &[Term], slots: &[Slot]) -> [f64; 3] {
 /// Projected Gauss–Seidel over the samples, each normal impulse starting at its value in
 /// `memory` (zero when it has none; the tangential ones at zero): no entry into a body
 /// moving at `body_velocity` (m/s, per body), then friction (each sample's
-/// [`Contact::friction`] and [`Contact::adhesion`]) where a sample presses.
-pub fn solve(set: &mut Contacts, body_velocity: &[[f64; 3]], memory: &Memory) {
+/// [`Contact::friction`] and [`Contact::adhesion`]) where a sample presses; until no sweep
+/// changes a contact's velocity by more than `tolerance` of the solve's scale
+/// ([`TOLERANCE`] by default).
+pub fn solve(set: &mut Contacts, body_velocity: &[[f64; 3]], memory: &Memory, tolerance: f64) {
     let slots = &mut set.slots[..];
     for s in slots.iter_mut() {
         s.pressed = [0.0; 3];
@@ -348,7 +351,7 @@ pub fn solve(set: &mut Contacts, body_velocity: &[[f64; 3]], memory: &Memory) {
             }
         }
         let scale = reference.max(*first.get_or_insert(largest));
-        if largest <= TOLERANCE * scale {
+        if largest <= tolerance * scale {
             break;
         }
     }

@@ -276,6 +276,7 @@ fn numerics(solver: &SolverSpec, dt: f64, full_node_mass: f64, initial_energy: f
         flip: solver.flip,
         min_node_mass: solver.node_mass_cutoff * full_node_mass,
         virtual_mass_floor: solver.virtual_mass_floor * full_node_mass,
+        contact_tolerance: solver.contact_tolerance,
         initial_energy,
     }
 }

@@ -435,6 +435,11 @@ pub struct SolverSpec {
     /// (halved per grid face the node lies on; default 0.01). See `Settings::virtual_mass_floor`.
     #[serde(default = "default_virtual_mass_floor")]
     pub virtual_mass_floor: f64,
+    /// A rigid-body contact solve stops when no sweep changes a contact's velocity by more
+    /// than this fraction of the solve's scale (default 1e-5; at most 1e-3). Looser is
+    /// fewer sweeps and a less exact contact: see docs/performance.md.
+    #[serde(default = "default_contact_tolerance")]
+    pub contact_tolerance: f64,
     /// FLIP fraction α of the point velocity update: 1 (default) is FLIP, 0 is PIC, which
     /// damps the velocity noise of the points.
     #[serde(default = "default_flip")]
@@ -498,6 +503,10 @@ fn default_node_mass_cutoff() -> f64 {
 
 fn default_virtual_mass_floor() -> f64 {
     0.01
+}
+
+fn default_contact_tolerance() -> f64 {
+    crate::rigid::contact::TOLERANCE
 }
 
 fn default_sort_every() -> u64 {

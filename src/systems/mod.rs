@@ -798,6 +798,7 @@ mod tests {
             anti_locking: AntiLocking::Off,
             sort_every: 100,
             peak_interpolation: false,
+            contact_tolerance: crate::rigid::contact::TOLERANCE,
             flip: 1.0,
             min_node_mass: 0.0,
             initial_energy: 0.0,

@@ -326,7 +326,13 @@ impl<D: Dim, S: Shape> System<D> for RigidContact<D, S> {
         };
         let bodies = &ctx.model.bodies;
         let velocities: Vec<[f64; 3]> = ctx.state.control.bodies.iter().map(|b| b.velocity).collect();
-        solve(&mut set, &velocities, &ctx.state.control.contact_memory);
+        let tolerance = ctx.numerics.contact_tolerance;
+        solve(
+            &mut set,
+            &velocities,
+            &ctx.state.control.contact_memory,
+            tolerance,
+        );
         ctx.state.control.contact_memory = remember(&set.contacts);
         let dt = ctx.numerics.dt;
         let n = nodes(&ctx.world);
@@ -412,7 +418,12 @@ pub fn project<D: Dim>(ctx: &mut Context<D>) {
     for p in &mut control.contacts.contacts {
         p.adhesion = 0.0;
     }
-    solve(&mut control.contacts, &velocities, &Memory::new());
+    solve(
+        &mut control.contacts,
+        &velocities,
+        &Memory::new(),
+        ctx.numerics.contact_tolerance,
+    );
     for s in &control.contacts.slots {
         if held.as_ref().is_none_or(|h| h.contains(&s.node)) {
             nv[s.node].0 = D::vec_from(s.v);

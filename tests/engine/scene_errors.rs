@@ -202,6 +202,13 @@ fn non_physical_values_are_rejected_with_the_rule() {
         13,
         &["solver.time_step", "0 < α ≤ 1"],
     );
+    rejects(
+        "contact_tolerance",
+        "max_steps: 10",
+        "max_steps: 10, contact_tolerance: 0.01",
+        13,
+        &["solver.contact_tolerance", "(0, 1e-3]"],
+    );
 }
 
 #[test]

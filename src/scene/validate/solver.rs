@@ -105,6 +105,16 @@ pub(super) fn check_solver(r: &Rules) -> Result<(), SceneError> {
             );
         }
     }
+    let t = s.solver.contact_tolerance;
+    if !(t > 0.0 && t <= 1e-3) {
+        return r.bad(
+            "solver.contact_tolerance",
+            format!(
+                "must be in (0, 1e-3] (a fraction of the contact solve's scale; looser leaves \
+                 part of each step's entry into a body), found {t}"
+            ),
+        );
+    }
     if !(0.0..=1.0).contains(&s.solver.flip) {
         return r.bad(
             "solver.flip",
