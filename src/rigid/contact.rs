@@ -248,23 +248,23 @@ fn velocity(terms: &[Term], slots: &[Slot]) -> [f64; 3] {
 /// ([`TOLERANCE`] by default).
 pub fn solve(set: &mut Contacts, body_velocity: &[[f64; 3]], memory: &Memory, tolerance: f64) {
     let slots = &mut set.slots[..];
-    for s in slots.iter_mut() {
-        s.pressed = [0.0; 3];
-        s.share = 0.0;
-    }
-    for p in set.contacts.iter_mut() {
-        p.normal_impulse = 0.0;
-        p.impulse = [0.0; 3];
-        if p.surface {
-            for &(k, w) in &p.nodes {
-                slots[k].share += w / p.weight;
-            }
-        }
-    }
     // Each constraint's nodes as the sweeps use them, and how its normal change spreads:
     // the weights, inertias and free axes do not change during the solve.
     let (terms, starts) = terms(&set.contacts, slots);
     let of = |c: usize| &terms[starts[c]..starts[c + 1]];
+    for s in slots.iter_mut() {
+        s.pressed = [0.0; 3];
+        s.share = 0.0;
+    }
+    for (c, p) in set.contacts.iter_mut().enumerate() {
+        p.normal_impulse = 0.0;
+        p.impulse = [0.0; 3];
+        if p.surface {
+            for t in of(c) {
+                slots[t.slot].share += t.share;
+            }
+        }
+    }
     let normal_spread: Vec<(f64, f64)> = (set.contacts.iter().enumerate())
         .map(|(c, p)| spread(of(c), slots, p.normal))
         .collect();

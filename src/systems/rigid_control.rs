@@ -94,33 +94,28 @@ fn push_out<D: Dim>(ctx: &mut Context<D>, bodies: &[RigidBodySpec]) -> Vec<(u64,
         // Each point is moved on its own; the count and the deepest entry come out the
         // same in any order (a sum of integers, a maximum), so on any thread count.
         let add = |a: (u64, f64), b: (u64, f64)| (a.0 + b.0, a.1.max(b.1));
+        // One chunk of points, with its displacements where the points keep them.
+        let chunk = |x: &mut [Position<D::Vec>], mut u: Option<&mut [Displacement<D::Vec>]>| {
+            let mut n = (0, 0.0);
+            for (p, xp) in x.iter_mut().enumerate() {
+                if let Some((s, depth)) = shift(xp) {
+                    xp.0 += s;
+                    if let Some(u) = u.as_deref_mut() {
+                        u[p].0 += s;
+                    }
+                    n = add(n, (1, depth));
+                }
+            }
+            n
+        };
         for arch in points_with::<Position<D::Vec>>(&ctx.world) {
             let mut x = col_mut::<Position<D::Vec>>(arch);
             let moved = match arch.get::<&mut Displacement<D::Vec>>() {
                 Some(mut u) => (x.par_chunks_mut(CHUNK).zip(u.par_chunks_mut(CHUNK)))
-                    .map(|(x, u)| {
-                        let mut n = (0, 0.0);
-                        for (xp, up) in x.iter_mut().zip(u) {
-                            if let Some((s, depth)) = shift(xp) {
-                                xp.0 += s;
-                                up.0 += s;
-                                n = add(n, (1, depth));
-                            }
-                        }
-                        n
-                    })
+                    .map(|(x, u)| chunk(x, Some(u)))
                     .reduce(|| (0, 0.0), add),
                 None => (x.par_chunks_mut(CHUNK))
-                    .map(|x| {
-                        let mut n = (0, 0.0);
-                        for xp in x {
-                            if let Some((s, depth)) = shift(xp) {
-                                xp.0 += s;
-                                n = add(n, (1, depth));
-                            }
-                        }
-                        n
-                    })
+                    .map(|x| chunk(x, None))
                     .reduce(|| (0, 0.0), add),
             };
             out[b] = add(out[b], moved);
