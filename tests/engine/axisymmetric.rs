@@ -394,8 +394,8 @@ fn a_cone_in_sand_bears_in_proportion_to_its_confining_stress() {
 /// `scenes/ball.ron` over its first 0.3 D (h = D/8, three increments): a smooth sphere
 /// moved along the axis through confined Tresca clay. Randolph, Martin & Hu (2000) give
 /// N = F/(c_u π D²/4) = 11.0 for full flow round a smooth sphere; over the first 0.3 D
-/// the flow round it is not yet whole and the static states (9.80, 10.54, 10.36) lie
-/// under that, their mean 10.23 within 10 % (the scene reaches 10.77 over its second
+/// the flow round it is not yet whole and the static states (9.14, 10.49, 10.42) lie
+/// under that, their mean 10.02 within 10 % (the scene reaches 10.72 over its second
 /// diameter, docs/verification.md); the last is pinned.
 #[test]
 fn a_smooth_ball_on_the_axis_has_the_flow_round_factor() {
@@ -406,7 +406,7 @@ fn a_smooth_ball_on_the_axis_has_the_flow_round_factor() {
     let mean = n.iter().sum::<f64>() / 3.0;
     assert!(n.iter().all(|&f| f < 11.0), "N {n:?} against 11.0");
     assert!(rel(mean, 11.0).abs() < 0.10, "N {n:?}, mean {mean} against 11.0");
-    assert_eq!(n[2], 10.357935869704056);
+    assert_eq!(n[2], 10.421726919312526);
     let ball = &s.rigid_bodies[0];
     assert!(ball.deepest_entry < 0.1 * 0.125, "{ball:?}");
 }
