@@ -391,22 +391,23 @@ fn a_cone_in_sand_bears_in_proportion_to_its_confining_stress() {
     assert_eq!(at_200, 10.494907210552185);
 }
 
-/// `scenes/ball.ron` over its first 0.3 D (h = D/8, three increments): a smooth sphere
-/// moved along the axis through confined Tresca clay. Randolph, Martin & Hu (2000) give
-/// N = F/(c_u π D²/4) = 11.0 for full flow round a smooth sphere; over the first 0.3 D
-/// the flow round it is not yet whole and the static states (9.14, 10.49, 10.42) lie
-/// under that, their mean 10.02 within 10 % (the scene reaches 10.72 over its second
-/// diameter, docs/verification.md); the last is pinned.
+/// `scenes/ball.ron` over its first 0.3 D (h = D/8, 3 × 3 points a cell, three
+/// increments): a smooth sphere moved along the axis through confined Tresca clay.
+/// Randolph, Martin & Hu (2000) give N = F/(c_u π D²/4) = 11.0 for full flow round a
+/// smooth sphere; the static states (10.75, 10.93, 11.21) are within 3 % of it already
+/// (the scene reads 10.90 over its second diameter, docs/verification.md); the last is
+/// pinned.
 #[test]
 fn a_smooth_ball_on_the_axis_has_the_flow_round_factor() {
     let s = run("ball.ron", &["rigid_bodies[0].motion.travel=0.3"]);
     assert!(s.converged, "{:?}", s.error);
     let n = factors(&s, 10.0e3);
     assert_eq!(n.len(), 3);
-    let mean = n.iter().sum::<f64>() / 3.0;
-    assert!(n.iter().all(|&f| f < 11.0), "N {n:?} against 11.0");
-    assert!(rel(mean, 11.0).abs() < 0.10, "N {n:?}, mean {mean} against 11.0");
-    assert_eq!(n[2], 10.421726919312526);
+    assert!(
+        n.iter().all(|&f| rel(f, 11.0).abs() < 0.03),
+        "N {n:?} against 11.0"
+    );
+    assert_eq!(n[2], 11.205747476249151);
     let ball = &s.rigid_bodies[0];
     assert!(ball.deepest_entry < 0.1 * 0.125, "{ball:?}");
 }
