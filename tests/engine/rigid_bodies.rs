@@ -4,6 +4,8 @@
 use crate::common;
 
 use crate::common::{factors, forces, refusal, rel, run};
+use kdmpm::run::Run;
+use kdmpm::scene::LoadedScene;
 
 /// `scenes/footing_rigid.ron`: the smooth strip footing of `footing.ron` as a rigid body
 /// pushed 0.1 m into weightless Tresca clay. Prandtl's limit pressure (2 + π) c = 51.42 kPa
@@ -336,31 +338,29 @@ fn a_rough_tbar_has_the_rough_flow_round_factor() {
 /// and the mean N over 0.5–1 D is pinned (12.57; 11.94 exact, D/4 reads high).
 #[test]
 fn the_cell_means_keep_the_clay_a_rough_tbar_drags_in_compression() {
-    let scene = common::scene("tbar.ron");
     let coarse = |anti_locking: &str| {
         let out = common::scratch("rough-tbar", anti_locking);
-        let done = common::run_into(
-            &scene,
-            &out,
-            &[
-                "rigid_bodies[0].interface=Rough",
-                "rigid_bodies[0].motion.travel=1.0",
-                "grid.cell_size=0.25",
-                "grid.cells=[10, 28]",
-                "bodies[0].points_per_cell=[2, 2]",
-                &format!("solver.anti_locking={anti_locking}"),
-            ],
-        );
-        assert!(done.status.success(), "{anti_locking}: {done:?}");
+        let overrides = [
+            "rigid_bodies[0].interface=Rough",
+            "rigid_bodies[0].motion.travel=1.0",
+            "grid.cell_size=0.25",
+            "grid.cells=[10, 28]",
+            "bodies[0].points_per_cell=[2, 2]",
+        ]
+        .map(String::from)
+        .into_iter()
+        .chain([format!("solver.anti_locking={anti_locking}")])
+        .collect::<Vec<_>>();
+        let loaded = LoadedScene::from_file(&common::scene("tbar.ron"), &overrides).expect("loads");
+        let report =
+            common::on_own_thread(|| Run::scene(loaded).into_dir(&out).quiet(true).go()).expect("runs");
+        let s = &report.summary;
+        assert!(s.converged, "{anti_locking}: {:?}", s.error);
         let points = common::read_vtu(&out.join("points.vtu"));
         let most_tensile = points["mean_stress"].1.iter().copied().fold(f64::MIN, f64::max);
-        let summary = common::summary_numbers(&out);
-        let late: Vec<f64> = summary["curve"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .filter(|c| c["displacement"].as_f64().unwrap() > 0.5 + 1e-9)
-            .map(|c| c["pressure"].as_f64().unwrap() / 10.0e3)
+        let late: Vec<f64> = (s.curve.iter().zip(factors(s, 10.0e3)))
+            .filter(|(c, _)| c.displacement > 0.5 + 1e-9)
+            .map(|(_, n)| n)
             .collect();
         assert_eq!(late.len(), 10, "{anti_locking}");
         (most_tensile, late.iter().sum::<f64>() / late.len() as f64)
