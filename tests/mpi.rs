@@ -346,10 +346,11 @@ fn curves_agree(one: &Value, many: &Value, tolerance: f64, what: &str) {
 /// The penetration problems on 2 and 4 ranks follow one rank step for step: a footing of
 /// driven nodes and a rigid one (their reactions summed over the nodes each rank owns), a
 /// c–φ footing with the cell means against locking, the T-bar under a confining pressure,
-/// the cone's first half diameter with its surcharge as a pressure, and a rigid footing
-/// and a surface load under load control. Every rank solves the contacts whole, from the
-/// nodal values their owners gather, so the curves differ from one rank's only by the
-/// order of additions in the shared node layers.
+/// the cone's first quarter diameter with its surcharge as a pressure and its tip rough
+/// (the clay's strength beside each sample summed over every rank's points), and a rigid
+/// footing and a surface load under load control. Every rank solves the contacts whole,
+/// from the nodal values their owners gather, so the curves differ from one rank's only
+/// by the order of additions in the shared node layers.
 #[test]
 fn rigid_bodies_motions_and_loads_on_2_and_4_ranks_agree_with_one_rank_to_1e_10() {
     let cases: [(&str, &str, &[&str]); 7] = [
@@ -364,7 +365,10 @@ fn rigid_bodies_motions_and_loads_on_2_and_4_ranks_agree_with_one_rank_to_1e_10(
         (
             "cpt.ron",
             "cpt",
-            &["rigid_bodies[0].motion=(velocity: [0.0, -0.05], travel: 0.25, increment: 0.25)"],
+            &[
+                "rigid_bodies[0].motion=(velocity: [0.0, -0.05], travel: 0.25, increment: 0.25)",
+                "rigid_bodies[0].parts[0].interface=Some(Rough)",
+            ],
         ),
         ("footing_rigid_load.ron", "rigid-load", &[]),
         ("footing_load.ron", "load", &[]),

@@ -118,6 +118,13 @@ pub trait Material: Send + Sync {
     fn undrained_strength(&self, _stress: &Sym3, _state: &Self::State) -> Option<f64> {
         None
     }
+    /// The shear strength of the soil on a plane through a point at `stress` (Pa) and
+    /// `state`, τ ≤ c + σ_n tan φ with σ_n the plane's normal pressure: (c in Pa, tan φ).
+    /// What a `Rough` interface beside the point can carry (`rigid/soil_strength.rs`).
+    /// `None` for a model without strength (elastic): the interface does not slip.
+    fn plane_strength(&self, _stress: &Sym3, _state: &Self::State) -> Option<(f64, f64)> {
+        None
+    }
 }
 
 /// A material as a scene gives it: the serde struct is its schema.
@@ -383,6 +390,17 @@ macro_rules! define_materials {
                     $(MaterialModel::$variant(m) => match same_type(&mut own) {
                         Some(own) => m.undrained_strength(stress, own),
                         None => m.undrained_strength(stress, &stateless::<<$spec as SceneMaterial>::Model>()),
+                    },)*
+                }
+            }
+
+            /// [`Material::plane_strength`] of a point whose state column is of type `S`.
+            pub fn plane_strength<S: MaterialState>(&self, stress: &Sym3, state: &S) -> Option<(f64, f64)> {
+                let mut own = *state;
+                match self {
+                    $(MaterialModel::$variant(m) => match same_type(&mut own) {
+                        Some(own) => m.plane_strength(stress, own),
+                        None => m.plane_strength(stress, &stateless::<<$spec as SceneMaterial>::Model>()),
                     },)*
                 }
             }

@@ -515,6 +515,16 @@ impl Material for ModifiedCamClay {
         let p_f = REFERENCE_PRESSURE * ((gamma - state.specific_volume) / self.lambda).exp();
         Some(0.5 * self.m * p_f)
     }
+    /// Undrained (water in the state): s_u on any plane, [`Material::undrained_strength`].
+    /// Drained: the critical state's friction, sin φ_cs = 3M/(6 + M) (triaxial compression,
+    /// Wood 1990), without cohesion.
+    fn plane_strength(&self, stress: &Sym3, state: &CamClayState) -> Option<(f64, f64)> {
+        if self.holds_water() {
+            return self.undrained_strength(stress, state).map(|s_u| (s_u, 0.0));
+        }
+        let sin = 3.0 * self.m / (6.0 + self.m);
+        Some((0.0, sin / (1.0 - sin * sin).sqrt()))
+    }
 }
 
 #[cfg(test)]

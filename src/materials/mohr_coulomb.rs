@@ -442,6 +442,11 @@ impl Material for MohrCoulomb {
     fn undrained_strength(&self, _: &Sym3, _: &PlasticStrain) -> Option<f64> {
         (self.friction == 0.0).then_some(self.cohesion)
     }
+    /// Coulomb's line: c and tan φ whatever the stress (the tension cut-off aside: an
+    /// interface that the soil presses is not in tension).
+    fn plane_strength(&self, _: &Sym3, _: &PlasticStrain) -> Option<(f64, f64)> {
+        Some((self.cohesion, self.friction.tan()))
+    }
     fn p_wave_modulus(&self) -> f64 {
         self.elasticity.p_wave()
     }

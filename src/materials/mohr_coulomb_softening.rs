@@ -211,6 +211,10 @@ impl Material for MohrCoulombSoftening {
             mc.undrained_strength(stress, &PlasticStrain(state.0))
         })
     }
+    /// Coulomb's line at the point's softened c and φ.
+    fn plane_strength(&self, stress: &Sym3, state: &SofteningStrain) -> Option<(f64, f64)> {
+        self.with_strength(state.0, |mc| mc.plane_strength(stress, &PlasticStrain(state.0)))
+    }
     #[inline(always)]
     fn update(&self, stress: &mut Sym3, de: &Sym3, state: &mut SofteningStrain) {
         self.with_strength(state.0, |mc| {

@@ -53,7 +53,8 @@ pub struct Contact {
     pub part: usize,
     /// Unit outward normal of the body (x y z).
     pub normal: [f64; 3],
-    /// Friction coefficient tan δ of the sample's part (infinite when rough).
+    /// Friction coefficient tan δ of the sample's part (a rough part's: the soil's tan φ
+    /// beside it; infinite, no slip, where that soil has no strength).
     pub friction: f64,
     /// Adhesion cap on the sample's tangential impulse (N s), a·A_s·Δt.
     pub adhesion: f64,

@@ -4,7 +4,8 @@
 //! A body is a [`Geometry`] that moves with its control's velocity. It meets the soil at
 //! the grid (`systems::rigid_contact`): at each node the soil touches it, the soil may not
 //! move into the body along the geometry's normal, and the tangential motion is free
-//! (smooth), the body's (rough), or limited by Coulomb friction and an adhesion cap. The
+//! (smooth), limited by Coulomb friction and an adhesion cap, or the body's until the shear
+//! reaches the soil's own strength beside it (rough). The
 //! force this takes is summed per body in node order (its reaction is the opposite).
 //!
 //! A body is driven one of two ways (`systems::rigid_control`), in increments each relaxed
@@ -85,8 +86,8 @@ pub struct RigidBody {
     /// Its surface samples in its starting frame, each with its part's index
     /// ([`RigidBodySpec::samples`]).
     pub samples: Samples,
-    /// Per part: (tan δ, adhesion a in Pa) of its interface ([`Interface::friction`]).
-    pub interfaces: Vec<(f64, f64)>,
+    /// Per part: its interface as the contact holds it ([`Interface::law`]).
+    pub interfaces: Vec<InterfaceLaw>,
     /// Its piezocone readings, checked ([`CptSpec::check`]).
     pub cpt: Option<Cpt>,
 }
@@ -95,7 +96,7 @@ impl RigidBody {
     /// The body of `spec` with the surface `samples` cut for the run's grid.
     pub fn new(spec: RigidBodySpec, samples: Samples) -> Self {
         let interfaces = (0..spec.parts.len())
-            .map(|k| spec.interface_of(k).friction())
+            .map(|k| spec.interface_of(k).law())
             .collect();
         let cpt = (spec.cpt.as_ref()).map(|c| {
             c.check(&spec)
@@ -133,7 +134,10 @@ pub enum Interface {
     /// No shear: the soil slides freely along the body.
     #[default]
     Smooth,
-    /// No slip: soil in contact moves with the body.
+    /// As strong as the soil beside it: the soil moves with the body until the shear
+    /// reaches the soil's own strength on the surface, c + σ_n tan φ (c_u on Tresca clay,
+    /// the fully rough interface of the plasticity solutions), and then slips
+    /// (`systems/soil_strength.rs`). No slip on a soil without strength (elastic).
     Rough,
     /// Coulomb friction τ ≤ tan δ · σ_n + a, δ in degrees, the adhesion a in Pa (α·c_u on
     /// clay).
@@ -224,13 +228,34 @@ impl BodyMotion {
     }
 }
 
+/// An interface as the contact holds it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum InterfaceLaw {
+    /// Coulomb's: the shear at most tan δ times the normal stress plus the adhesion;
+    /// both 0 when smooth.
+    Coulomb {
+        /// tan δ.
+        friction: f64,
+        /// Adhesion a (Pa).
+        adhesion: f64,
+    },
+    /// The soil's own strength beside each sample, found each step (`Rough`).
+    Soil,
+}
+
 impl Interface {
-    /// tan δ, and the adhesion (Pa).
-    pub fn friction(&self) -> (f64, f64) {
+    /// The law the contact holds.
+    pub fn law(&self) -> InterfaceLaw {
         match *self {
-            Interface::Smooth => (0.0, 0.0),
-            Interface::Rough => (f64::INFINITY, f64::INFINITY),
-            Interface::Frictional { angle, adhesion } => (angle.to_radians().tan(), adhesion),
+            Interface::Smooth => InterfaceLaw::Coulomb {
+                friction: 0.0,
+                adhesion: 0.0,
+            },
+            Interface::Rough => InterfaceLaw::Soil,
+            Interface::Frictional { angle, adhesion } => InterfaceLaw::Coulomb {
+                friction: angle.to_radians().tan(),
+                adhesion,
+            },
         }
     }
 

@@ -39,6 +39,7 @@ pub mod remap;
 pub mod rigid_contact;
 pub mod rigid_control;
 pub mod shared;
+pub mod soil_strength;
 pub mod spatial_sort;
 pub mod stages;
 pub mod stress_update;

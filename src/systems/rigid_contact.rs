@@ -13,7 +13,8 @@
 //! summed per sample), so that overlapping samples share their nodes' correction. Where the
 //! soil presses, the tangential slip at a sample is removed the same way, by at most
 //! tan δ · N_s + a·A_s·Δt (Coulomb friction with an adhesion cap a on the sample's surface
-//! A_s, from the interface of the sample's part; no cap when rough, nothing when smooth),
+//! A_s, from the interface of the sample's part; when rough, the soil's own c and tan φ
+//! beside the sample, [`crate::systems::soil_strength`]; nothing when smooth),
 //! N_s being the normal impulse its nodes took, from the samples and the inside nodes
 //! alike, shared among the samples that reach them ([`crate::rigid::contact`]).
 //!
@@ -38,11 +39,12 @@ use crate::error::StepError;
 use crate::grid::NodeBox;
 use crate::infra::columns::{col, col_mut, nodes};
 use crate::rigid::contact::{key, remember, solve, Contact, Contacts, Memory, Slot};
-use crate::rigid::{CornerTest, Corners, Located};
+use crate::rigid::{CornerTest, Corners, InterfaceLaw, Located};
 use crate::schedule::System;
 use crate::shape::{for_each_node, Shape};
 use crate::systems::exchange::{exchange, EXTERNAL, FORCE, MASS, MOMENTUM};
 use crate::systems::shared::{constrain, hold, Hold};
+use crate::systems::soil_strength::SoilStrength;
 use std::marker::PhantomData;
 
 /// Holds the contacts at the bodies' surface samples ([`crate::rigid::RigidBody::samples`],
@@ -52,6 +54,8 @@ pub struct RigidContact<D: Dim, S> {
     /// Per node, its slot in this step's [`Contacts::slots`] (`u32::MAX`: none); all
     /// `u32::MAX` between steps.
     slot_of: Vec<u32>,
+    /// The soil's strength round the rough samples, summed again each step.
+    strength: SoilStrength,
     _marker: PhantomData<fn() -> (D, S)>,
 }
 
@@ -59,6 +63,7 @@ impl<D: Dim, S> Default for RigidContact<D, S> {
     fn default() -> Self {
         RigidContact {
             slot_of: Vec::new(),
+            strength: SoilStrength::default(),
             _marker: PhantomData,
         }
     }
@@ -186,7 +191,12 @@ fn soil<'a, D: Dim, S: Shape>(
 /// `corners: Released` those that do not face a corner of the body
 /// ([`crate::rigid::corners`]). `slot_of` (one entry a node)
 /// is all `u32::MAX` on entry and is left so.
-fn place<D: Dim, S: Shape>(ctx: &Context<D>, soil: &Soil<D>, slot_of: &mut Vec<u32>) -> Contacts {
+fn place<D: Dim, S: Shape>(
+    ctx: &Context<D>,
+    soil: &Soil<D>,
+    strength: &SoilStrength,
+    slot_of: &mut Vec<u32>,
+) -> Contacts {
     let fix = col::<NodeFixity>(nodes(&ctx.world));
     let (grid, st) = (&ctx.grid, &ctx.numerics);
     let drives = &ctx.state.control.drives;
@@ -285,13 +295,25 @@ fn place<D: Dim, S: Shape>(ctx: &Context<D>, soil: &Soil<D>, slot_of: &mut Vec<u
             } else {
                 s.measure
             };
+            // A rough part's caps are the soil's strength beside the sample; no slip where
+            // that soil has none.
+            let law = match interfaces[*part] {
+                InterfaceLaw::Soil => strength
+                    .at_sample(grid, reach.iter().map(|&(k, w)| (set.slots[k].node, w)))
+                    .unwrap_or(InterfaceLaw::Soil),
+                law => law,
+            };
+            let (friction, adhesion) = match law {
+                InterfaceLaw::Coulomb { friction, adhesion } => (friction, adhesion),
+                InterfaceLaw::Soil => (f64::INFINITY, f64::INFINITY),
+            };
             set.contacts.push(Contact {
                 key: key(b, true, index),
                 body: b,
                 part: *part,
                 normal: s.normal,
-                friction: interfaces[*part].0,
-                adhesion: interfaces[*part].1 * area * st.dt,
+                friction,
+                adhesion: adhesion * area * st.dt,
                 surface: true,
                 nodes: reach,
                 weight,
@@ -321,8 +343,10 @@ impl<D: Dim, S: Shape> System<D> for RigidContact<D, S> {
                 col::<NodeMomentum<D::Vec>>(n),
                 col::<NodeForce<D::Vec>>(n),
             );
+            let offsets: Vec<[f64; 3]> = ctx.state.control.bodies.iter().map(|b| b.offset).collect();
+            self.strength.gather(ctx, &ctx.model.bodies, &offsets);
             let soil = soil::<D, S>(ctx, &nm, &np, &nf);
-            place::<D, S>(ctx, &soil, &mut self.slot_of)
+            place::<D, S>(ctx, &soil, &self.strength, &mut self.slot_of)
         };
         let bodies = &ctx.model.bodies;
         let velocities: Vec<[f64; 3]> = ctx.state.control.bodies.iter().map(|b| b.velocity).collect();

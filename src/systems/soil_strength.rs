@@ -1,0 +1,188 @@
+//! The strength of the soil beside a body's surface: what a `Rough` interface carries.
+//!
+//! A rough interface is as strong as the soil it touches: the soil moves with the body
+//! until the shear on the surface reaches the soil's own strength on that plane,
+//! τ = c + σ_n tan φ (σ_n the normal pressure the body takes there), and then slips in a
+//! skin along it. On Tresca clay that is a shear of c_u, the fully rough interface of the
+//! plasticity solutions (the T-bar and the ball of Randolph & Houlsby 1984 and Martin &
+//! Randolph 2006, the cone's α = 1 of Teh & Houlsby 1991); a no-slip face would hold
+//! more than the clay beside it can (a no-slip cone face carries 3–6 c_u,
+//! docs/verification.md).
+//!
+//! Each step the points in the cells round the rough samples give their model's (c, tan φ)
+//! at their stress and state ([`crate::materials::Material::plane_strength`]), summed per
+//! cell with their mass; a node takes the sums of the 2ⁿ cells it is a corner of, and a
+//! sample the mean over its nodes weighted by w_i times the nodes' sums of mass:
+//!
+//! c_s = Σ_i w_i Σ_{p∈cells(i)} m_p c_p / Σ_i w_i Σ_{p∈cells(i)} m_p, and tan φ_s alike.
+//!
+//! Its friction is then tan φ_s on the normal impulse it leans on and its adhesion c_s·A_s·Δt,
+//! the caps of a `Frictional` interface ([`crate::rigid::contact`]). A sample whose nodes
+//! meet no point with strength (an elastic soil) holds the soil without slip. Over several
+//! ranks each rank sums its own points and the sums are made whole on every rank; the
+//! pass reads the points once a step, and only in a scene with a rough part.
+
+use crate::components::*;
+use crate::context::Context;
+use crate::dim::Dim;
+use crate::grid::Grid;
+use crate::infra::columns::{col, points_with};
+use crate::materials::{with_state_column, MaterialState, WithStates};
+use crate::rigid::{InterfaceLaw, RigidBody};
+use crate::tensor::StoredSym;
+
+/// How far round a rough sample's cell the points are summed (cells along each axis): a
+/// sample's nodes lie within two cells of its own for every shape, and a node's cells
+/// within one of it.
+const REACH: usize = 2;
+
+/// Per cell round the rough samples: Σ m, Σ m c, Σ m tan φ over its points with strength.
+/// Cells are keyed by the id of their lowest node ([`Grid::cell_key`]).
+#[derive(Debug, Default)]
+pub struct SoilStrength {
+    /// Per cell key: its index in `cells` (`u32::MAX`: not summed). All `u32::MAX` for
+    /// cells not in `cells`.
+    index: Vec<u32>,
+    /// The summed cells' keys, ascending.
+    cells: Vec<usize>,
+    /// Per summed cell: Σ m (kg), Σ m c (kg Pa), Σ m tan φ (kg).
+    sums: Vec<[f64; 3]>,
+}
+
+impl SoilStrength {
+    /// Sums the points round every rough sample of `bodies` at its body's current place
+    /// (`offsets`, m); nothing when no part is rough.
+    pub fn gather<D: Dim>(&mut self, ctx: &Context<D>, bodies: &[RigidBody], offsets: &[[f64; 3]]) {
+        for &c in &self.cells {
+            self.index[c] = u32::MAX;
+        }
+        self.cells.clear();
+        self.sums.clear();
+        let grid = &ctx.grid;
+        self.index.resize(grid.node_count(), u32::MAX);
+        let cells = grid.cells();
+        for (body, offset) in bodies.iter().zip(offsets) {
+            for (s, part) in &body.samples {
+                if body.interfaces[*part] != InterfaceLaw::Soil {
+                    continue;
+                }
+                let x = D::vec_from(std::array::from_fn(|a| s.x[a] + offset[a]));
+                let Some(c) = grid.cell_of(x) else { continue };
+                let range = |a: usize| {
+                    if a < D::N {
+                        c[a].saturating_sub(REACH)..(c[a] + REACH + 1).min(cells[a])
+                    } else {
+                        0..1
+                    }
+                };
+                for k in range(2) {
+                    for j in range(1) {
+                        for i in range(0) {
+                            let key = grid.node_id([i, j, k]);
+                            if self.index[key] == u32::MAX {
+                                self.index[key] = 0;
+                                self.cells.push(key);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        if self.cells.is_empty() {
+            return;
+        }
+        self.cells.sort_unstable();
+        for (n, &c) in self.cells.iter().enumerate() {
+            self.index[c] = n as u32;
+        }
+        self.sums = vec![[0.0; 3]; self.cells.len()];
+        for arch in points_with::<Volume>(&ctx.world) {
+            with_state_column(arch, &mut Summing { ctx, strength: self });
+        }
+        ctx.comm.sum(self.sums.as_flattened_mut());
+    }
+
+    /// The sums of mass and of mass times c and tan φ over the cells that have node `i`
+    /// (id) as a corner.
+    fn at_node<D: Dim>(&self, grid: &Grid<D>, i: usize) -> [f64; 3] {
+        let ijk = grid.node_ijk(i);
+        let cells = grid.cells();
+        let mut sum = [0.0; 3];
+        for corner in 0..1usize << D::N {
+            let mut c = ijk;
+            let mut inside = true;
+            for (a, ca) in c.iter_mut().enumerate().take(D::N) {
+                if corner >> a & 1 == 1 {
+                    inside &= *ca > 0;
+                    *ca = ca.wrapping_sub(1);
+                }
+                inside &= *ca < cells[a];
+            }
+            if !inside {
+                continue;
+            }
+            let k = self.index[grid.node_id(c)];
+            if k != u32::MAX {
+                let s = self.sums[k as usize];
+                (0..3).for_each(|q| sum[q] += s[q]);
+            }
+        }
+        sum
+    }
+
+    /// The soil's Coulomb line (tan φ, and c as the adhesion) at a sample reaching `nodes`
+    /// (ids) with weights `w`; `None` when none of them meets a point with strength.
+    pub fn at_sample<D: Dim>(
+        &self,
+        grid: &Grid<D>,
+        nodes: impl Iterator<Item = (usize, f64)>,
+    ) -> Option<InterfaceLaw> {
+        let mut sum = [0.0; 3];
+        for (i, w) in nodes {
+            let s = self.at_node(grid, i);
+            (0..3).for_each(|q| sum[q] += w * s[q]);
+        }
+        (sum[0] > 0.0).then(|| InterfaceLaw::Coulomb {
+            friction: sum[2] / sum[0],
+            adhesion: sum[1] / sum[0],
+        })
+    }
+}
+
+/// Adds an archetype's points in summed cells to their cell's sums.
+struct Summing<'a, D: Dim> {
+    ctx: &'a Context<D>,
+    strength: &'a mut SoilStrength,
+}
+
+impl<D: Dim> WithStates for Summing<'_, D> {
+    fn with<T: MaterialState>(&mut self, arch: &hecs::Archetype, states: Option<&[T]>) {
+        let (xg, mg, ig, sg) = (
+            col::<Position<D::Vec>>(arch),
+            col::<Mass>(arch),
+            col::<MaterialId>(arch),
+            col::<Stress<D::Stress>>(arch),
+        );
+        let (grid, materials) = (&self.ctx.grid, &self.ctx.materials);
+        let s = &mut *self.strength;
+        for p in 0..xg.len() {
+            let k = s.index[grid.cell_key(xg[p].0)];
+            if k == u32::MAX {
+                continue;
+            }
+            let sigma = sg[p].0.to_sym3();
+            let model = &materials[ig[p].0 as usize];
+            let strength = match states {
+                Some(st) => model.plane_strength(&sigma, &st[p]),
+                None => model.plane_strength(&sigma, &()),
+            };
+            if let Some((c, tan)) = strength {
+                let m = mg[p].0;
+                let sum = &mut s.sums[k as usize];
+                sum[0] += m;
+                sum[1] += m * c;
+                sum[2] += m * tan;
+            }
+        }
+    }
+}
