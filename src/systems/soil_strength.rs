@@ -17,7 +17,11 @@
 //! c_s = Σ_i w_i Σ_{p∈cells(i)} m_p c_p / Σ_i w_i Σ_{p∈cells(i)} m_p, and tan φ_s alike.
 //!
 //! Its friction is then tan φ_s on the normal impulse it leans on and its adhesion c_s·A_s·Δt,
-//! the caps of a `Frictional` interface ([`crate::rigid::contact`]). A sample whose nodes
+//! the caps of a `Frictional` interface ([`crate::rigid::contact`]). Each mean is held
+//! within the least and the largest value of the points it averages, so that a soil of
+//! one strength gives exactly that strength, however its points are summed (over several
+//! ranks the sums come in another order, and a cap one bit off grows, through the
+//! relaxation, into a curve that differs in its fourth figure). A sample whose nodes
 //! meet no point with strength (an elastic soil) holds the soil without slip. Over several
 //! ranks each rank sums its own points and the sums are made whole on every rank; the
 //! pass reads the points once a step, and only in a scene with a rough part.
@@ -47,6 +51,9 @@ pub struct SoilStrength {
     cells: Vec<usize>,
     /// Per summed cell: Σ m (kg), Σ m c (kg Pa), Σ m tan φ (kg).
     sums: Vec<[f64; 3]>,
+    /// Per summed cell: −min c, max c (Pa), −min tan φ, max tan φ over its points with
+    /// strength (−∞ where it has none), so that one reduction (max) takes both bounds.
+    bounds: Vec<[f64; 4]>,
 }
 
 impl SoilStrength {
@@ -58,6 +65,7 @@ impl SoilStrength {
         }
         self.cells.clear();
         self.sums.clear();
+        self.bounds.clear();
         let grid = &ctx.grid;
         self.index.resize(grid.node_count(), u32::MAX);
         let cells = grid.cells();
@@ -96,18 +104,21 @@ impl SoilStrength {
             self.index[c] = n as u32;
         }
         self.sums = vec![[0.0; 3]; self.cells.len()];
+        self.bounds = vec![[f64::NEG_INFINITY; 4]; self.cells.len()];
         for arch in points_with::<Volume>(&ctx.world) {
             with_state_column(arch, &mut Summing { ctx, strength: self });
         }
         ctx.comm.sum(self.sums.as_flattened_mut());
+        ctx.comm.max(self.bounds.as_flattened_mut());
     }
 
     /// The sums of mass and of mass times c and tan φ over the cells that have node `i`
-    /// (id) as a corner.
-    fn at_node<D: Dim>(&self, grid: &Grid<D>, i: usize) -> [f64; 3] {
+    /// (id) as a corner, and the bounds of c and tan φ there (as [`SoilStrength::bounds`]).
+    fn at_node<D: Dim>(&self, grid: &Grid<D>, i: usize) -> ([f64; 3], [f64; 4]) {
         let ijk = grid.node_ijk(i);
         let cells = grid.cells();
         let mut sum = [0.0; 3];
+        let mut bounds = [f64::NEG_INFINITY; 4];
         for corner in 0..1usize << D::N {
             let mut c = ijk;
             let mut inside = true;
@@ -123,11 +134,12 @@ impl SoilStrength {
             }
             let k = self.index[grid.node_id(c)];
             if k != u32::MAX {
-                let s = self.sums[k as usize];
+                let (s, b) = (self.sums[k as usize], self.bounds[k as usize]);
                 (0..3).for_each(|q| sum[q] += s[q]);
+                (0..4).for_each(|q| bounds[q] = bounds[q].max(b[q]));
             }
         }
-        sum
+        (sum, bounds)
     }
 
     /// The soil's Coulomb line (tan φ, and c as the adhesion) at a sample reaching `nodes`
@@ -138,13 +150,17 @@ impl SoilStrength {
         nodes: impl Iterator<Item = (usize, f64)>,
     ) -> Option<InterfaceLaw> {
         let mut sum = [0.0; 3];
+        let mut bounds = [f64::NEG_INFINITY; 4];
         for (i, w) in nodes {
-            let s = self.at_node(grid, i);
-            (0..3).for_each(|q| sum[q] += w * s[q]);
+            let (s, b) = self.at_node(grid, i);
+            if w > 0.0 && s[0] > 0.0 {
+                (0..3).for_each(|q| sum[q] += w * s[q]);
+                (0..4).for_each(|q| bounds[q] = bounds[q].max(b[q]));
+            }
         }
         (sum[0] > 0.0).then(|| InterfaceLaw::Coulomb {
-            friction: sum[2] / sum[0],
-            adhesion: sum[1] / sum[0],
+            friction: (sum[2] / sum[0]).clamp(-bounds[2], bounds[3]),
+            adhesion: (sum[1] / sum[0]).clamp(-bounds[0], bounds[1]),
         })
     }
 }
@@ -182,7 +198,81 @@ impl<D: Dim> WithStates for Summing<'_, D> {
                 sum[0] += m;
                 sum[1] += m * c;
                 sum[2] += m * tan;
+                let b = &mut s.bounds[k as usize];
+                *b = [b[0].max(-c), b[1].max(c), b[2].max(-tan), b[3].max(tan)];
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::dim::Dim2;
+    use glam::DVec2;
+
+    /// A strength table over a 4 × 4 grid (h = 1 m) with the sums of two cells given.
+    fn two_cells(grid: &Grid<Dim2>) -> SoilStrength {
+        let mut s = SoilStrength {
+            index: vec![u32::MAX; grid.node_count()],
+            ..SoilStrength::default()
+        };
+        // Cell (0, 0): 1 kg of clay, c = 10 kPa; cell (1, 0): 3 kg of sand, tan φ = 0.5.
+        for (n, (cell, sums)) in [([0, 0, 0], [1.0, 10.0e3, 0.0]), ([1, 0, 0], [3.0, 0.0, 1.5])]
+            .into_iter()
+            .enumerate()
+        {
+            let key = grid.node_id(cell);
+            s.index[key] = n as u32;
+            s.cells.push(key);
+            s.sums.push(sums);
+            let (c, t) = (sums[1] / sums[0], sums[2] / sums[0]);
+            s.bounds.push([-c, c, -t, t]);
+        }
+        s
+    }
+
+    #[test]
+    fn a_node_takes_the_mass_weighted_strength_of_the_cells_it_corners() {
+        let grid = Grid::<Dim2>::new(DVec2::ZERO, 1.0, [4, 4, 0]);
+        let s = two_cells(&grid);
+        // Node (1, 0) corners both cells (and none below the grid's edge).
+        let law = s.at_sample(&grid, [(grid.node_id([1, 0, 0]), 1.0)].into_iter());
+        let expect = InterfaceLaw::Coulomb {
+            friction: 1.5 / 4.0,
+            adhesion: 10.0e3 / 4.0,
+        };
+        assert_eq!(law, Some(expect));
+        // Node (0, 0) corners the clay's cell alone: c = 10 kPa, no friction.
+        let law = s.at_sample(&grid, [(grid.node_id([0, 0, 0]), 1.0)].into_iter());
+        assert_eq!(
+            law,
+            Some(InterfaceLaw::Coulomb {
+                friction: 0.0,
+                adhesion: 10.0e3
+            })
+        );
+    }
+
+    #[test]
+    fn a_sample_weighs_its_nodes_by_shape_weight_times_mass() {
+        let grid = Grid::<Dim2>::new(DVec2::ZERO, 1.0, [4, 4, 0]);
+        let s = two_cells(&grid);
+        // Nodes (0, 0) (1 kg) and (2, 0) (the sand's 3 kg) at weights 0.75 and 0.25: mass
+        // times weight 0.75 and 0.75, so the mean of the two.
+        let nodes = [(grid.node_id([0, 0, 0]), 0.75), (grid.node_id([2, 0, 0]), 0.25)];
+        let law = s.at_sample(&grid, nodes.into_iter());
+        assert_eq!(
+            law,
+            Some(InterfaceLaw::Coulomb {
+                friction: 0.25,
+                adhesion: 5.0e3
+            })
+        );
+        // Nodes that corner no summed cell (no point with strength): no law, no slip.
+        assert_eq!(
+            s.at_sample(&grid, [(grid.node_id([3, 3, 0]), 1.0)].into_iter()),
+            None
+        );
     }
 }
