@@ -39,7 +39,7 @@ use crate::error::StepError;
 use crate::grid::NodeBox;
 use crate::infra::columns::{col, col_mut, nodes};
 use crate::rigid::contact::{key, remember, solve, Contact, Contacts, Memory, Slot};
-use crate::rigid::{CornerTest, Corners, InterfaceLaw, Located};
+use crate::rigid::{CornerTest, Corners, Located};
 use crate::schedule::System;
 use crate::shape::{for_each_node, Shape};
 use crate::systems::exchange::{exchange, EXTERNAL, FORCE, MASS, MOMENTUM};
@@ -295,18 +295,8 @@ fn place<D: Dim, S: Shape>(
             } else {
                 s.measure
             };
-            // A rough part's caps are the soil's strength beside the sample; no slip where
-            // that soil has none.
-            let law = match interfaces[*part] {
-                InterfaceLaw::Soil => strength
-                    .at_sample(grid, reach.iter().map(|&(k, w)| (set.slots[k].node, w)))
-                    .unwrap_or(InterfaceLaw::Soil),
-                law => law,
-            };
-            let (friction, adhesion) = match law {
-                InterfaceLaw::Coulomb { friction, adhesion } => (friction, adhesion),
-                InterfaceLaw::Soil => (f64::INFINITY, f64::INFINITY),
-            };
+            let nodes = reach.iter().map(|&(k, w)| (set.slots[k].node, w));
+            let (friction, adhesion) = strength.caps(interfaces[*part], grid, nodes);
             set.contacts.push(Contact {
                 key: key(b, true, index),
                 body: b,
@@ -343,8 +333,7 @@ impl<D: Dim, S: Shape> System<D> for RigidContact<D, S> {
                 col::<NodeMomentum<D::Vec>>(n),
                 col::<NodeForce<D::Vec>>(n),
             );
-            let offsets: Vec<[f64; 3]> = ctx.state.control.bodies.iter().map(|b| b.offset).collect();
-            self.strength.gather(ctx, &ctx.model.bodies, &offsets);
+            self.strength.gather(ctx);
             let soil = soil::<D, S>(ctx, &nm, &np, &nf);
             place::<D, S>(ctx, &soil, &self.strength, &mut self.slot_of)
         };

@@ -32,7 +32,7 @@ use crate::dim::Dim;
 use crate::grid::Grid;
 use crate::infra::columns::{col, points_with};
 use crate::materials::{with_state_column, MaterialState, WithStates};
-use crate::rigid::{InterfaceLaw, RigidBody};
+use crate::rigid::InterfaceLaw;
 use crate::tensor::StoredSym;
 
 /// How far round a rough sample's cell the points are summed (cells along each axis): a
@@ -57,19 +57,24 @@ pub struct SoilStrength {
 }
 
 impl SoilStrength {
-    /// Sums the points round every rough sample of `bodies` at its body's current place
-    /// (`offsets`, m); nothing when no part is rough.
-    pub fn gather<D: Dim>(&mut self, ctx: &Context<D>, bodies: &[RigidBody], offsets: &[[f64; 3]]) {
+    /// Sums the points round every rough sample of the scene's bodies at the body's current
+    /// place; nothing (and no table) when no part is rough.
+    pub fn gather<D: Dim>(&mut self, ctx: &Context<D>) {
         for &c in &self.cells {
             self.index[c] = u32::MAX;
         }
         self.cells.clear();
         self.sums.clear();
         self.bounds.clear();
+        let bodies = &ctx.model.bodies;
+        if !bodies.iter().any(|b| b.interfaces.contains(&InterfaceLaw::Soil)) {
+            return;
+        }
         let grid = &ctx.grid;
         self.index.resize(grid.node_count(), u32::MAX);
         let cells = grid.cells();
-        for (body, offset) in bodies.iter().zip(offsets) {
+        for (body, state) in bodies.iter().zip(&ctx.state.control.bodies) {
+            let offset = state.offset;
             for (s, part) in &body.samples {
                 if body.interfaces[*part] != InterfaceLaw::Soil {
                     continue;
@@ -140,6 +145,25 @@ impl SoilStrength {
             }
         }
         (sum, bounds)
+    }
+
+    /// A surface sample's caps under its part's `law` (tan δ, and the adhesion a in Pa):
+    /// Coulomb's own, or for a rough part the soil's beside the sample reaching `nodes`
+    /// (ids, weights), infinite (no slip) where that soil has no strength.
+    pub fn caps<D: Dim>(
+        &self,
+        law: InterfaceLaw,
+        grid: &Grid<D>,
+        nodes: impl Iterator<Item = (usize, f64)>,
+    ) -> (f64, f64) {
+        let law = match law {
+            InterfaceLaw::Soil => self.at_sample(grid, nodes).unwrap_or(law),
+            law => law,
+        };
+        match law {
+            InterfaceLaw::Coulomb { friction, adhesion } => (friction, adhesion),
+            InterfaceLaw::Soil => (f64::INFINITY, f64::INFINITY),
+        }
     }
 
     /// The soil's Coulomb line (tan φ, and c as the adhesion) at a sample reaching `nodes`

@@ -480,6 +480,13 @@ fn a_smooth_wall_pushed_into_sand_meets_rankines_passive_thrust() {
     assert_eq!(thrust[2], 101263.76280602142);
 }
 
+/// `scenes/passive_wall_rough.ron` coarser and shorter: h = H/10, pushed 3 % of H.
+const COARSE_ROUGH_WALL: [&str; 3] = [
+    "grid.cell_size=0.2",
+    "grid.cells=[65, 25]",
+    "rigid_bodies[0].motion.travel=0.06",
+];
+
 /// `scenes/passive_wall_rough.ron`, coarser and shorter (h = H/10, 3 % of H): a rough wall
 /// (δ = φ = 30°) pushed into sand that goes on below its toe. Lancellotta's lower bound
 /// (2002, Géotechnique 52(8), eq. 1) for the wall's normal stress, K_p = 5.03, gives
@@ -490,11 +497,7 @@ fn a_smooth_wall_pushed_into_sand_meets_rankines_passive_thrust() {
 /// below the toe), its shear held under tan δ times the thrust.
 #[test]
 fn a_rough_wall_pushed_into_sand_carries_more_than_the_smooth_one() {
-    let coarse = [
-        "grid.cell_size=0.2",
-        "grid.cells=[65, 25]",
-        "rigid_bodies[0].motion.travel=0.06",
-    ];
+    let coarse = COARSE_ROUGH_WALL;
     let rough = run("passive_wall_rough.ron", &coarse);
     let mut smooth_sets = coarse.to_vec();
     smooth_sets.push("rigid_bodies[0].interface=Smooth");
@@ -529,11 +532,7 @@ fn a_rough_wall_pushed_into_sand_carries_more_than_the_smooth_one() {
 /// has one tan φ, which the points' mean gives exactly.
 #[test]
 fn a_rough_wall_takes_the_sands_friction_angle() {
-    let coarse = [
-        "grid.cell_size=0.2",
-        "grid.cells=[65, 25]",
-        "rigid_bodies[0].motion.travel=0.06",
-    ];
+    let coarse = COARSE_ROUGH_WALL;
     let frictional = run("passive_wall_rough.ron", &coarse);
     let mut rough_sets = coarse.to_vec();
     rough_sets.push("rigid_bodies[0].interface=Rough");
