@@ -197,48 +197,81 @@ fn place<D: Dim, S: Shape>(
     strength: &SoilStrength,
     slot_of: &mut Vec<u32>,
 ) -> Contacts {
+    slot_of.resize(ctx.grid.node_count(), u32::MAX);
     let fix = col::<NodeFixity>(nodes(&ctx.world));
-    let (grid, st) = (&ctx.grid, &ctx.numerics);
-    let drives = &ctx.state.control.drives;
-    let mut set = Contacts::default();
-    slot_of.resize(grid.node_count(), u32::MAX);
-    // The slot of node `i` (which carries mass), made at its first reach with the node's
-    // trial velocity p/m + f Δt/m̃, inertia and free axes.
-    let slot = |slots: &mut Vec<Slot>, slot_of: &mut Vec<u32>, i: usize| -> usize {
-        if slot_of[i] != u32::MAX {
-            return slot_of[i] as usize;
+    let mut placer = Placer {
+        ctx,
+        soil,
+        fix: &fix,
+        slot_of,
+        set: Contacts::default(),
+    };
+    let region = region(ctx);
+    for b in 0..ctx.model.bodies.len() {
+        placer.inside_nodes(b, region);
+        placer.surface_samples::<S>(b, strength);
+    }
+    let Placer { set, slot_of, .. } = placer;
+    for s in &set.slots {
+        slot_of[s.node] = u32::MAX;
+    }
+    set
+}
+
+/// [`place`]'s working state: the contacts placed so far and each reached node's slot.
+struct Placer<'a, 'b, D: Dim> {
+    ctx: &'a Context<D>,
+    soil: &'a Soil<'b, D>,
+    fix: &'a [NodeFixity],
+    slot_of: &'a mut Vec<u32>,
+    set: Contacts,
+}
+
+impl<D: Dim> Placer<'_, '_, D> {
+    /// The slot of node `i` (which carries mass), made at its first reach with the node's
+    /// trial velocity p/m + f Δt/m̃, inertia and free axes.
+    fn slot(&mut self, i: usize) -> usize {
+        if self.slot_of[i] != u32::MAX {
+            return self.slot_of[i] as usize;
         }
-        let (m, p, f) = soil.at(i);
+        let (grid, st) = (&self.ctx.grid, &self.ctx.numerics);
+        let drives = &self.ctx.state.control.drives;
+        let (m, p, f) = self.soil.at(i);
         let inertia = grid.inertia(i, m, st.virtual_mass_floor);
         // The held components as `boundary` will hold them (it runs next, so that a
         // friction face and a motion feel the contact's force).
         let mut v = p * (1.0 / m) + f * (st.dt / inertia);
-        constrain(&mut v, fix[i], D::N, drives);
+        constrain(&mut v, self.fix[i], D::N, drives);
         let v = D::vec_to3(v);
-        let free = std::array::from_fn(|a| a < D::N && hold(fix[i], a, drives) == Hold::Free);
+        let fix = self.fix[i];
+        let free = std::array::from_fn(|a| a < D::N && hold(fix, a, drives) == Hold::Free);
+        let slots = &mut self.set.slots;
         slots.push(Slot::new(i, v, inertia, free));
-        slot_of[i] = (slots.len() - 1) as u32;
+        self.slot_of[i] = (slots.len() - 1) as u32;
         slots.len() - 1
-    };
-    let region = region(ctx);
-    for (b, body) in ctx.model.bodies.iter().enumerate() {
-        let state = &ctx.state.control.bodies[b];
-        let (spec, interfaces) = (&body.spec, &body.interfaces);
-        // The nodes inside the body hold their normal velocity too: the soil's field
-        // there is the body's, and a light node that only a point's tail reaches would
-        // otherwise be free to run into it (under a confining stress it does).
-        for i in inside_box(ctx, body, state.offset, region).rows(grid).flatten() {
-            if !grid.carries(i, soil.at(i).0, st.min_node_mass) {
+    }
+
+    /// Body `b`'s constraints at the nodes inside it (within `region`) that carry soil.
+    /// They hold their normal velocity too: the soil's field there is the body's, and a
+    /// light node that only a point's tail reaches would otherwise be free to run into it
+    /// (under a confining stress it does).
+    fn inside_nodes(&mut self, b: usize, region: NodeBox) {
+        let ctx = self.ctx;
+        let (grid, st) = (&ctx.grid, &ctx.numerics);
+        let body = &ctx.model.bodies[b];
+        let offset = ctx.state.control.bodies[b].offset;
+        for i in inside_box(ctx, body, offset, region).rows(grid).flatten() {
+            if !grid.carries(i, self.soil.at(i).0, st.min_node_mass) {
                 continue;
             }
             let x = D::vec_to3(grid.node_position(grid.node_ijk(i)));
-            let at: [f64; 3] = std::array::from_fn(|a| x[a] - state.offset[a]);
-            let (phi, normal, part) = spec.distance(at, D::N);
+            let at: [f64; 3] = std::array::from_fn(|a| x[a] - offset[a]);
+            let (phi, normal, part) = body.spec.distance(at, D::N);
             if phi > 0.0 {
                 continue;
             }
-            let k = slot(&mut set.slots, slot_of, i);
-            set.contacts.push(Contact {
+            let k = self.slot(i);
+            self.set.contacts.push(Contact {
                 key: key(b, false, i),
                 body: b,
                 part,
@@ -252,12 +285,21 @@ fn place<D: Dim, S: Shape>(
                 impulse: [0.0; 3],
             });
         }
+    }
+
+    /// Body `b`'s surface samples that meet soil, each with its nodes, weights and the
+    /// caps of its part's interface (`strength` where rough).
+    fn surface_samples<S: Shape>(&mut self, b: usize, strength: &SoilStrength) {
+        let ctx = self.ctx;
+        let (grid, st) = (&ctx.grid, &ctx.numerics);
+        let body = &ctx.model.bodies[b];
+        let offset = ctx.state.control.bodies[b].offset;
         let bounds = (D::vec_to3(grid.origin), D::vec_to3(grid.max_corner()));
-        let corners = (spec.corners == Corners::Released)
-            .then(|| CornerTest::new(&spec.parts, D::N, state.offset, bounds, grid.cell_size));
+        let corners = (body.spec.corners == Corners::Released)
+            .then(|| CornerTest::new(&body.spec.parts, D::N, offset, bounds, grid.cell_size));
         let mut located: std::collections::HashMap<usize, Located> = Default::default();
         for (index, (s, part)) in body.samples.iter().enumerate() {
-            let x3: [f64; 3] = std::array::from_fn(|a| s.x[a] + state.offset[a]);
+            let x3: [f64; 3] = std::array::from_fn(|a| s.x[a] + offset[a]);
             let x = D::vec_from(x3);
             if !grid.contains(x) {
                 continue;
@@ -267,7 +309,7 @@ fn place<D: Dim, S: Shape>(
             // those it holds.
             let (mut soil_weight, mut weight) = (0.0, 0.0);
             for_each_node::<D, S>(grid, x, |i, w, _| {
-                if w <= 0.0 || !grid.carries(i, soil.at(i).0, st.min_node_mass) {
+                if w <= 0.0 || !grid.carries(i, self.soil.at(i).0, st.min_node_mass) {
                     return;
                 }
                 soil_weight += w;
@@ -282,8 +324,7 @@ fn place<D: Dim, S: Shape>(
                         return;
                     }
                 }
-                let k = slot(&mut set.slots, slot_of, i);
-                reach.push((k, w));
+                reach.push((self.slot(i), w));
                 weight += w;
             });
             if soil_weight < 0.5 || weight <= 0.0 {
@@ -295,9 +336,9 @@ fn place<D: Dim, S: Shape>(
             } else {
                 s.measure
             };
-            let nodes = reach.iter().map(|&(k, w)| (set.slots[k].node, w));
-            let (friction, adhesion) = strength.caps(interfaces[*part], grid, nodes);
-            set.contacts.push(Contact {
+            let nodes = reach.iter().map(|&(k, w)| (self.set.slots[k].node, w));
+            let (friction, adhesion) = strength.caps(body.interfaces[*part], grid, nodes);
+            self.set.contacts.push(Contact {
                 key: key(b, true, index),
                 body: b,
                 part: *part,
@@ -312,10 +353,6 @@ fn place<D: Dim, S: Shape>(
             });
         }
     }
-    for s in &set.slots {
-        slot_of[s.node] = u32::MAX;
-    }
-    set
 }
 
 impl<D: Dim, S: Shape> System<D> for RigidContact<D, S> {
