@@ -1,0 +1,100 @@
+#!/usr/bin/env python3
+"""The piezocone's readings in Modified Cam Clay by spherical cavity expansion and critical
+state (SCE-CSSM), the published closed form for `scenes/cptu_clay.ron`
+(docs/verification.md, "The piezocone in Cam Clay").
+
+Mayne (1991, "Determination of OCR in clays by piezocone tests using cavity expansion and
+critical state concepts", Soils and Foundations 31(2)), Chen & Mayne (1993, "Piezocone
+evaluation of undrained shear strength in clays", 11th SEAGC) and Burns & Mayne (2002,
+"Analytical cavity expansion-critical state model for piezocone dissipation in
+fine-grained soils", Soils and Foundations 42(2)) read a piezocone in a clay of Modified
+Cam Clay parameters M, Lambda = (lambda - kappa)/lambda and OCR R from the isotropic
+p'0 = sigma'v0:
+
+    s_u         = (M/2) (R/2)^Lambda p'0                   (Wood 1990, triaxial, undrained)
+    q_t - s_v0  = s_u [ (4/3)(ln I_r + 1) + pi/2 + 1 ]     (the tip: Vesic's spherical
+                                                            cavity limit and the shoulder)
+    du2         = (2/3) M (R/2)^Lambda p'0 ln I_r          (octahedral: the cavity's
+                  + p'0 [1 - (R/2)^Lambda]                  mean stress, (4/3) s_u ln I_r;
+                                                            shear: p'0 - p'f on the
+                                                            undrained path)
+
+so that q_t - u2 = p'0 (R/2)^Lambda (1.95 M + 1), the form these papers invert for the
+OCR. I_r = G/s_u with G of the clay at rest: K = v p'0/kappa, G = 3K(1 - 2nu)/(2(1 + nu)),
+v on the swelling line through p'c = R p'0 below the normal compression line
+v = N - lambda ln(p'/1 kPa), as the engine starts a point (src/materials/modified_cam_clay.rs).
+The engine's G falls with p' along the undrained path (to (R/2)^Lambda of the start at the
+critical state), so the cone shears clay of a smaller I_r than the one at rest; the table
+prints both ends.
+
+Run: `python3 studies/cptu_cssm.py` prints the readings at R = 1 and 2 for the clay of
+`scenes/cptu_clay.ron`; `python3 studies/cptu_cssm.py R OUT [OUT ...]` sets the rows of
+each run's OUT/cpt.csv (a run of that scene with `preconsolidation=Ratio(R)`) against them,
+and with two runs whose cells halve (h, h/2, in that order) the first-order extrapolation
+2 X(h/2) - X(h) of the mean over the last four rows.
+"""
+import csv
+import math
+import sys
+
+LAMBDA, KAPPA, M, NU, N = 0.25, 0.05, 0.9, 0.3, 3.0
+P0 = 100e3  # Pa, isotropic effective, u0 = 0
+REF = 1e3  # Pa, N's pressure
+
+
+def readings(r_ocr, g_at="rest"):
+    """(s_u, I_r, N_kt, N_du, B_q) of SCE-CSSM; G at rest or at the critical state."""
+    lam = (LAMBDA - KAPPA) / LAMBDA
+    ratio = (r_ocr / 2.0) ** lam  # p'f / p'0 on the undrained path
+    s_u = M / 2.0 * ratio * P0
+    pc = r_ocr * P0
+    v = N - LAMBDA * math.log(pc / REF) + KAPPA * math.log(pc / P0)
+    p = P0 if g_at == "rest" else P0 * ratio
+    k = v * p / KAPPA
+    g = 3.0 * k * (1.0 - 2.0 * NU) / (2.0 * (1.0 + NU))
+    i_r = g / s_u
+    n_kt = 4.0 / 3.0 * (math.log(i_r) + 1.0) + math.pi / 2.0 + 1.0
+    du2 = 2.0 / 3.0 * M * ratio * P0 * math.log(i_r) + P0 * (1.0 - ratio)
+    return s_u, i_r, n_kt, du2 / s_u, du2 / (n_kt * s_u)
+
+
+def logged(out):
+    """(depth, N_kt, N_du, B_q) of each row of OUT/cpt.csv that has all three."""
+    rows = []
+    with open(f"{out}/cpt.csv") as f:
+        for r in csv.DictReader(f):
+            if r["N_kt"] and r["N_du"] and r["B_q"]:
+                rows.append((float(r["depth"]), float(r["N_kt"]), float(r["N_du"]), float(r["B_q"])))
+    return rows
+
+
+def main():
+    if len(sys.argv) < 3:
+        print("R  G at     s_u (kPa)  I_r    N_kt   N_du   B_q")
+        for r_ocr in (1.0, 2.0):
+            for g_at in ("rest", "critical"):
+                s_u, i_r, n_kt, n_du, b_q = readings(r_ocr, g_at)
+                print(f"{r_ocr:<2g} {g_at:<8} {s_u / 1e3:9.2f}  {i_r:5.1f}  {n_kt:5.2f}  {n_du:5.2f}  {b_q:5.3f}")
+        return
+    r_ocr = float(sys.argv[1])
+    s_u, i_r, n_kt, n_du, b_q = readings(r_ocr)
+    print(f"SCE-CSSM, R = {r_ocr:g}, I_r = {i_r:.1f} at rest: N_kt {n_kt:.2f}, N_du {n_du:.2f}, B_q {b_q:.3f}")
+    means = []
+    for out in sys.argv[2:]:
+        rows = logged(out)
+        print(f"{out}: depth, N_kt, N_du, B_q (difference on SCE-CSSM)")
+        for d, kt, du, bq in rows:
+            print(f"  {d:5.2f}  {kt:6.2f} ({kt / n_kt - 1:+6.1%})  {du:6.2f} ({du / n_du - 1:+6.1%})  {bq:5.2f}")
+        last = rows[-4:]
+        means.append([sum(x[i] for x in last) / len(last) for i in (1, 2, 3)])
+        print("  mean of the last four rows: N_kt {:.2f}, N_du {:.2f}, B_q {:.2f}".format(*means[-1]))
+    if len(means) == 2:
+        ext = [2.0 * f - c for c, f in zip(*means)]
+        print(
+            f"extrapolated (2 X(h/2) - X(h)): N_kt {ext[0]:.2f} ({ext[0] / n_kt - 1:+.1%}), "
+            f"N_du {ext[1]:.2f} ({ext[1] / n_du - 1:+.1%}), B_q {ext[2]:.2f}"
+        )
+
+
+if __name__ == "__main__":
+    main()
