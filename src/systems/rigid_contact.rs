@@ -189,8 +189,9 @@ fn soil<'a, D: Dim, S: Shape>(
 /// soil and their weights, each node's trial velocity p/m + f Δt/m̃. A sample meets soil
 /// when nodes carrying mass hold at least half its support; it holds them all, or with
 /// `corners: Released` those that do not face a corner of the body
-/// ([`crate::rigid::corners`]). `slot_of` (one entry a node)
-/// is all `u32::MAX` on entry and is left so.
+/// ([`crate::rigid::corners`]). Body by body, its inside nodes first, then its samples: the
+/// order the solve visits them in. `slot_of` (one entry a node) is all `u32::MAX` on entry
+/// and is left so.
 fn place<D: Dim, S: Shape>(
     ctx: &Context<D>,
     soil: &Soil<D>,
