@@ -32,8 +32,10 @@ the clay at rest under the cavity's 100 kPa, the stage `in situ`) and the pressu
 reference gives at that a/a0.
 
 `python3 studies/cavity_mcc.py R OUT --sphere` does the same for a run of
-`scenes/cavity_sphere.ron` (or `cavity_sphere_r2.ron`): a thick sphere of outer radius
-b = 6 m under the far field's 100 kPa, whose reference is the same integral from the
+`scenes/cavity_sphere.ron` (or `cavity_sphere_r2.ron`; `--from 1.025` adds the shell of
+clay from 1.025 m, for a run at h = 0.05 m, whose loaded points lie within 0.025 m of the
+wall): a thick sphere of outer radius b = 6 m under the far field's 100 kPa, whose
+reference is the same integral from the
 outer face's strain e_b = -ln(1 - (a^3 - a0^3)/b^3)/3 instead of 0 (the kinematics of an
 incompressible sphere hold in a finite one; only the far field's pressure now acts at b),
 and whose cavity radius comes from the volume of the cavity: the traced points `wall9`,
@@ -137,8 +139,9 @@ def compare(path, out):
 B_SPHERE = 6.0  # m, the outer radius of scenes/cavity_sphere.ron
 
 
-def compare_sphere(path, out):
-    """The spherical run in `out` against the reference for its thick sphere."""
+def compare_sphere(path, out, near=1.075):
+    """The spherical run in `out` against the reference for its thick sphere; the clay's
+    excess pore pressure in shells from `near` m out (past the loaded points)."""
     import json
 
     history = {int(r["step"]): r for r in csv.DictReader(open(out + "/history.csv"))}
@@ -179,7 +182,10 @@ def compare_sphere(path, out):
     if not os.path.exists(out + "/points.vtu"):
         return
     points = vtu_arrays(out + "/points.vtu", {"points", "displacement", "excess_pore_pressure"})
-    for band in ((1.075, 1.175), (1.175, 1.275), (1.275, 1.4), (1.4, 1.6)):
+    bands = ((1.075, 1.175), (1.175, 1.275), (1.275, 1.4), (1.4, 1.6))
+    if near < bands[0][0]:
+        bands = ((near, bands[0][0]),) + bands
+    for band in bands:
         near_wall(path, points, grown, e_b, band)
 
 
@@ -240,7 +246,9 @@ def main():
     path, pf = element(r_ocr)
     if len(sys.argv) > 2:
         if "--sphere" in sys.argv[3:]:
-            compare_sphere(path, sys.argv[2])
+            rest = sys.argv[3:]
+            near = float(rest[rest.index("--from") + 1]) if "--from" in rest else 1.075
+            compare_sphere(path, sys.argv[2], near)
         else:
             compare(path, sys.argv[2])
         return
