@@ -125,6 +125,12 @@ pub trait Material: Send + Sync {
     fn plane_strength(&self, _stress: &Sym3, _state: &Self::State) -> Option<(f64, f64)> {
         None
     }
+    /// [`Material::plane_strength`] when it is the same at every stress and state (c in Pa,
+    /// tan φ): a `Rough` interface on a soil of one such material takes it without summing
+    /// the points beside it. `None` where the strength varies, or where there is none.
+    fn constant_strength(&self) -> Option<(f64, f64)> {
+        None
+    }
 }
 
 /// A material as a scene gives it: the serde struct is its schema.
@@ -329,6 +335,14 @@ macro_rules! define_materials {
             pub fn holds_water(&self) -> bool {
                 match self {
                     $(MaterialModel::$variant(m) => m.holds_water(),)*
+                }
+            }
+
+            /// Its strength when the same at every stress and state (see
+            /// [`Material::constant_strength`]).
+            pub fn constant_strength(&self) -> Option<(f64, f64)> {
+                match self {
+                    $(MaterialModel::$variant(m) => m.constant_strength(),)*
                 }
             }
 

@@ -445,6 +445,9 @@ impl Material for MohrCoulomb {
     /// Coulomb's line: c and tan φ whatever the stress (the tension cut-off aside: an
     /// interface that the soil presses is not in tension).
     fn plane_strength(&self, _: &Sym3, _: &PlasticStrain) -> Option<(f64, f64)> {
+        self.constant_strength()
+    }
+    fn constant_strength(&self) -> Option<(f64, f64)> {
         Some((self.cohesion, self.friction.tan()))
     }
     fn p_wave_modulus(&self) -> f64 {

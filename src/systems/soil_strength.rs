@@ -24,7 +24,10 @@
 //! relaxation, into a curve that differs in its fourth figure). A sample whose nodes
 //! meet no point with strength (an elastic soil) holds the soil without slip. Over several
 //! ranks each rank sums its own points and the sums are made whole on every rank; the
-//! pass reads the points once a step, and only in a scene with a rough part.
+//! pass reads the points once a step, and only in a scene with a rough part. A scene of
+//! one material whose strength is the same at every stress and state (Mohr–Coulomb) is
+//! not summed: every rough sample takes that strength, the value the sums would give
+//! wherever a sample's nodes meet its points.
 
 use crate::components::*;
 use crate::context::Context;
@@ -54,6 +57,10 @@ pub struct SoilStrength {
     /// Per summed cell: −min c, max c (Pa), −min tan φ, max tan φ over its points with
     /// strength (−∞ where it has none), so that one reduction (max) takes both bounds.
     bounds: Vec<[f64; 4]>,
+    /// The soil's (c, tan φ) when the scene has one material and its strength is the same
+    /// at every stress and state ([`crate::materials::Material::constant_strength`]):
+    /// every rough sample takes it, and no points are summed.
+    uniform: Option<(f64, f64)>,
 }
 
 impl SoilStrength {
@@ -68,6 +75,13 @@ impl SoilStrength {
         self.bounds.clear();
         let bodies = &ctx.model.bodies;
         if !bodies.iter().any(|b| b.interfaces.contains(&InterfaceLaw::Soil)) {
+            return;
+        }
+        self.uniform = match &ctx.materials[..] {
+            [one] => one.constant_strength(),
+            _ => None,
+        };
+        if self.uniform.is_some() {
             return;
         }
         let grid = &ctx.grid;
@@ -156,9 +170,13 @@ impl SoilStrength {
         grid: &Grid<D>,
         nodes: impl Iterator<Item = (usize, f64)>,
     ) -> (f64, f64) {
-        let law = match law {
-            InterfaceLaw::Soil => self.at_sample(grid, nodes).unwrap_or(law),
-            law => law,
+        let law = match (law, self.uniform) {
+            (InterfaceLaw::Soil, Some((c, tan))) => InterfaceLaw::Coulomb {
+                friction: tan,
+                adhesion: c,
+            },
+            (InterfaceLaw::Soil, None) => self.at_sample(grid, nodes).unwrap_or(law),
+            (law, _) => law,
         };
         match law {
             InterfaceLaw::Coulomb { friction, adhesion } => (friction, adhesion),
@@ -298,5 +316,23 @@ mod tests {
             s.at_sample(&grid, [(grid.node_id([3, 3, 0]), 1.0)].into_iter()),
             None
         );
+    }
+
+    #[test]
+    fn a_soil_of_one_constant_strength_gives_it_to_every_rough_sample() {
+        let grid = Grid::<Dim2>::new(DVec2::ZERO, 1.0, [4, 4, 0]);
+        // No table: the scene's one material is Tresca clay of c_u = 10 kPa.
+        let s = SoilStrength {
+            uniform: Some((10.0e3, 0.0)),
+            ..SoilStrength::default()
+        };
+        let nodes = || [(grid.node_id([3, 3, 0]), 1.0)].into_iter();
+        assert_eq!(s.caps(InterfaceLaw::Soil, &grid, nodes()), (0.0, 10.0e3));
+        // A Coulomb part keeps its own caps.
+        let own = InterfaceLaw::Coulomb {
+            friction: 0.5,
+            adhesion: 2.0e3,
+        };
+        assert_eq!(s.caps(own, &grid, nodes()), (0.5, 2.0e3));
     }
 }
