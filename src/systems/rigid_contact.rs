@@ -238,13 +238,13 @@ impl<D: Dim> Placer<'_, '_, D> {
         let (grid, st) = (&self.ctx.grid, &self.ctx.numerics);
         let drives = &self.ctx.state.control.drives;
         let (m, p, f) = self.soil.at(i);
+        let fix = self.fix[i];
         let inertia = grid.inertia(i, m, st.virtual_mass_floor);
         // The held components as `boundary` will hold them (it runs next, so that a
         // friction face and a motion feel the contact's force).
         let mut v = p * (1.0 / m) + f * (st.dt / inertia);
-        constrain(&mut v, self.fix[i], D::N, drives);
+        constrain(&mut v, fix, D::N, drives);
         let v = D::vec_to3(v);
-        let fix = self.fix[i];
         let free = std::array::from_fn(|a| a < D::N && hold(fix, a, drives) == Hold::Free);
         let slots = &mut self.set.slots;
         slots.push(Slot::new(i, v, inertia, free));
