@@ -72,6 +72,8 @@ pub struct CellMean<D: Dim, S> {
     /// Per cell, at its lowest node: whether a point in it was returned this round (all
     /// false between rounds).
     dirty: Vec<bool>,
+    /// The points of each cell, found in a step that returns a point.
+    index: CellPoints,
     _marker: PhantomData<fn() -> (D, S)>,
 }
 
@@ -82,6 +84,7 @@ impl<D: Dim, S> CellMean<D, S> {
             part,
             sums: NodePairs::default(),
             dirty: Vec::new(),
+            index: CellPoints::default(),
             _marker: PhantomData,
         }
     }
@@ -166,8 +169,7 @@ impl<D: Dim, S: Shape> CellMean<D, S> {
             if !ctx.comm.any(returned.iter().any(|r| !r.is_empty())) {
                 break;
             }
-            // The cells a returned point is in (emptied), and every point in them,
-            // archetype by archetype in point order.
+            // The cells a returned point is in.
             let grid = &ctx.grid;
             let (dirty, sums) = (&mut self.dirty, &mut self.sums);
             dirty.resize(grid.node_count(), false);
@@ -177,7 +179,6 @@ impl<D: Dim, S: Shape> CellMean<D, S> {
                 for &p in points {
                     let key = grid.cell_key(x[p as usize].0);
                     if !std::mem::replace(&mut dirty[key], true) {
-                        *sums.at_mut(key) = [0.0; 2];
                         cells.push(key);
                     }
                 }
@@ -186,38 +187,38 @@ impl<D: Dim, S: Shape> CellMean<D, S> {
             // every rank takes them all afresh, whichever rank returned a point in them.
             for key in shared_cells(ctx) {
                 if !std::mem::replace(&mut dirty[key], true) {
-                    *sums.at_mut(key) = [0.0; 2];
                     cells.push(key);
                 }
             }
-            // Every point in them, archetype by archetype in point order, and their
-            // means afresh, each cell's summed in point order as in the first round.
-            let dirty: &[bool] = dirty;
-            let active: Vec<Vec<u32>> = points_with::<Volume>(&ctx.world)
-                .map(|arch| {
-                    let xg = col::<Position<D::Vec>>(arch);
-                    xg.par_chunks(CHUNK)
-                        .enumerate()
-                        .flat_map_iter(|(c, x)| {
-                            (0..x.len())
-                                .filter(|&k| dirty[grid.cell_key(x[k].0)])
-                                .map(move |k| (c * CHUNK + k) as u32)
-                        })
-                        .collect()
+            // Every point in them (the points of each cell found once a step), and their
+            // means afresh, each cell's summed in archetype and point order as in the
+            // first round (cell by cell in parallel: 3D flow returns most points).
+            if round == 1 {
+                self.index.build(&ctx.world, grid);
+            }
+            let index = &self.index;
+            let guards: Vec<_> = points_with::<Volume>(&ctx.world)
+                .map(|arch| (col::<Volume>(arch), col::<Stress<D::Stress>>(arch)))
+                .collect();
+            let columns: Vec<_> = guards.iter().map(|(v, s)| (&v[..], &s[..])).collect();
+            let fresh: Vec<[f64; 2]> = (cells.par_iter().with_min_len(64))
+                .map(|&key| {
+                    let mut pair = [0.0; 2];
+                    for &(a, p) in index.of(key) {
+                        let (vol, s) = columns[a as usize];
+                        let v = vol[p as usize].0;
+                        pair[0] += v * mean_stress::<D>(&s[p as usize].0);
+                        pair[1] += v;
+                    }
+                    pair
                 })
                 .collect();
-            for arch in points_with::<Volume>(&ctx.world) {
-                let (xg, vg, sg) = (
-                    col::<Position<D::Vec>>(arch),
-                    col::<Volume>(arch),
-                    col::<Stress<D::Stress>>(arch),
-                );
-                let (x, vol): (&[Position<D::Vec>], &[Volume]) = (&xg, &vg);
-                let s: &[Stress<D::Stress>] = &sg;
-                sums.scatter_cells_where::<D, S>(&mut ctx.slabs, grid, x, |p| {
-                    dirty[grid.cell_key(x[p].0)].then(|| [vol[p].0 * mean_stress::<D>(&s[p].0), vol[p].0])
-                });
+            for (&key, pair) in cells.iter().zip(fresh) {
+                *sums.at_mut(key) = pair;
             }
+            drop(columns);
+            drop(guards);
+            let active = index.in_cells(&cells, dirty);
             sums.sum_over_ranks(grid, &ctx.comm, &ctx.decomposition);
             let dirty = &mut self.dirty;
             for key in cells {
@@ -254,6 +255,98 @@ impl<D: Dim, S: Shape> CellMean<D, S> {
                 }
             })
             .collect()
+    }
+}
+
+/// Every point grouped by the cell that holds it (by the cell's lowest node), a cell's
+/// points in archetype then point order: the order a cell's sums take them in.
+#[derive(Debug, Default)]
+struct CellPoints {
+    /// Where each cell's run starts in `points`: one entry a node, and one more.
+    start: Vec<u32>,
+    /// (archetype among those with a volume, point) by cell.
+    points: Vec<(u32, u32)>,
+    /// Each point's cell, archetype after archetype (kept between steps for its room).
+    keys: Vec<u32>,
+    /// Each cell's next free entry while the points are placed (as `keys`).
+    next: Vec<u32>,
+    /// Where each archetype's points end in `keys`.
+    ends: Vec<usize>,
+}
+
+impl CellPoints {
+    /// Groups the points of `world` as they stand (a counting sort by cell).
+    fn build<D: Dim>(&mut self, world: &hecs::World, grid: &Grid<D>) {
+        let n = grid.node_count();
+        self.keys.clear();
+        self.ends.clear();
+        for arch in points_with::<Volume>(world) {
+            let x = col::<Position<D::Vec>>(arch);
+            let from = self.keys.len();
+            self.keys.resize(from + x.len(), 0);
+            (self.keys[from..].par_chunks_mut(CHUNK))
+                .zip(x.par_chunks(CHUNK))
+                .for_each(|(k, x)| {
+                    k.iter_mut()
+                        .zip(x)
+                        .for_each(|(k, x)| *k = grid.cell_key(x.0) as u32)
+                });
+            self.ends.push(self.keys.len());
+        }
+        self.start.clear();
+        self.start.resize(n + 1, 0);
+        for &k in &self.keys {
+            self.start[k as usize + 1] += 1;
+        }
+        for i in 0..n {
+            self.start[i + 1] += self.start[i];
+        }
+        self.next.clear();
+        self.next.extend_from_slice(&self.start[..n]);
+        self.points.resize(self.keys.len(), (0, 0));
+        let mut from = 0;
+        for (a, &end) in self.ends.iter().enumerate() {
+            for (p, &k) in self.keys[from..end].iter().enumerate() {
+                let at = &mut self.next[k as usize];
+                self.points[*at as usize] = (a as u32, p as u32);
+                *at += 1;
+            }
+            from = end;
+        }
+    }
+
+    /// The points of the cell whose lowest node is `key`.
+    fn of(&self, key: usize) -> &[(u32, u32)] {
+        &self.points[self.start[key] as usize..self.start[key + 1] as usize]
+    }
+
+    /// The points in `cells` (the cells `dirty` marks), by archetype in point order: from
+    /// the cells' lists when they hold few points, else from a scan of every point's cell
+    /// (the same lists either way).
+    fn in_cells(&self, cells: &[usize], dirty: &[bool]) -> Vec<Vec<u32>> {
+        let count: usize = cells.iter().map(|&k| self.of(k).len()).sum();
+        let mut active = vec![Vec::new(); self.ends.len()];
+        if count * 16 < self.keys.len() {
+            for &key in cells {
+                for &(a, p) in self.of(key) {
+                    active[a as usize].push(p);
+                }
+            }
+            active.iter_mut().for_each(|points| points.sort_unstable());
+            return active;
+        }
+        let mut from = 0;
+        for (points, &end) in active.iter_mut().zip(&self.ends) {
+            *points = (self.keys[from..end].par_chunks(CHUNK).enumerate())
+                .flat_map_iter(|(c, keys)| {
+                    (keys.iter().enumerate())
+                        .filter(|&(_, &k)| dirty[k as usize])
+                        .map(move |(k, _)| (c * CHUNK + k) as u32)
+                })
+                .collect();
+            from = end;
+        }
+        active
     }
 }
 
