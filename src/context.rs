@@ -1,15 +1,14 @@
 //! What every system reads and writes.
 
 use crate::dim::Dim;
-use crate::grid::Grid;
+use crate::grid::{Grid, RankNodes};
 use crate::infra::comm::Comm;
-use crate::infra::decomposition::Decomposition;
+use crate::infra::decomposition::{Decomposition, ACROSS, SLAB};
 use crate::materials::MaterialModel;
 use crate::model::Model;
 use crate::parallel::SlabCache;
 use crate::state::{Numerics, SolverState};
 use hecs::World;
-use std::ops::Range;
 use std::sync::Arc;
 
 /// Everything the systems read and write: the world (points and nodes), the grid, the
@@ -48,20 +47,22 @@ impl<D: Dim> Context<D> {
 
     /// The node ids this rank owns when the run has several ranks (each node is owned by
     /// one rank, so sums over owned nodes add up over the ranks); `None` with one rank.
-    pub fn owned_node_ids(&self) -> Option<Range<usize>> {
+    pub fn owned_node_ids(&self) -> Option<RankNodes> {
         if self.comm.size() == 1 {
             return None;
         }
-        Some(self.grid.layer_node_ids(self.decomposition.owned_nodes()))
+        let d = &self.decomposition;
+        Some(self.grid.rank_nodes(d.owned_nodes(SLAB), d.owned_nodes(ACROSS)))
     }
 
     /// The node ids whose values this rank holds whole when the run has several ranks
     /// (its own and the bands it shares, once summed: [`Decomposition::held_nodes`]);
     /// `None` with one rank.
-    pub fn held_node_ids(&self) -> Option<Range<usize>> {
+    pub fn held_node_ids(&self) -> Option<RankNodes> {
         if self.comm.size() == 1 {
             return None;
         }
-        Some(self.grid.layer_node_ids(self.decomposition.held_nodes()))
+        let d = &self.decomposition;
+        Some(self.grid.rank_nodes(d.held_nodes(SLAB), d.held_nodes(ACROSS)))
     }
 }

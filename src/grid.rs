@@ -96,6 +96,30 @@ impl NodeBox {
     }
 }
 
+/// The nodes of a rank in a run over MPI ranks (those it owns, or those it holds whole):
+/// node layers along the slab axis and along the second split axis, every node along the
+/// third ([`crate::infra::decomposition`]).
+#[derive(Clone, Debug)]
+pub struct RankNodes {
+    /// The node ids of the slab-axis layers (ids run layer by layer).
+    ids: std::ops::Range<usize>,
+    /// The layers along the second split axis, with its stride and node count; `None` when
+    /// they are all of them.
+    across: Option<(std::ops::Range<usize>, usize, usize)>,
+}
+
+impl RankNodes {
+    /// True when node `id` is one of them.
+    #[inline]
+    pub fn contains(&self, id: &usize) -> bool {
+        self.ids.contains(id)
+            && self
+                .across
+                .as_ref()
+                .is_none_or(|(r, stride, n)| r.contains(&((id / stride) % n)))
+    }
+}
+
 /// Geometry of a uniform background grid of square (cubic) cells.
 #[derive(Clone, Debug)]
 pub struct Grid<D: Dim> {
@@ -222,6 +246,50 @@ impl<D: Dim> Grid<D> {
             *ca = self.clamped_cell_along(x, a);
         }
         c
+    }
+
+    /// The second axis a split over MPI ranks cuts ([`crate::infra::decomposition`]): the
+    /// middle axis in 3D, x in 2D.
+    pub fn across_axis(&self) -> usize {
+        if D::N == 3 {
+            3 - self.slab_axis
+        } else {
+            0
+        }
+    }
+
+    /// The cell holding `x` as its layers along the slab axis and the second split axis,
+    /// clamped into the grid.
+    #[inline]
+    pub fn split_cell(&self, x: D::Vec) -> [usize; 2] {
+        [
+            self.clamped_cell_along(x, self.slab_axis),
+            self.clamped_cell_along(x, self.across_axis()),
+        ]
+    }
+
+    /// The box of node layers `slab` along the slab axis and `across` along the second
+    /// split axis, every node along the third.
+    pub fn split_box(&self, slab: std::ops::Range<usize>, across: std::ops::Range<usize>) -> NodeBox {
+        let mut b = NodeBox::default();
+        for a in 0..3 {
+            (b.lo[a], b.hi[a]) = (0, self.nodes[a]);
+        }
+        (b.lo[self.slab_axis], b.hi[self.slab_axis]) = (slab.start, slab.end);
+        let m = self.across_axis();
+        (b.lo[m], b.hi[m]) = (across.start, across.end);
+        b
+    }
+
+    /// The nodes in node layers `slab` along the slab axis and `across` along the second
+    /// split axis, as a membership test on node ids.
+    pub fn rank_nodes(&self, slab: std::ops::Range<usize>, across: std::ops::Range<usize>) -> RankNodes {
+        let m = self.across_axis();
+        let all = across.start == 0 && across.end >= self.nodes[m];
+        RankNodes {
+            ids: self.layer_node_ids(slab),
+            across: (!all).then_some((across, self.strides[m], self.nodes[m])),
+        }
     }
 
     /// Index of the cell holding `x` along `axis`, clamped into the grid.

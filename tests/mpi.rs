@@ -114,7 +114,7 @@ fn ranks_find_the_same_decomposition() {
     }
     let comm = Comm::world().expect("MPI starts");
     let counts: Vec<u64> = (0..45).map(|c| 180 - 4 * c).collect();
-    let d = Decomposition::balanced(&counts, comm.size(), comm.rank(), 3);
+    let d = Decomposition::balanced([&counts, &[1]], [comm.size(), 1], comm.rank(), 3);
     let bounds: Vec<f64> = d.bounds.iter().map(|&b| b as f64).collect();
     let all = comm.gather_all(&bounds);
     assert!(all.chunks(bounds.len()).all(|b| b == &bounds[..]), "{all:?}");
@@ -124,7 +124,19 @@ fn ranks_find_the_same_decomposition() {
 /// `kdmpm run SCENE` on `ranks` ranks (one thread each) into a scratch directory; its
 /// summary.json.
 fn run_on(scene: &str, ranks: usize, name: &str, overrides: &[&str]) -> (PathBuf, Value) {
-    let out = common::scratch("mpi", &format!("{name}-{ranks}"));
+    run_laid(scene, ranks, None, name, overrides)
+}
+
+/// [`run_on`] with the ranks laid as `split` asks (`--split SLABSxACROSS`).
+fn run_laid(
+    scene: &str,
+    ranks: usize,
+    split: Option<[usize; 2]>,
+    name: &str,
+    overrides: &[&str],
+) -> (PathBuf, Value) {
+    let laid = split.map_or(String::new(), |[a, b]| format!("-{a}x{b}"));
+    let out = common::scratch("mpi", &format!("{name}-{ranks}{laid}"));
     let path = common::scene(scene);
     let mut cmd = Command::new("mpirun");
     cmd.args(["--allow-run-as-root", "--oversubscribe", "-n", &ranks.to_string()])
@@ -140,6 +152,9 @@ fn run_on(scene: &str, ranks: usize, name: &str, overrides: &[&str]) -> (PathBuf
         .arg(&out);
     for o in overrides {
         cmd.args(["--set", o]);
+    }
+    if let Some([a, b]) = split {
+        cmd.args(["--split", &format!("{a}x{b}")]);
     }
     let o = cmd.output().expect("mpirun starts");
     assert!(
@@ -527,6 +542,93 @@ fn snapshots_on_2_ranks_hold_every_point_once_as_one_rank_does() {
             "point {id}: {v:?} against {u:?}"
         );
     }
+}
+
+/// Four ranks laid 2 × 2 (slabs cut once more across, so four ranks meet at the corners of
+/// their cells): the 3D block, a rigid footing and the T-bar whose bodies span the cut
+/// across, the cone about its axis (the cut across is in r), the c–φ footing's cell means
+/// and the slope with its water follow one rank step for step, as the slabs do.
+#[test]
+fn ranks_split_2_by_2_agree_with_one_rank_to_1e_10() {
+    let cases: [(&str, &str, &[&str]); 6] = [
+        ("block_10k.ron", "block", &[]),
+        ("footing_rigid.ron", "rigid", &[]),
+        (
+            "tbar.ron",
+            "tbar",
+            &["rigid_bodies[0].motion=(velocity: [0.0, -0.01], travel: 0.1, increment: 0.05)"],
+        ),
+        (
+            "cpt.ron",
+            "cpt",
+            &["rigid_bodies[0].motion=(velocity: [0.0, -0.05], travel: 0.25, increment: 0.25)"],
+        ),
+        ("footing_cphi.ron", "cphi", &["motions[0].travel=0.06"]),
+        ("slope_water.ron", "water", &["solver.anti_locking=Off"]),
+    ];
+    for (scene, name, overrides) in cases {
+        let (_, one) = run_on(scene, 1, name, overrides);
+        let (_, many) = run_laid(scene, 4, Some([2, 2]), name, overrides);
+        let what = format!("{name} on 2 × 2 ranks");
+        agrees(&one, &many, 1e-10, &what);
+        if one["curve"].is_array() {
+            curves_agree(&one, &many, 1e-10, &what);
+        }
+        assert_eq!(many["ranks"]["split"], serde_json::json!([2, 2]), "{what}");
+        let points = many["ranks"]["points"].as_array().unwrap();
+        assert!(
+            points.iter().all(|p| p.as_u64().unwrap() > 0),
+            "{what}: every rank holds points ({points:?})"
+        );
+    }
+    // Laid other than as many parts as ranks: refused, naming the count.
+    let o = kdmpm_on(
+        4,
+        &[
+            "run",
+            common::scene("block_10k.ron").to_str().unwrap(),
+            "--split",
+            "3x2",
+        ],
+    );
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{e}");
+    assert!(e.contains("4 rank(s)"), "{e}");
+}
+
+/// The fast slope laid 2 × 2 fails and runs out across both cuts (points move along each
+/// axis, two hops at a corner, and the cells are cut again along both as they pile up at
+/// the toe); it stops by itself at one rank's angle. Checkpointed at step 2 000 and resumed
+/// on 2 × 2, it writes the bytes of the run that never stopped.
+#[test]
+fn the_failing_slope_split_2_by_2_comes_to_rest_at_the_angle_of_one_rank_and_resumes() {
+    let (_, one) = run_on("slope_fast.ron", 1, "slope22", &[]);
+    let every = ["solver.checkpoint_every=Steps(2000)"];
+    let (run, many) = run_laid("slope_fast.ron", 4, Some([2, 2]), "slope22", &every);
+    assert_eq!(many["outcome"], "converged");
+    let angle = |s: &Value| s["surface_angle"]["degrees"].as_f64().expect("an angle");
+    assert!(
+        (angle(&one) - angle(&many)).abs() <= 0.05,
+        "{} against {}",
+        angle(&many),
+        angle(&one)
+    );
+    assert_eq!(one["total_mass"], many["total_mass"]);
+    assert!(many["ranks"]["migrations"].as_u64().unwrap() > 0);
+    let held: u64 = many["ranks"]["points"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| p.as_u64().unwrap())
+        .sum();
+    assert_eq!(held, one["particles"].as_u64().unwrap());
+    assert!(many["ranks"]["rebalances"].as_u64().unwrap() > 0);
+    let full = run.with_file_name("slope22-full");
+    let _ = std::fs::remove_dir_all(&full);
+    common::copy_dir(&run, &full);
+    let o = kdmpm_on(4, &["resume", run.to_str().expect("UTF-8")]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    same_results_over(&run, &full, 4);
 }
 
 /// `mpirun -n RANKS kdmpm ARGS` (one thread each), waited for.

@@ -37,7 +37,7 @@ use thiserror::Error;
 /// The first bytes of a checkpoint file.
 const MAGIC: &[u8; 8] = b"KDMPMCK\0";
 /// Format version; a file of another version is refused.
-const VERSION: u32 = 14;
+const VERSION: u32 = 15;
 /// The build that writes and reads checkpoints: the crate's version and a fingerprint of
 /// its sources (build.rs).
 pub const BUILD_ID: &str = concat!(env!("CARGO_PKG_VERSION"), "+", env!("KDMPM_SOURCE_HASH"));
@@ -151,7 +151,7 @@ pub fn restore_part<D: Dim>(
         return Err(r.fault(format!("saved in {}D, the scene is {}D", r.dimension, D::N)));
     }
     let mut state = decode_state(&mut r)?;
-    let (ranks, rank, bounds) = decode_ranks(&mut r, &mut state.ranks)?;
+    let (ranks, rank, [bounds, across]) = decode_ranks(&mut r, &mut state.ranks)?;
     let (size, here) = (sim.ctx.comm.size(), sim.ctx.comm.rank());
     if (ranks, rank) != (size, here) {
         return Err(r.fault(format!(
@@ -159,16 +159,28 @@ pub fn restore_part<D: Dim>(
              run with the rank count it was started with"
         )));
     }
-    let layers = sim.ctx.grid.axes[sim.ctx.grid.slab_axis].cells;
-    if bounds.len() != ranks + 1
-        || bounds[0] != 0
-        || bounds[ranks] != layers
-        || bounds.windows(2).any(|b| b[0] > b[1])
+    let grid = &sim.ctx.grid;
+    let layers = [grid.slab_axis, grid.across_axis()].map(|a| grid.axes[a].cells);
+    let fits = |cuts: &[usize], layers: usize| {
+        cuts.len() >= 2
+            && cuts[0] == 0
+            && cuts[cuts.len() - 1] == layers
+            && cuts.windows(2).all(|b| b[0] <= b[1])
+    };
+    if !fits(&bounds, layers[0])
+        || !fits(&across, layers[1])
+        || (bounds.len() - 1) * (across.len() - 1) != ranks
     {
         return Err(r.fault(format!(
-            "the saved split of {} cell layers differs from the scene's grid ({layers} layers \
-             along its slab axis): a checkpoint of another scene",
-            bounds.last().copied().unwrap_or_default()
+            "the saved split ({} × {} parts over {} × {} cell layers) differs from the scene's \
+             grid ({} × {} cell layers along its split axes) over {ranks} rank(s): a checkpoint \
+             of another scene",
+            bounds.len().saturating_sub(1),
+            across.len().saturating_sub(1),
+            bounds.last().copied().unwrap_or_default(),
+            across.last().copied().unwrap_or_default(),
+            layers[0],
+            layers[1]
         )));
     }
     if ranks > 1 {
@@ -184,6 +196,7 @@ pub fn restore_part<D: Dim>(
     sim.ctx.state = state;
     sim.ctx.decomposition = Decomposition {
         bounds,
+        across,
         ..sim.ctx.decomposition.clone()
     };
     // Nodes are zero and no box is active right after building, as after a grid reset.
@@ -456,8 +469,10 @@ fn decode_state(r: &mut Reader) -> Result<SolverState, CheckpointError> {
 fn encode_ranks(w: &mut Writer, d: &Decomposition, counters: &RankCounters) {
     w.u64(d.ranks() as u64);
     w.u64(d.rank as u64);
-    w.u64(d.bounds.len() as u64);
-    d.bounds.iter().for_each(|&b| w.u64(b as u64));
+    for cuts in [&d.bounds, &d.across] {
+        w.u64(cuts.len() as u64);
+        cuts.iter().for_each(|&b| w.u64(b as u64));
+    }
     w.u64(counters.migrations);
     w.u64(counters.rebalances);
 }
@@ -466,19 +481,22 @@ fn encode_ranks(w: &mut Writer, d: &Decomposition, counters: &RankCounters) {
 fn decode_ranks(
     r: &mut Reader,
     counters: &mut RankCounters,
-) -> Result<(usize, usize, Vec<usize>), CheckpointError> {
+) -> Result<(usize, usize, [Vec<usize>; 2]), CheckpointError> {
     let ranks = r.u64()? as usize;
     let rank = r.u64()? as usize;
-    let n = r.u64()?;
-    if n > 1 << 32 {
-        return Err(r.fault("the saved cell layers of the ranks do not fit the grid".into()));
-    }
-    let bounds = (0..n)
-        .map(|_| Ok(r.u64()? as usize))
-        .collect::<Result<Vec<_>, _>>()?;
+    let mut cuts = || {
+        let n = r.u64()?;
+        if n > 1 << 32 {
+            return Err(r.fault("the saved cell layers of the ranks do not fit the grid".into()));
+        }
+        (0..n)
+            .map(|_| Ok(r.u64()? as usize))
+            .collect::<Result<Vec<_>, _>>()
+    };
+    let (bounds, across) = (cuts()?, cuts()?);
     counters.migrations = r.u64()?;
     counters.rebalances = r.u64()?;
-    Ok((ranks, rank, bounds))
+    Ok((ranks, rank, [bounds, across]))
 }
 
 fn encode_clock(w: &mut Writer, c: &Clock) {

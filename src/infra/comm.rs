@@ -4,6 +4,7 @@
 //! rank's values and adds them in rank order on every rank, so all ranks hold the same bits
 //! and a rerun gives them again. Nothing depends on message arrival order.
 
+use crate::infra::decomposition::Split;
 use std::sync::atomic::{AtomicU64, Ordering};
 #[cfg(feature = "mpi")]
 use std::sync::Mutex;
@@ -14,6 +15,8 @@ pub struct Comm {
     size: usize,
     /// Bytes this rank has sent to others (exchanges and its part of the gathers).
     sent: AtomicU64,
+    /// How the ranks are to be laid over a grid, when asked ([`Comm::with_layout`]).
+    layout: Option<Split>,
     #[cfg(feature = "mpi")]
     mpi: Option<Mpi>,
 }
@@ -54,6 +57,7 @@ impl Comm {
             rank: 0,
             size: 1,
             sent: AtomicU64::new(0),
+            layout: None,
             #[cfg(feature = "mpi")]
             mpi: None,
         }
@@ -96,6 +100,7 @@ impl Comm {
                 rank,
                 size,
                 sent: AtomicU64::new(0),
+                layout: None,
                 mpi: Some(Mpi {
                     world: Mutex::new(world),
                     _universe: universe,
@@ -114,6 +119,30 @@ impl Comm {
             }
             Ok(Comm::single())
         }
+    }
+
+    /// These ranks, to be laid over a grid as `layout[0]` slabs cut `layout[1]` times
+    /// across ([`crate::infra::decomposition`]), as MPI's Cartesian communicators carry their
+    /// dimensions; refused unless the parts are as many as the ranks.
+    pub fn with_layout(mut self, layout: Split) -> Result<Comm, String> {
+        if layout[0] == 0 || layout[1] == 0 || layout[0] * layout[1] != self.size {
+            return Err(format!(
+                "--split {}x{} lays {} parts, but the run has {} rank(s): the slabs times the \
+                 cuts across must be the rank count (mpirun -n {})",
+                layout[0],
+                layout[1],
+                layout[0] * layout[1],
+                self.size,
+                layout[0] * layout[1]
+            ));
+        }
+        self.layout = Some(layout);
+        Ok(self)
+    }
+
+    /// The layout asked for with [`Comm::with_layout`], if any.
+    pub fn layout(&self) -> Option<Split> {
+        self.layout
     }
 
     /// This process's rank, from 0.

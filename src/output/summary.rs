@@ -133,8 +133,14 @@ pub struct Ranks {
     pub migrations: u64,
     /// Times the cell layers were split again because the ranks' loads drifted apart.
     pub rebalances: u64,
-    /// Each rank's first cell layer, and the end of the last (the final split).
+    /// The parts along the slab axis and across it (`[ranks, 1]`: slabs).
+    pub split: [usize; 2],
+    /// Each slab's first cell layer along the slab axis, and the end of the last (the final
+    /// split).
     pub bounds: Vec<usize>,
+    /// Each part's first cell layer along the second split axis, and the end of the last
+    /// (`[0, cells]` for slabs).
+    pub across: Vec<usize>,
     /// Bytes the ranks sent each other, all ranks together, per step (exchanges of shared
     /// nodes and of moving points, and the reductions), over the steps this invocation
     /// made (a resumed run's since its checkpoint).
@@ -285,7 +291,9 @@ impl Summary {
                 points: points.iter().map(|&p| p as u64).collect(),
                 migrations: migrations[0] as u64,
                 rebalances: s.ranks.rebalances,
+                split: sim.ctx.decomposition.split(),
                 bounds: sim.ctx.decomposition.bounds.clone(),
+                across: sim.ctx.decomposition.across.clone(),
                 bytes_per_step: migrations[1] / (s.clock.step - s.ranks.first_step).max(1) as f64,
                 peak_memory_bytes: peaks.iter().map(|&p| p as u64).collect(),
             }

@@ -16,7 +16,7 @@ use std::sync::Arc;
 /// Joins `sim`, this rank's part of the scene, to the run over `comm`'s ranks: the split it
 /// was built with must be over as many ranks. With one rank nothing changes.
 pub fn join<D: Dim>(sim: &mut Simulation<D>, comm: Arc<Comm>) {
-    let ranks = sim.ctx.decomposition.bounds.len() - 1;
+    let ranks = sim.ctx.decomposition.ranks();
     assert_eq!(
         ranks,
         comm.size(),

@@ -293,6 +293,7 @@ impl Watch<'_> {
         RankPart {
             ranks: self.comm.size(),
             rank: self.comm.rank(),
+            split: self.comm.layout(),
         }
     }
 

@@ -12,7 +12,7 @@ use crate::dim::{Dim, Dim2, Dim3, DimAxi, Vector};
 use crate::error::SceneError;
 use crate::grid::Grid;
 use crate::infra::columns::fill;
-use crate::infra::decomposition::Decomposition;
+use crate::infra::decomposition::{Decomposition, Split, ACROSS, SLAB};
 use crate::materials::{MaterialModel, MaterialState, StateVisitor};
 use crate::model::{Control, Gravity, LoadStage, Model, MotionSpec};
 use crate::parallel::SlabCache;
@@ -37,6 +37,9 @@ pub struct RankPart {
     pub ranks: usize,
     /// This rank (< `ranks`).
     pub rank: usize,
+    /// The parts along the slab axis and the second split axis, whose product is `ranks`;
+    /// `None`: [`Decomposition::split_for`]'s choice.
+    pub split: Option<Split>,
 }
 
 /// [`build`], spawning only the points of `part`'s cell layers when a part is given: the
@@ -303,8 +306,7 @@ fn build_dim<D: Dim>(
     let mut world = World::new();
     spawn_nodes(&mut world, &grid, &checked_grid.faces);
     let decomposition = split(s, &grid, part);
-    let layers = decomposition.cells();
-    let keep = |x: [f64; 3]| layers.contains(&grid.clamped_cell_along(D::vec_from(x), grid.slab_axis));
+    let keep = |x: [f64; 3]| decomposition.holds(grid.split_cell(D::vec_from(x)));
     let Bodies {
         ids: body_ids,
         next_id,
@@ -543,22 +545,28 @@ fn spawn_nodes<D: Dim>(world: &mut World, grid: &Grid<D>, faces: &[FaceHold]) {
     }));
 }
 
-/// The split of the scene's cell layers over `part`'s ranks (every layer on one rank without
-/// a part), balanced on the points every body and point load puts in each layer: the counts
-/// the spawned points would give, found from the regions alone.
+/// The split of the scene's cells over `part`'s ranks (every cell on one rank without a
+/// part), balanced on the points every body and point load puts in each layer along the
+/// two split axes: the counts the spawned points would give, found from the regions alone.
 fn split<D: Dim>(s: &Scene, grid: &Grid<D>, part: Option<RankPart>) -> Decomposition {
-    let (axis, support) = (grid.slab_axis, s.shape.support());
-    let layers = grid.axes[axis].cells;
-    let Some(RankPart { ranks, rank }) = part.filter(|p| p.ranks > 1) else {
-        return Decomposition::whole(layers, support);
+    let support = s.shape.support();
+    let [slab_axis, across_axis] = [grid.slab_axis, grid.across_axis()];
+    let layers = [slab_axis, across_axis].map(|a| grid.axes[a].cells);
+    let Some(RankPart { ranks, rank, split }) = part.filter(|p| p.ranks > 1) else {
+        return Decomposition::whole(layers[SLAB], layers[ACROSS], support);
     };
-    let mut counts = vec![0u64; layers];
-    let mut count = |x: [f64; 3]| counts[grid.clamped_cell_along(D::vec_from(x), axis)] += 1;
+    let split = Decomposition::split_for(ranks, layers[SLAB], layers[ACROSS], support, split);
+    let mut counts = layers.map(|n| vec![0u64; n]);
+    let mut count = |x: [f64; 3]| {
+        let c = grid.split_cell(D::vec_from(x));
+        counts[SLAB][c[SLAB]] += 1;
+        counts[ACROSS][c[ACROSS]] += 1;
+    };
     for body in &s.bodies {
         fill_points(grid, &body.region, &body.points_per_cell, &s.rigid_bodies).for_each(&mut count);
     }
     s.point_loads.iter().for_each(|l| count(pad3(&l.position)));
-    Decomposition::balanced(&counts, ranks, rank, support)
+    Decomposition::balanced([&counts[SLAB], &counts[ACROSS]], split, rank, support)
 }
 
 /// Every body's points in id order, regenerated from the regions (`ids`: each body's).

@@ -44,6 +44,7 @@ use crate::dim::Dim;
 use crate::error::StepError;
 use crate::grid::Grid;
 use crate::infra::columns::{col, col_mut, points_with};
+use crate::infra::decomposition::{ACROSS, SLAB};
 use crate::materials::{visit_states, MaterialModel, MaterialState, StateVisitor};
 use crate::parallel::CHUNK;
 use crate::schedule::System;
@@ -353,15 +354,19 @@ impl CellPoints {
 /// The cells (by their lowest node) of the node layers this rank shares with its
 /// neighbours; none with one rank.
 fn shared_cells<D: Dim>(ctx: &Context<D>) -> impl Iterator<Item = usize> + '_ {
-    let bands = if ctx.comm.size() > 1 {
-        ctx.decomposition.bands()
-    } else {
-        [None, None]
-    };
-    bands
+    let d = &ctx.decomposition;
+    let several = ctx.comm.size() > 1;
+    let bands = [SLAB, ACROSS]
         .into_iter()
-        .flatten()
-        .flat_map(|(_, l)| ctx.grid.layer_node_ids(l))
+        .filter(move |_| several)
+        .flat_map(move |axis| {
+            let other = d.held_nodes(1 - axis);
+            d.bands(axis).into_iter().flatten().map(move |(_, l)| match axis {
+                SLAB => ctx.grid.split_box(l, other.clone()),
+                _ => ctx.grid.split_box(other.clone(), l),
+            })
+        });
+    bands.flat_map(|b| b.rows(&ctx.grid)).flatten()
 }
 
 /// How many times a step returns the points that the shift of their mean took outside

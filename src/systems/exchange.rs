@@ -14,7 +14,7 @@ use crate::dim::Dim;
 use crate::grid::{Grid, NodeBox};
 use crate::infra::columns::{col, col_mut, nodes};
 use crate::infra::comm::Comm;
-use crate::infra::decomposition::Decomposition;
+use crate::infra::decomposition::{Decomposition, ACROSS, SLAB};
 use std::ops::Range;
 
 /// Node mass.
@@ -53,59 +53,79 @@ pub fn exchange_again<D: Dim>(ctx: &mut Context<D>, what: u8) {
     );
     // The shared bands are part of this rank's grid from now on in the step: reset, updated
     // and read like the nodes its own points reach.
-    for b in bands.into_iter().flatten() {
+    for b in bands {
         ctx.state.active_nodes = ctx.state.active_nodes.union(b);
     }
 }
 
 /// The partial values of the node layers this rank shares with its neighbours, made whole:
-/// `pack(ids)` gives this rank's values at the node ids of a band (any number a node, the
-/// same layout on both sides), `unpack(ids, lower, upper)` gets the lower rank's part and
-/// the upper rank's and combines them (added in that order, the same bits on both ranks).
-/// Returns the bands' boxes.
+/// `pack(rows)` gives this rank's values at a band's nodes (runs of consecutive node ids,
+/// any number of values a node, the same layout on both sides), `unpack(rows, lower,
+/// upper)` gets the lower rank's part and the upper rank's and combines them (added in that
+/// order, the same bits on both ranks). Returns the bands' boxes.
+///
+/// A two-axis split sums along the slab axis first, over the layers this rank holds across
+/// (its own and its bands there), then across, over the layers it holds along the slab
+/// axis, the first sums included: a node at a corner of four ranks ends as (lower-left +
+/// upper-left) + (lower-right + upper-right) on all four.
 pub(crate) fn share_bands<D: Dim>(
     grid: &Grid<D>,
     comm: &Comm,
     decomposition: &Decomposition,
-    pack: impl Fn(Range<usize>) -> Vec<f64>,
-    mut unpack: impl FnMut(Range<usize>, &[f64], &[f64]),
-) -> [Option<NodeBox>; 2] {
-    let [below, above] = decomposition.bands();
-    let ids = |b: &Option<(usize, Range<usize>)>| b.as_ref().map(|(_, l)| grid.layer_node_ids(l.clone()));
-    let (ids_below, ids_above) = (ids(&below), ids(&above));
-    let mine_below = ids_below.clone().map(&pack).unwrap_or_default();
-    let mine_above = ids_above.clone().map(&pack).unwrap_or_default();
-    let (rank_below, rank_above) = (below.as_ref().map(|b| b.0), above.as_ref().map(|a| a.0));
-    let from_below = comm.exchange(rank_above, &mine_above, rank_below);
-    let from_above = comm.exchange(rank_below, &mine_below, rank_above);
-    if let Some(r) = ids_below {
-        unpack(r, &from_below, &mine_below);
+    pack: impl Fn(&[Range<usize>]) -> Vec<f64>,
+    mut unpack: impl FnMut(&[Range<usize>], &[f64], &[f64]),
+) -> Vec<NodeBox> {
+    let mut boxes = Vec::new();
+    for axis in [SLAB, ACROSS] {
+        let [below, above] = decomposition.bands(axis);
+        let other = decomposition.held_nodes(1 - axis);
+        let band = |b: &Option<(usize, Range<usize>)>| {
+            b.as_ref().map(|(_, l)| match axis {
+                SLAB => grid.split_box(l.clone(), other.clone()),
+                _ => grid.split_box(other.clone(), l.clone()),
+            })
+        };
+        let (box_below, box_above) = (band(&below), band(&above));
+        let rows = |b: Option<NodeBox>| b.map(|b| runs(b.rows(grid)));
+        let (rows_below, rows_above) = (rows(box_below), rows(box_above));
+        let mine_below = rows_below.as_deref().map(&pack).unwrap_or_default();
+        let mine_above = rows_above.as_deref().map(&pack).unwrap_or_default();
+        let (rank_below, rank_above) = (below.as_ref().map(|b| b.0), above.as_ref().map(|a| a.0));
+        let from_below = comm.exchange(rank_above, &mine_above, rank_below);
+        let from_above = comm.exchange(rank_below, &mine_below, rank_above);
+        if let Some(r) = &rows_below {
+            unpack(r, &from_below, &mine_below);
+        }
+        if let Some(r) = &rows_above {
+            unpack(r, &mine_above, &from_above);
+        }
+        boxes.extend(box_below.into_iter().chain(box_above));
     }
-    if let Some(r) = ids_above {
-        unpack(r, &mine_above, &from_above);
+    boxes
+}
+
+/// Runs of consecutive node ids, neighbouring runs joined (a band across the whole grid is
+/// one run).
+fn runs(rows: impl Iterator<Item = Range<usize>>) -> Vec<Range<usize>> {
+    let mut out: Vec<Range<usize>> = Vec::new();
+    for r in rows {
+        match out.last_mut() {
+            Some(last) if last.end == r.start => last.end = r.end,
+            _ => out.push(r),
+        }
     }
-    [below, above].map(|b| {
-        b.map(|(_, r)| {
-            let mut b = NodeBox::default();
-            for a in 0..3 {
-                (b.lo[a], b.hi[a]) = if a == grid.slab_axis {
-                    (r.start, r.end)
-                } else {
-                    (0, grid.nodes[a])
-                };
-            }
-            b
-        })
-    })
+    out
 }
 
 /// The values of the columns of `what` at node ids `ids`, in node order, column after
 /// column (mass, momentum, force, external force).
-fn pack<D: Dim>(ctx: &Context<D>, what: u8, ids: Range<usize>) -> Vec<f64> {
+fn pack<D: Dim>(ctx: &Context<D>, what: u8, rows: &[Range<usize>]) -> Vec<f64> {
     let n = nodes(&ctx.world);
     let mut out = Vec::new();
+    let each = || rows.iter().flat_map(|r| r.clone());
     if what & MASS != 0 {
-        out.extend(col::<NodeMass>(n)[ids.clone()].iter().map(|m| m.0));
+        let m = col::<NodeMass>(n);
+        out.extend(each().map(|i| m[i].0));
     }
     let vectors = |out: &mut Vec<f64>, v: &mut dyn Iterator<Item = D::Vec>| {
         for v in v {
@@ -113,28 +133,23 @@ fn pack<D: Dim>(ctx: &Context<D>, what: u8, ids: Range<usize>) -> Vec<f64> {
         }
     };
     if what & MOMENTUM != 0 {
-        vectors(
-            &mut out,
-            &mut col::<NodeMomentum<D::Vec>>(n)[ids.clone()].iter().map(|p| p.0),
-        );
+        let p = col::<NodeMomentum<D::Vec>>(n);
+        vectors(&mut out, &mut each().map(|i| p[i].0));
     }
     if what & FORCE != 0 {
-        vectors(
-            &mut out,
-            &mut col::<NodeForce<D::Vec>>(n)[ids.clone()].iter().map(|f| f.0),
-        );
+        let f = col::<NodeForce<D::Vec>>(n);
+        vectors(&mut out, &mut each().map(|i| f[i].0));
     }
     if what & EXTERNAL != 0 {
-        vectors(
-            &mut out,
-            &mut col::<NodeExternalForce<D::Vec>>(n)[ids].iter().map(|f| f.0),
-        );
+        let f = col::<NodeExternalForce<D::Vec>>(n);
+        vectors(&mut out, &mut each().map(|i| f[i].0));
     }
     out
 }
 
-/// Puts `values` (as [`pack`] lays them out) into the columns of `what` at `ids`.
-fn unpack<D: Dim>(ctx: &Context<D>, what: u8, ids: Range<usize>, values: &[f64]) {
+/// Puts `values` (as [`pack`] lays them out) into the columns of `what` at the nodes of
+/// `rows`.
+fn unpack<D: Dim>(ctx: &Context<D>, what: u8, rows: &[Range<usize>], values: &[f64]) {
     let n = nodes(&ctx.world);
     let mut at = 0;
     let mut next = |k: usize| {
@@ -147,24 +162,21 @@ fn unpack<D: Dim>(ctx: &Context<D>, what: u8, ids: Range<usize>, values: &[f64])
         c[..D::N].copy_from_slice(v);
         D::vec_from(c)
     };
+    let each = || rows.iter().flat_map(|r| r.clone());
     if what & MASS != 0 {
-        for m in &mut col_mut::<NodeMass>(n)[ids.clone()] {
-            m.0 = next(1)[0];
-        }
+        let mut m = col_mut::<NodeMass>(n);
+        each().for_each(|i| m[i].0 = next(1)[0]);
     }
     if what & MOMENTUM != 0 {
-        for p in &mut col_mut::<NodeMomentum<D::Vec>>(n)[ids.clone()] {
-            p.0 = vec(next(D::N));
-        }
+        let mut p = col_mut::<NodeMomentum<D::Vec>>(n);
+        each().for_each(|i| p[i].0 = vec(next(D::N)));
     }
     if what & FORCE != 0 {
-        for f in &mut col_mut::<NodeForce<D::Vec>>(n)[ids.clone()] {
-            f.0 = vec(next(D::N));
-        }
+        let mut f = col_mut::<NodeForce<D::Vec>>(n);
+        each().for_each(|i| f[i].0 = vec(next(D::N)));
     }
     if what & EXTERNAL != 0 {
-        for f in &mut col_mut::<NodeExternalForce<D::Vec>>(n)[ids] {
-            f.0 = vec(next(D::N));
-        }
+        let mut f = col_mut::<NodeExternalForce<D::Vec>>(n);
+        each().for_each(|i| f[i].0 = vec(next(D::N)));
     }
 }

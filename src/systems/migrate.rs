@@ -1,4 +1,4 @@
-//! Points that left this rank's cell layers move to the neighbouring rank (runs over MPI).
+//! Points that left this rank's cells move to the neighbouring rank (runs over MPI).
 //!
 //! [`Migrate`] ends every step of a run over several ranks (`distribute::join` adds
 //! it): a point moves less than a cell a step, so at the next mapping every point lies in
@@ -12,7 +12,7 @@ use crate::context::Context;
 use crate::dim::Dim;
 use crate::error::StepError;
 use crate::infra::columns::{col, points_with};
-use crate::infra::decomposition::Decomposition;
+use crate::infra::decomposition::{Decomposition, ACROSS, SLAB};
 use crate::schedule::System;
 use hecs::{Entity, EntityBuilder, World};
 
@@ -37,25 +37,42 @@ pub const REBALANCE_EVERY: u64 = 100;
 /// Largest point count of a rank over the mean above which the layers are split again.
 pub const IMBALANCE_LIMIT: f64 = 1.2;
 
-/// Every [`REBALANCE_EVERY`] steps, splits the cell layers again by point count when the
-/// ranks' loads differ by more than [`IMBALANCE_LIMIT`] (a failing slope moves its points
-/// down and out), and moves the points to their new ranks; true when it did. A collective.
+/// Every [`REBALANCE_EVERY`] steps, splits the cells again by point count when the ranks'
+/// loads differ by more than [`IMBALANCE_LIMIT`] (a failing slope moves its points down and
+/// out), and moves the points to their new ranks; true when it did. A collective.
 pub fn rebalance<D: Dim>(ctx: &mut Context<D>) -> bool {
     if ctx.comm.size() == 1 || !ctx.state.clock.step.is_multiple_of(REBALANCE_EVERY) {
         return false;
     }
-    let mut counts: Vec<f64> = layer_counts(ctx).iter().map(|&c| c as f64).collect();
+    let d = &ctx.decomposition;
+    let split = d.split();
+    // Layers across count only when the ranks are cut across.
+    let across = if split[ACROSS] > 1 {
+        ctx.grid.axes[ctx.grid.across_axis()].cells
+    } else {
+        1
+    };
+    let mut counts: Vec<f64> = cell_counts(ctx, across).iter().map(|&c| c as f64).collect();
     ctx.comm.sum(&mut counts);
     let counts: Vec<u64> = counts.iter().map(|&c| c as u64).collect();
-    let d = &ctx.decomposition;
-    let per_rank: Vec<u64> = (0..d.ranks())
-        .map(|r| counts[d.bounds[r]..d.bounds[r + 1]].iter().sum())
-        .collect();
-    if Decomposition::imbalance(&per_rank) <= IMBALANCE_LIMIT {
+    if Decomposition::imbalance(&d.points_per_rank(&counts, across)) <= IMBALANCE_LIMIT {
         return false;
     }
-    let next = Decomposition::balanced(&counts, d.ranks(), d.rank, d.support);
-    if next.bounds == d.bounds {
+    // Each axis cut again on the points in its layers.
+    let slab: Vec<u64> = counts.chunks(across).map(|row| row.iter().sum()).collect();
+    let next = Decomposition {
+        bounds: Decomposition::cuts(&slab, split[SLAB], d.support),
+        across: if split[ACROSS] > 1 {
+            let columns: Vec<u64> = (0..across)
+                .map(|j| counts.iter().skip(j).step_by(across).sum())
+                .collect();
+            Decomposition::cuts(&columns, split[ACROSS], d.support)
+        } else {
+            d.across.clone()
+        },
+        ..d.clone()
+    };
+    if next == *d {
         return false;
     }
     ctx.decomposition = next;
@@ -64,33 +81,45 @@ pub fn rebalance<D: Dim>(ctx: &mut Context<D>) -> bool {
     true
 }
 
-/// This rank's points in each cell layer along the slab axis.
-pub fn layer_counts<D: Dim>(ctx: &Context<D>) -> Vec<u64> {
-    let axis = ctx.grid.slab_axis;
-    let mut counts = vec![0u64; ctx.grid.axes[axis].cells];
+/// This rank's points in each cell's layers along the slab axis and the second split axis,
+/// `[slab layer][across layer]` row-major over `across` layers across (1: the slab axis
+/// alone).
+pub fn cell_counts<D: Dim>(ctx: &Context<D>, across: usize) -> Vec<u64> {
+    let grid = &ctx.grid;
+    let mut counts = vec![0u64; grid.axes[grid.slab_axis].cells * across];
     for arch in points_with::<Position<D::Vec>>(&ctx.world) {
         for x in col::<Position<D::Vec>>(arch).iter() {
-            counts[ctx.grid.clamped_cell_along(x.0, axis)] += 1;
+            let [i, j] = grid.split_cell(x.0);
+            counts[i * across + if across > 1 { j } else { 0 }] += 1;
         }
     }
     counts
 }
 
-/// Sends this rank's points outside its cell layers towards the ranks that own them and
-/// spawns the points the others send, until every point is on its owner; true when points
-/// came or went (rows moved: slabs and traced points must be found again). A collective.
+/// Sends this rank's points outside its cells towards the ranks that own them and spawns
+/// the points the others send, until every point is on its owner; true when points came or
+/// went (rows moved: slabs and traced points must be found again). A collective.
+///
+/// Points move along the slab axis first, then across: the neighbours along the slab axis
+/// hold the same layers across, so a point that crossed a corner reaches its owner in two
+/// hops.
 pub fn migrate<D: Dim>(ctx: &mut Context<D>) -> bool {
     if ctx.comm.size() == 1 {
         return false;
     }
     let mut moved = false;
-    // A point hops one rank at a time, so one that must cross an empty rank (or several,
-    // after a new decomposition) takes more than one round.
-    loop {
-        let (left, came, astray) = migrate_once(ctx);
-        moved |= left + came > 0;
-        if !ctx.comm.any(astray) {
-            break;
+    for axis in [SLAB, ACROSS] {
+        if ctx.decomposition.split()[axis] == 1 {
+            continue;
+        }
+        // A point hops one rank at a time, so one that must cross an empty rank (or
+        // several, after a new decomposition) takes more than one round.
+        loop {
+            let (left, came, astray) = migrate_once(ctx, axis);
+            moved |= left + came > 0;
+            if !ctx.comm.any(astray) {
+                break;
+            }
         }
     }
     if moved {
@@ -100,18 +129,25 @@ pub fn migrate<D: Dim>(ctx: &mut Context<D>) -> bool {
     moved
 }
 
-/// One round: points below this rank's layers go to rank − 1, points above to rank + 1,
-/// and the points they send come in. Returns the points sent, the points received and
-/// whether a received point is still outside this rank's layers.
-fn migrate_once<D: Dim>(ctx: &mut Context<D>) -> (usize, usize, bool) {
-    let (rank, ranks) = (ctx.comm.rank(), ctx.comm.size());
-    let below = rank.checked_sub(1);
-    let above = (rank + 1 < ranks).then_some(rank + 1);
-    let cells = ctx.decomposition.cells();
-    let axis = ctx.grid.slab_axis;
+/// One round along split axis `axis`: points below this rank's layers along it go to the
+/// part below, points above to the part above, and the points they send come in. Returns
+/// the points sent, the points received and whether a received point is still outside this
+/// rank's layers along that axis.
+fn migrate_once<D: Dim>(ctx: &mut Context<D>, axis: usize) -> (usize, usize, bool) {
+    let d = &ctx.decomposition;
+    let [parts, me] = [d.split()[axis], d.part_of(d.rank)[axis]];
+    let at = |k: usize| {
+        let mut p = d.part_of(d.rank);
+        p[axis] = k;
+        d.rank_at(p)
+    };
+    let below = me.checked_sub(1).map(at);
+    let above = (me + 1 < parts).then(|| at(me + 1));
+    let cells = d.cells_along(axis);
+    let grid = &ctx.grid;
     let (mut down, mut up): (Vec<Entity>, Vec<Entity>) = (Vec::new(), Vec::new());
     for (e, x) in ctx.world.query::<(Entity, &Position<D::Vec>)>().iter() {
-        let c = ctx.grid.clamped_cell_along(x.0, axis);
+        let c = grid.split_cell(x.0)[axis];
         if c < cells.start {
             down.push(e);
         } else if c >= cells.end {
@@ -141,7 +177,7 @@ fn migrate_once<D: Dim>(ctx: &mut Context<D>) -> (usize, usize, bool) {
             let Some(x) = read_point::<D>(bytes, &mut at, &mut builder) else {
                 break;
             };
-            astray |= !cells.contains(&ctx.grid.clamped_cell_along(x, axis));
+            astray |= !cells.contains(&ctx.grid.split_cell(x)[axis]);
             ctx.world.spawn(builder.build());
             came += 1;
         }

@@ -157,18 +157,22 @@ impl NodePairs {
             grid,
             comm,
             decomposition,
-            |ids| sums.borrow()[ids].as_flattened().to_vec(),
-            |ids, lower, upper| {
-                for ((pair, l), u) in sums.borrow_mut()[ids]
-                    .iter_mut()
-                    .zip(lower.chunks_exact(2))
-                    .zip(upper.chunks_exact(2))
-                {
-                    *pair = combine([l[0], l[1]], [u[0], u[1]]);
+            |rows| {
+                let sums = sums.borrow();
+                rows.iter()
+                    .flat_map(|r| sums[r.clone()].as_flattened())
+                    .copied()
+                    .collect()
+            },
+            |rows, lower, upper| {
+                let mut sums = sums.borrow_mut();
+                let pairs = rows.iter().flat_map(|r| r.clone());
+                for ((i, l), u) in pairs.zip(lower.chunks_exact(2)).zip(upper.chunks_exact(2)) {
+                    sums[i] = combine([l[0], l[1]], [u[0], u[1]]);
                 }
             },
         );
-        for b in bands.into_iter().flatten() {
+        for b in bands {
             self.active = self.active.union(b);
         }
     }

@@ -49,15 +49,14 @@ fn rows<D: Dim>(sim: &Simulation<D>) -> Vec<Row> {
     rows
 }
 
-/// The points a part holds outside its own cell layers.
+/// The points a part holds outside its own cells.
 fn outside<D: Dim>(sim: &Simulation<D>) -> usize {
-    let (grid, axis) = (&sim.ctx.grid, sim.ctx.grid.slab_axis);
-    let layers = sim.ctx.decomposition.cells();
+    let (grid, d) = (&sim.ctx.grid, &sim.ctx.decomposition);
     sim.ctx
         .world
         .query::<&Position<D::Vec>>()
         .iter()
-        .filter(|x| !layers.contains(&grid.clamped_cell_along(x.0, axis)))
+        .filter(|x| !d.holds(grid.split_cell(x.0)))
         .count()
 }
 
@@ -70,10 +69,10 @@ fn shared<D: Dim>(sim: &Simulation<D>) -> String {
     )
 }
 
-/// Builds `scene` whole and as the parts of `ranks` ranks; the parts' points together are
-/// the whole's, each part holds the points of its own layers only, and every part agrees
-/// on what is global.
-fn parts_make_the_whole(scene: &str, sets: &[&str], ranks: usize) {
+/// Builds `scene` whole and as the parts of `ranks` ranks (laid as `split` asks); the parts'
+/// points together are the whole's, each part holds the points of its own cells only, and
+/// every part agrees on what is global.
+fn parts_make_the_whole(scene: &str, sets: &[&str], ranks: usize, split: Option<[usize; 2]>) {
     let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
     let loaded = LoadedScene::from_file(&common::scene(scene), &sets).unwrap();
     let (mut whole, derived) = build(&loaded).unwrap();
@@ -82,14 +81,18 @@ fn parts_make_the_whole(scene: &str, sets: &[&str], ranks: usize) {
     let mut union = Vec::new();
     let mut held = Vec::new();
     for rank in 0..ranks {
-        let (mut part, d) = build_part(&loaded, Some(RankPart { ranks, rank })).unwrap();
+        let (mut part, d) = build_part(&loaded, Some(RankPart { ranks, rank, split })).unwrap();
         assert_eq!(
             d.points, derived.points,
             "{scene}: rank {rank} counts every point"
         );
         assert_eq!(d.active_nodes, derived.active_nodes, "{scene}: rank {rank}");
-        let (r, sh, outside, split) = with_simulation!(&mut part, s => (rows(s), shared(s), outside(s), s.ctx.decomposition.bounds.len() - 1));
-        assert_eq!(split, ranks);
+        let (r, sh, outside, laid) =
+            with_simulation!(&mut part, s => (rows(s), shared(s), outside(s), s.ctx.decomposition.split()));
+        assert_eq!(laid[0] * laid[1], ranks);
+        if let Some(asked) = split {
+            assert_eq!(laid, asked, "{scene}: laid as asked");
+        }
         assert_eq!(
             outside, 0,
             "{scene}: rank {rank} holds points of another rank's layers"
@@ -112,7 +115,7 @@ fn parts_make_the_whole(scene: &str, sets: &[&str], ranks: usize) {
 #[test]
 fn each_ranks_part_of_a_scene_is_the_one_rank_build_cut_to_its_layers() {
     // Tractions in increments and a traced point (plane strain).
-    parts_make_the_whole("footing_load.ron", &[], 2);
+    parts_make_the_whole("footing_load.ron", &[], 2, None);
     // A pressure beside a rigid body, an initial pressure, axisymmetry.
     parts_make_the_whole(
         "cpt.ron",
@@ -122,11 +125,21 @@ fn each_ranks_part_of_a_scene_is_the_one_rank_build_cut_to_its_layers() {
             "tractions[0].min=[0.5, 13.75]",
         ],
         4,
+        None,
     );
     // Water and traced points.
-    parts_make_the_whole("slope_water.ron", &[], 3);
+    parts_make_the_whole("slope_water.ron", &[], 3, None);
     // 3D.
-    parts_make_the_whole("block_10k.ron", &[], 2);
+    parts_make_the_whole("block_10k.ron", &[], 2, None);
+}
+
+/// Split along a second axis too: 2 × 2 in 3D (slabs along z cut along y) and in plane
+/// strain (slabs along y cut along x), each part the whole's points in its own cells.
+#[test]
+fn each_ranks_part_of_a_two_axis_split_is_the_one_rank_build_cut_to_its_cells() {
+    parts_make_the_whole("block_10k.ron", &[], 4, Some([2, 2]));
+    parts_make_the_whole("footing_load.ron", &[], 4, Some([2, 2]));
+    parts_make_the_whole("slope_water.ron", &[], 6, Some([3, 2]));
 }
 
 /// The nearest point to a traced place is the first made among equals, so that every rank
@@ -141,7 +154,15 @@ fn a_traced_place_equidistant_from_points_names_the_first_of_them_on_every_rank(
     let (mut whole, _) = build(&loaded).unwrap();
     let id = with_simulation!(&mut whole, s => s.traced[0].id);
     for rank in 0..2 {
-        let (mut part, _) = build_part(&loaded, Some(RankPart { ranks: 2, rank })).unwrap();
+        let (mut part, _) = build_part(
+            &loaded,
+            Some(RankPart {
+                ranks: 2,
+                rank,
+                split: None,
+            }),
+        )
+        .unwrap();
         assert_eq!(with_simulation!(&mut part, s => s.traced[0].id), id);
     }
     // The four points round (2, 2) at a quarter cell each way; the lowest id is the point

@@ -47,6 +47,25 @@ pub struct Refining {
     pub refine: Option<u32>,
 }
 
+/// How a run over MPI ranks lays them over the grid, for `run` and `fos` alike.
+#[derive(clap::Args, Clone, Copy)]
+pub struct Layout {
+    /// Under mpirun: lay the ranks as SLABS slabs along the grid's slab axis, each cut
+    /// ACROSS times along a second axis (e.g. `--split 2x2` on 4 ranks; default: slabs while
+    /// each can be 4 cell layers wide for B-splines, 3 for linear shapes, then as few cuts
+    /// across as let the slabs hold the rest).
+    #[arg(long, value_name = "SLABSxACROSS", value_parser = parse_split)]
+    pub split: Option<[usize; 2]>,
+}
+
+/// `AxB` as the two counts.
+fn parse_split(s: &str) -> Result<[usize; 2], String> {
+    let bad = || format!("`{s}` is not SLABSxACROSS, two counts of 1 or more joined by x (e.g. 2x2)");
+    let (a, b) = s.split_once(['x', 'X']).ok_or_else(bad)?;
+    let n = |t: &str| t.trim().parse::<usize>().ok().filter(|&n| n > 0).ok_or_else(bad);
+    Ok([n(a)?, n(b)?])
+}
+
 #[derive(Subcommand)]
 pub enum Command {
     /// Run a scene to static equilibrium (or its step/time limit).
@@ -68,6 +87,8 @@ pub enum Command {
         mean_from: Option<String>,
         #[command(flatten)]
         stepping: Stepping,
+        #[command(flatten)]
+        layout: Layout,
         /// Write a Chrome trace (chrome://tracing, Perfetto) of every system call to FILE
         /// (needs a build with `--features trace`).
         #[arg(long, value_name = "FILE")]
@@ -115,6 +136,8 @@ pub enum Command {
         refining: Refining,
         #[command(flatten)]
         workers: Workers,
+        #[command(flatten)]
+        layout: Layout,
     },
     /// Draw (again) the plots of a run from its output directory, finished or running:
     /// kinetic energy, K_F and K_E, traced displacements, displacement field (SVG).

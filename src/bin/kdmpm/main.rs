@@ -53,6 +53,15 @@ fn main() -> ExitCode {
         },
         _ => Comm::world(),
     };
+    // The ranks' layout over the grid, when asked.
+    let layout = match &cli.command {
+        Command::Run { layout, .. } | Command::Fos { layout, .. } => layout.split,
+        _ => None,
+    };
+    let comm = comm.and_then(|c| match layout {
+        Some(l) => c.with_layout(l),
+        None => Ok(c),
+    });
     let comm = match comm {
         Ok(c) => Arc::new(c),
         Err(e) => return Fault::bad(e).report(),
@@ -206,6 +215,7 @@ fn command(command: Command, comm: &Arc<Comm>) -> Result<ExitCode, Fault> {
             overrides,
             refining,
             workers,
+            ..
         } => run_fos(&scene, out, &overrides, refining.refine, workers.quiet, comm)?,
         Command::Resume { dir, stepping } => {
             let run = Run::resume(dir).quiet(stepping.workers.quiet).over(comm.clone());
