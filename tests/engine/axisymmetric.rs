@@ -290,6 +290,23 @@ fn a_smooth_cone_takes_its_resistance_at_the_tip() {
     assert_eq!(n_kt, SMOOTH_CONE_FIRST_N_KT);
 }
 
+/// `scenes/cpt_fast.ron` (the cone started 3 D down in a hole bored to its shape) at
+/// h = D/4 over its first D/4: the tip wished in place bears at once, though less than the
+/// steady 13.8 of the cone pushed from the top at this cell (its resistance builds up over
+/// about 3 D of push, docs/verification.md "A fast cone"), and the smooth shaft in the
+/// hole takes next to nothing. N_kt pinned.
+#[test]
+fn the_fast_cone_bears_from_its_first_increment_in_its_bored_hole() {
+    let s = run("cpt_fast.ron", &at_d4("rigid_bodies[0].motion.travel=0.25"));
+    assert!(s.converged, "{:?}", s.error);
+    let tip = s.curve.iter().find(|c| c.name == "cone.tip").unwrap();
+    let shaft = s.curve.iter().find(|c| c.name == "cone.shaft").unwrap();
+    let n_kt = factor_over_overburden(tip.pressure.unwrap());
+    assert!(shaft.force[1].abs() < 0.05 * tip.force[1].abs(), "{shaft:?}");
+    assert!(n_kt < 13.8, "{n_kt}");
+    assert_eq!(n_kt, 10.86561541517993);
+}
+
 /// N_kt of the smooth cone at h = D/4 after its first D/4 (pinned above).
 const SMOOTH_CONE_FIRST_N_KT: f64 = 8.04446256281579;
 
