@@ -19,6 +19,12 @@ pub struct Velocity<V>(pub V);
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Displacement<V>(pub V);
 
+/// Where a material point was when the static check's window opened (m); points carry it
+/// only in a scene with a `static_check`, and it moves with them between ranks and into
+/// checkpoints.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WindowStart<V>(pub V);
+
 /// Mass of a material point (kg; per metre of thickness in plane strain).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Mass(pub f64);
@@ -155,7 +161,8 @@ macro_rules! point_components_and_states {
             Volume,
             Stress<<$d as Dim>::Stress>,
             MaterialId,
-            PointId
+            PointId,
+            WindowStart<<$d as Dim>::Vec>
             $(, <<$spec as $crate::materials::SceneMaterial>::Model as $crate::materials::Material>::State)*
         )
     };

@@ -321,11 +321,9 @@ impl Convergence {
 pub struct StaticWindow {
     /// Time at which the current window opened (s).
     pub start: Option<f64>,
-    /// Largest point movement over the last completed window (m).
+    /// Largest point movement over the last completed window (m). Where each point was
+    /// when the window opened is its [`WindowStart`](crate::components::WindowStart).
     pub movement: Option<f64>,
-    /// Point positions (m, x y z, by [`PointId`](crate::components::PointId)) when the
-    /// current window opened.
-    pub snapshot: Vec<[f64; 3]>,
 }
 
 /// Counters of a run over MPI ranks (empty or zero on one rank).

@@ -406,9 +406,6 @@ fn check_ids<D: Dim>(sim: &Simulation<D>, state: &SolverState, count: usize) -> 
     {
         return Err("the loads' increments saved do not fit the scene's loads".into());
     }
-    if !state.static_window.snapshot.is_empty() && state.static_window.snapshot.len() != count {
-        return Err("the static check's saved positions do not fit the scene's points".into());
-    }
     if !state.clock.time.is_finite() {
         return Err("the saved time is not a finite number".into());
     }
@@ -577,30 +574,14 @@ fn decode_convergence(r: &mut Reader) -> Result<Convergence, CheckpointError> {
 }
 
 fn encode_static_window(w: &mut Writer, s: &StaticWindow) {
-    let StaticWindow {
-        start,
-        movement,
-        snapshot,
-    } = s;
+    let StaticWindow { start, movement } = s;
     w.opt(*start);
     w.opt(*movement);
-    w.u64(snapshot.len() as u64);
-    for x in snapshot {
-        x.iter().for_each(|&c| w.f64(c));
-    }
 }
 
 fn decode_static_window(r: &mut Reader) -> Result<StaticWindow, CheckpointError> {
     let (start, movement) = (r.opt()?, r.opt()?);
-    let mut snapshot = Vec::new();
-    for _ in 0..r.u64()? {
-        snapshot.push([r.f64()?, r.f64()?, r.f64()?]);
-    }
-    Ok(StaticWindow {
-        start,
-        movement,
-        snapshot,
-    })
+    Ok(StaticWindow { start, movement })
 }
 
 fn encode_control(w: &mut Writer, c: &Control) {

@@ -249,25 +249,6 @@ impl Comm {
         }
     }
 
-    /// Completes a list indexed by point id in which each rank filled its own points and
-    /// left the others NaN (see `measure::positions`): every rank gets every
-    /// point's entry. The lists may differ in length (ids above a rank's last point).
-    pub fn merge_by_id(&self, list: &mut Vec<[f64; 3]>) {
-        if self.size == 1 {
-            return;
-        }
-        let mut len = [list.len() as f64];
-        self.max(&mut len);
-        list.resize(len[0] as usize, [f64::NAN; 3]);
-        let n = list.len() * 3;
-        let all = self.gather_all(list.as_flattened());
-        for (i, v) in list.as_flattened_mut().iter_mut().enumerate() {
-            if let Some(found) = (0..self.size).map(|r| all[r * n + i]).find(|x| !x.is_nan()) {
-                *v = found;
-            }
-        }
-    }
-
     /// The correctly rounded sum of every rank's `values`: the same bits whatever the rank
     /// count and the order of the values (an exact sum, rounded once).
     pub fn exact_sum(&self, values: impl IntoIterator<Item = f64>) -> f64 {

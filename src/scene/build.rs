@@ -794,9 +794,13 @@ fn spawn_body<D: Dim>(
     if s.output.displacements {
         columns.add::<Displacement<D::Vec>>();
     }
+    if s.solver.static_check.is_some() {
+        columns.add::<WindowStart<D::Vec>>();
+    }
     let batch = columns.into_batch(count as u32);
     fill(&batch, xs.clone().map(|(_, id)| PointId(id)));
     fill(&batch, xs.clone().map(|(x, _)| Position(D::vec_from(x))));
+    fill(&batch, xs.clone().map(|(x, _)| WindowStart(D::vec_from(x))));
     fill(&batch, std::iter::repeat_n(Velocity(z), count));
     let start = |x: [f64; 3]| match &body.initial_stress {
         Some(spec) => ground.stress(spec, mat as u16, x),
@@ -898,6 +902,9 @@ fn spawn_point_loads<D: Dim>(
         ));
         if s.output.displacements {
             world.insert_one(carrier, Displacement(z)).expect("just spawned");
+        }
+        if s.solver.static_check.is_some() {
+            world.insert_one(carrier, WindowStart(x)).expect("just spawned");
         }
     }
 

@@ -5,9 +5,8 @@ use crate::components::*;
 use crate::context::Context;
 use crate::dim::{Dim, Vector};
 use crate::error::StepError;
-use crate::infra::columns::{col, nodes};
+use crate::infra::columns::{col, col_mut, nodes, points_with};
 use crate::infra::traffic::Traffic;
-use crate::measure::{max_movement, positions};
 use crate::parallel::grid_pass;
 use crate::schedule::System;
 use crate::state::{StaticCheck, StopReason};
@@ -150,8 +149,9 @@ pub fn force_norms<D: Dim>(ctx: &Context<D>) -> ForceNorms {
 /// more than the allowed distance, otherwise a new window opens at the next step that
 /// meets them.
 ///
-/// It keeps nothing itself: the window and its snapshot live in [`crate::state::SolverState`],
-/// so that a checkpoint holds them.
+/// It keeps nothing itself: the window lives in [`crate::state::SolverState`] and each
+/// point's place at its opening in the point's [`WindowStart`], so that a checkpoint holds
+/// them and over MPI ranks each rank keeps its own points' only.
 #[derive(Debug, Default)]
 pub struct Convergence;
 
@@ -160,10 +160,11 @@ impl Convergence {
         let now = ctx.state.clock.time;
         match ctx.state.static_window.start {
             Some(start) if now >= start + check.window * (1.0 - 1e-12) => {
-                let mut current = Vec::with_capacity(ctx.state.static_window.snapshot.len());
-                positions::<D>(&ctx.world, &mut current);
-                ctx.comm.merge_by_id(&mut current);
-                let moved = max_movement(&ctx.state.static_window.snapshot, &current);
+                // Each rank's points against where they were (their own column, which went
+                // with a point that changed rank), the largest over the ranks.
+                let mut moved = [window_movement::<D>(&ctx.world)];
+                ctx.comm.max(&mut moved);
+                let moved = moved[0];
                 ctx.state.static_window.movement = Some(moved);
                 ctx.state.static_window.start = None;
                 if met && moved <= check.max_displacement {
@@ -172,7 +173,7 @@ impl Convergence {
                 if met {
                     // Still balanced but moving: a creeping state. Watch a new window.
                     ctx.state.static_window.start = Some(now);
-                    ctx.state.static_window.snapshot = current;
+                    open_window::<D>(&ctx.world);
                 }
                 false
             }
@@ -180,13 +181,35 @@ impl Convergence {
             None => {
                 if met {
                     ctx.state.static_window.start = Some(now);
-                    positions::<D>(&ctx.world, &mut ctx.state.static_window.snapshot);
-                    ctx.comm.merge_by_id(&mut ctx.state.static_window.snapshot);
+                    open_window::<D>(&ctx.world);
                 }
                 false
             }
         }
     }
+}
+
+/// Marks where every point is as the static check's window opens ([`WindowStart`]).
+fn open_window<D: Dim>(world: &hecs::World) {
+    for arch in points_with::<WindowStart<D::Vec>>(world) {
+        let x = col::<Position<D::Vec>>(arch);
+        let mut start = col_mut::<WindowStart<D::Vec>>(arch);
+        start.iter_mut().zip(x.iter()).for_each(|(s, x)| s.0 = x.0);
+    }
+}
+
+/// The largest distance of this rank's points from where they were when the window opened
+/// (m).
+fn window_movement<D: Dim>(world: &hecs::World) -> f64 {
+    let mut moved = 0.0f64;
+    for arch in points_with::<WindowStart<D::Vec>>(world) {
+        let (x, start) = (col::<Position<D::Vec>>(arch), col::<WindowStart<D::Vec>>(arch));
+        for (x, s) in x.iter().zip(start.iter()) {
+            let (a, b) = (D::vec_to3(s.0), D::vec_to3(x.0));
+            moved = moved.max(((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt());
+        }
+    }
+    moved
 }
 
 impl<D: Dim> System<D> for Convergence {

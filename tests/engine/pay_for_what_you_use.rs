@@ -130,6 +130,26 @@ fn displacements_are_kept_only_when_asked_for_and_traced_points_do_without() {
     assert!(max_u >= with[0].abs());
 }
 
+/// Where each point was when a static check's window opened is a point column, carried
+/// only by the points of a scene with a `static_check`.
+#[test]
+fn only_a_scene_with_a_static_check_keeps_where_its_points_were() {
+    use kdmpm::components::WindowStart;
+    let count = |sim: &AnySimulation| match sim {
+        AnySimulation::Two(s) => points_with::<WindowStart<glam::DVec2>>(&s.ctx.world)
+            .map(|a| a.len() as usize)
+            .sum::<usize>(),
+        _ => panic!("a plane-strain slope"),
+    };
+    let with = load("slope_fast.ron", &[]);
+    let without = load("slope_fast.ron", &["solver.static_check=None"]);
+    let points = match &with {
+        AnySimulation::Two(s) => s.point_count(),
+        _ => panic!(),
+    };
+    assert_eq!((count(&with), count(&without)), (points, 0));
+}
+
 #[test]
 fn a_material_no_body_uses_does_not_set_the_time_step() {
     // The bar (E = 1, ρ = 1, ν = 0: c_p = 1 m/s) with a rock 100 times stiffer (c_p = 10 m/s)
