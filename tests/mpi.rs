@@ -358,6 +358,13 @@ fn curves_agree(one: &Value, many: &Value, tolerance: f64, what: &str) {
     }
 }
 
+/// The T-bar over its first 0.1 m, in two increments.
+const TBAR_SHORT: &str = "rigid_bodies[0].motion=(velocity: [0.0, -0.01], travel: 0.1, increment: 0.05)";
+
+/// The cone over its first quarter diameter, in one increment.
+const CONE_FIRST_QUARTER: &str =
+    "rigid_bodies[0].motion=(velocity: [0.0, -0.05], travel: 0.25, increment: 0.25)";
+
 /// The penetration problems on 2 and 4 ranks follow one rank step for step: a footing of
 /// driven nodes and a rigid one (their reactions summed over the nodes each rank owns), a
 /// c–φ footing with the cell means against locking, the T-bar under a confining pressure,
@@ -371,16 +378,8 @@ fn rigid_bodies_motions_and_loads_on_2_and_4_ranks_agree_with_one_rank_to_1e_10(
         ("footing.ron", "footing", &[]),
         ("footing_rigid.ron", "rigid", &[]),
         ("footing_cphi.ron", "cphi", &["motions[0].travel=0.06"]),
-        (
-            "tbar.ron",
-            "tbar",
-            &["rigid_bodies[0].motion=(velocity: [0.0, -0.01], travel: 0.1, increment: 0.05)"],
-        ),
-        (
-            "cpt.ron",
-            "cpt",
-            &["rigid_bodies[0].motion=(velocity: [0.0, -0.05], travel: 0.25, increment: 0.25)"],
-        ),
+        ("tbar.ron", "tbar", &[TBAR_SHORT]),
+        ("cpt.ron", "cpt", &[CONE_FIRST_QUARTER]),
         ("footing_rigid_load.ron", "rigid-load", &[]),
         ("footing_load.ron", "load", &[]),
     ];
@@ -553,16 +552,8 @@ fn ranks_split_2_by_2_agree_with_one_rank_to_1e_10() {
     let cases: [(&str, &str, &[&str]); 6] = [
         ("block_10k.ron", "block", &[]),
         ("footing_rigid.ron", "rigid", &[]),
-        (
-            "tbar.ron",
-            "tbar",
-            &["rigid_bodies[0].motion=(velocity: [0.0, -0.01], travel: 0.1, increment: 0.05)"],
-        ),
-        (
-            "cpt.ron",
-            "cpt",
-            &["rigid_bodies[0].motion=(velocity: [0.0, -0.05], travel: 0.25, increment: 0.25)"],
-        ),
+        ("tbar.ron", "tbar", &[TBAR_SHORT]),
+        ("cpt.ron", "cpt", &[CONE_FIRST_QUARTER]),
         ("footing_cphi.ron", "cphi", &["motions[0].travel=0.06"]),
         ("slope_water.ron", "water", &["solver.anti_locking=Off"]),
     ];

@@ -162,11 +162,6 @@ impl Decomposition {
         b[k]..b[k + 1]
     }
 
-    /// This rank's cell layers along the slab axis.
-    pub fn cells(&self) -> Range<usize> {
-        self.cells_along(SLAB)
-    }
-
     /// True when this rank holds cell `c` (its layers along the two split axes).
     pub fn holds(&self, c: [usize; 2]) -> bool {
         self.cells_along(SLAB).contains(&c[SLAB]) && self.cells_along(ACROSS).contains(&c[ACROSS])
@@ -210,16 +205,19 @@ impl Decomposition {
         if self.is_empty() {
             return (None, None);
         }
-        let (b, me) = (self.cuts_of(axis), self.part_of(self.rank));
+        let (b, me) = (self.cuts_of(axis), self.part_of(self.rank)[axis]);
         let busy = |k: &usize| b[*k] < b[*k + 1];
-        let at = |k: usize| {
-            let mut p = me;
-            p[axis] = k;
-            self.rank_at(p)
-        };
-        let below = (0..me[axis]).rev().find(busy).map(at);
-        let above = (me[axis] + 1..b.len() - 1).find(busy).map(at);
+        let below = (0..me).rev().find(busy).map(|k| self.rank_along(axis, k));
+        let above = (me + 1..b.len() - 1).find(busy).map(|k| self.rank_along(axis, k));
         (below, above)
+    }
+
+    /// The rank of the part at index `k` along split axis `axis` in this rank's row along
+    /// it (the same part as this rank's along the other axis).
+    pub fn rank_along(&self, axis: usize, k: usize) -> usize {
+        let mut p = self.part_of(self.rank);
+        p[axis] = k;
+        self.rank_at(p)
     }
 
     /// The node layers this rank shares with a neighbour whose range meets its own at cell
@@ -343,7 +341,7 @@ mod tests {
             for k in d.owned_nodes(SLAB) {
                 owners[k] += 1;
             }
-            for c in d.cells() {
+            for c in d.cells_along(SLAB) {
                 assert_eq!(d.owner_of_cell([c, 0]), d.rank);
             }
         }

@@ -49,6 +49,7 @@ use crate::materials::{visit_states, MaterialModel, MaterialState, StateVisitor}
 use crate::parallel::CHUNK;
 use crate::schedule::System;
 use crate::shape::Shape;
+use crate::systems::exchange::band_boxes;
 use crate::systems::node_pairs::{set_volumetric_rates, NodePairs};
 use crate::tensor::{StoredSym, Sym3};
 use hecs::Archetype;
@@ -354,19 +355,16 @@ impl CellPoints {
 /// The cells (by their lowest node) of the node layers this rank shares with its
 /// neighbours; none with one rank.
 fn shared_cells<D: Dim>(ctx: &Context<D>) -> impl Iterator<Item = usize> + '_ {
-    let d = &ctx.decomposition;
     let several = ctx.comm.size() > 1;
     let bands = [SLAB, ACROSS]
         .into_iter()
         .filter(move |_| several)
-        .flat_map(move |axis| {
-            let other = d.held_nodes(1 - axis);
-            d.bands(axis).into_iter().flatten().map(move |(_, l)| match axis {
-                SLAB => ctx.grid.split_box(l, other.clone()),
-                _ => ctx.grid.split_box(other.clone(), l),
-            })
+        .flat_map(|axis| {
+            band_boxes(&ctx.grid, &ctx.decomposition, axis)
+                .into_iter()
+                .flatten()
         });
-    bands.flat_map(|b| b.rows(&ctx.grid)).flatten()
+    bands.flat_map(|(_, b)| b.rows(&ctx.grid)).flatten()
 }
 
 /// How many times a step returns the points that the shift of their mean took outside

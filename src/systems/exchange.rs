@@ -77,20 +77,13 @@ pub(crate) fn share_bands<D: Dim>(
 ) -> Vec<NodeBox> {
     let mut boxes = Vec::new();
     for axis in [SLAB, ACROSS] {
-        let [below, above] = decomposition.bands(axis);
-        let other = decomposition.held_nodes(1 - axis);
-        let band = |b: &Option<(usize, Range<usize>)>| {
-            b.as_ref().map(|(_, l)| match axis {
-                SLAB => grid.split_box(l.clone(), other.clone()),
-                _ => grid.split_box(other.clone(), l.clone()),
-            })
-        };
-        let (box_below, box_above) = (band(&below), band(&above));
+        let [below, above] = band_boxes(grid, decomposition, axis);
+        let (box_below, box_above) = (below.map(|b| b.1), above.map(|a| a.1));
         let rows = |b: Option<NodeBox>| b.map(|b| runs(b.rows(grid)));
         let (rows_below, rows_above) = (rows(box_below), rows(box_above));
         let mine_below = rows_below.as_deref().map(&pack).unwrap_or_default();
         let mine_above = rows_above.as_deref().map(&pack).unwrap_or_default();
-        let (rank_below, rank_above) = (below.as_ref().map(|b| b.0), above.as_ref().map(|a| a.0));
+        let (rank_below, rank_above) = (below.map(|b| b.0), above.map(|a| a.0));
         let from_below = comm.exchange(rank_above, &mine_above, rank_below);
         let from_above = comm.exchange(rank_below, &mine_below, rank_above);
         if let Some(r) = &rows_below {
@@ -102,6 +95,26 @@ pub(crate) fn share_bands<D: Dim>(
         boxes.extend(box_below.into_iter().chain(box_above));
     }
     boxes
+}
+
+/// The bands this rank shares with its neighbours below and above along split axis `axis`,
+/// as (neighbour, box of nodes): the band's node layers along `axis` and, along the other
+/// split axis, every layer this rank holds (its own and its bands there).
+pub(crate) fn band_boxes<D: Dim>(
+    grid: &Grid<D>,
+    decomposition: &Decomposition,
+    axis: usize,
+) -> [Option<(usize, NodeBox)>; 2] {
+    let other = decomposition.held_nodes(1 - axis);
+    decomposition.bands(axis).map(|b| {
+        b.map(|(rank, l)| {
+            let b = match axis {
+                SLAB => grid.split_box(l, other.clone()),
+                _ => grid.split_box(other.clone(), l),
+            };
+            (rank, b)
+        })
+    })
 }
 
 /// Runs of consecutive node ids, neighbouring runs joined (a band across the whole grid is

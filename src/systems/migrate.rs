@@ -136,13 +136,8 @@ pub fn migrate<D: Dim>(ctx: &mut Context<D>) -> bool {
 fn migrate_once<D: Dim>(ctx: &mut Context<D>, axis: usize) -> (usize, usize, bool) {
     let d = &ctx.decomposition;
     let [parts, me] = [d.split()[axis], d.part_of(d.rank)[axis]];
-    let at = |k: usize| {
-        let mut p = d.part_of(d.rank);
-        p[axis] = k;
-        d.rank_at(p)
-    };
-    let below = me.checked_sub(1).map(at);
-    let above = (me + 1 < parts).then(|| at(me + 1));
+    let below = me.checked_sub(1).map(|k| d.rank_along(axis, k));
+    let above = (me + 1 < parts).then(|| d.rank_along(axis, me + 1));
     let cells = d.cells_along(axis);
     let grid = &ctx.grid;
     let (mut down, mut up): (Vec<Entity>, Vec<Entity>) = (Vec::new(), Vec::new());

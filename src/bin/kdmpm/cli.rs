@@ -51,9 +51,9 @@ pub struct Refining {
 #[derive(clap::Args, Clone, Copy)]
 pub struct Layout {
     /// Under mpirun: lay the ranks as SLABS slabs along the grid's slab axis, each cut
-    /// ACROSS times along a second axis (e.g. `--split 2x2` on 4 ranks; default: slabs while
-    /// each can be 4 cell layers wide for B-splines, 3 for linear shapes, then as few cuts
-    /// across as let the slabs hold the rest).
+    /// into ACROSS parts along a second axis (e.g. `--split 2x2` on 4 ranks; default: the
+    /// layout that keeps the most ranks holding cells, a part at least 4 cell layers wide
+    /// for B-splines and 3 for linear shapes, with the fewest cuts across among those).
     #[arg(long, value_name = "SLABSxACROSS", value_parser = parse_split)]
     pub split: Option<[usize; 2]>,
 }
