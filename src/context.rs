@@ -1,7 +1,8 @@
 //! What every system reads and writes.
 
-use crate::dim::Dim;
-use crate::grid::{Grid, RankNodes};
+use crate::components::*;
+use crate::dim::{Dim, Vector};
+use crate::grid::{Grid, NodeBox, RankNodes};
 use crate::infra::comm::Comm;
 use crate::infra::decomposition::{Decomposition, ACROSS, SLAB};
 use crate::materials::MaterialModel;
@@ -55,6 +56,55 @@ impl<D: Dim> Context<D> {
         Some(self.grid.rank_nodes(d.owned_nodes(SLAB), d.owned_nodes(ACROSS)))
     }
 
+    /// Sets this rank's cells to `d`'s and its grid's window to the nodes they hold
+    /// ([`Context::node_window`]): with a new window the node columns are spawned afresh,
+    /// zero, held as the model holds them, as after a grid reset.
+    pub fn set_decomposition(&mut self, d: Decomposition) {
+        self.decomposition = d;
+        let window = self.node_window();
+        if window == self.grid.window() {
+            return;
+        }
+        self.grid = self.grid.windowed(window);
+        let old: Vec<hecs::Entity> = self
+            .world
+            .query::<(hecs::Entity, &NodeMass)>()
+            .iter()
+            .map(|(e, _)| e)
+            .collect();
+        for e in old {
+            self.world.despawn(e).expect("listed just now");
+        }
+        spawn_nodes(&mut self.world, &self.grid, &self.model);
+        self.state.active_nodes = NodeBox::default();
+        self.slabs.invalidate();
+    }
+
+    /// The nodes this rank's grid numbers and its node columns hold: every node on one
+    /// rank; over several, along each split axis the nodes its points can reach before they
+    /// migrate (a point moves less than a cell a step, so from one cell layer below its
+    /// cells to one above, [`Grid::reach`]), which hold the bands it shares
+    /// ([`Decomposition::held_nodes`]); every node along the axis no split cuts.
+    pub fn node_window(&self) -> NodeBox {
+        let d = &self.decomposition;
+        if d.ranks() == 1 {
+            return self.grid.whole().window();
+        }
+        if d.is_empty() {
+            // No cells: the grid then numbers one node ([`Grid::windowed`]).
+            return NodeBox::default();
+        }
+        let g = &self.grid;
+        let [slab, across] = [SLAB, ACROSS].map(|axis| {
+            let (cells, held) = (d.cells_along(axis), d.held_nodes(axis));
+            let (lo, hi) = (cells.start.saturating_sub(1), cells.end);
+            let layers = g.axes[[g.slab_axis, g.across_axis()][axis]].cells;
+            let reach = lo.saturating_sub(1)..(hi.min(layers - 1) + d.support);
+            reach.start.min(held.start)..reach.end.max(held.end)
+        });
+        g.split_box(slab, across)
+    }
+
     /// The node ids whose values this rank holds whole when the run has several ranks
     /// (its own and the bands it shares, once summed: [`Decomposition::held_nodes`]);
     /// `None` with one rank.
@@ -65,4 +115,21 @@ impl<D: Dim> Context<D> {
         let d = &self.decomposition;
         Some(self.grid.rank_nodes(d.held_nodes(SLAB), d.held_nodes(ACROSS)))
     }
+}
+
+/// Spawns the nodes `grid` numbers into `world`, one archetype in id order, zero and held
+/// as `model` holds them ([`Model::node_fixity`]).
+pub fn spawn_nodes<D: Dim>(world: &mut World, grid: &Grid<D>, model: &Model) {
+    let z = D::Vec::ZERO;
+    world.spawn_batch(model.node_fixity(grid).into_iter().map(|f| {
+        (
+            NodeMass(0.0),
+            NodeMomentum(z),
+            NodeForce(z),
+            NodeExternalForce(z),
+            NodeAcceleration(z),
+            NodeVelocity(z),
+            f,
+        )
+    }));
 }

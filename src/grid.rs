@@ -1,11 +1,17 @@
 //! The structured background grid: geometry and node numbering.
 //!
-//! Nodes sit at `origin + h·(i, j, k)` for `i ≤ cells[0]` and so on; node `(i, j, k)` has id
-//! `i·stride[0] + j·stride[1] + k·stride[2]`. x runs fastest (stride 1, the inner loop of
-//! every stencil); of y and z, the axis with more cells runs slowest: it is the axis that
-//! parallel scatters cut into slabs, each slab a contiguous range of node ids (see
-//! `parallel`), so a long thin 3D slab between rollers still splits into many.
+//! Nodes sit at `origin + h·(i, j, k)` for `i ≤ cells[0]` and so on. x runs fastest (stride
+//! 1, the inner loop of every stencil); of y and z, the axis with more cells runs slowest: it
+//! is the axis that parallel scatters cut into slabs, each slab a contiguous range of node
+//! ids (see `parallel`), so a long thin 3D slab between rollers still splits into many.
 //! In 2D the third count is zero, so a 2D grid has one layer of nodes.
+//!
+//! A grid numbers (and a world stores) the nodes of its *window*, a box of them: the whole
+//! grid on one rank, the nodes a rank holds in a run over MPI ranks (its own layers and the
+//! bands it shares, [`crate::infra::decomposition`]), so that a rank's node columns shrink
+//! with its part. Node `(i, j, k)` of the window has id `(i − lo_0)·stride[0] + (j −
+//! lo_1)·stride[1] + (k − lo_2)·stride[2]`, the strides those of the window. Cells, faces and
+//! positions stay the whole grid's: a window only renumbers.
 
 use crate::dim::{Dim, Vector};
 
@@ -89,7 +95,9 @@ impl NodeBox {
         };
         outer.flat_map(move |a| {
             inner.clone().map(move |b| {
-                let first = lo[0] * grid.strides[0] + a * grid.strides[s] + b * grid.strides[m];
+                let mut ijk = [lo[0]; 3];
+                (ijk[s], ijk[m]) = (a, b);
+                let first = grid.node_id(ijk);
                 first..first + width
             })
         })
@@ -140,6 +148,12 @@ pub struct Grid<D: Dim> {
     pub strides: [usize; 3],
     /// The axis with the largest stride (y in 2D; y or z in 3D).
     pub slab_axis: usize,
+    /// The nodes this grid numbers (see the module's notes): all of them unless
+    /// [`Grid::windowed`].
+    window: NodeBox,
+    /// `Σ window.lo[a]·strides[a]`: subtracted from a node's `Σ ijk[a]·strides[a]` to give
+    /// its id (0 for the whole grid).
+    offset: usize,
 }
 
 impl<D: Dim> Grid<D> {
@@ -149,19 +163,73 @@ impl<D: Dim> Grid<D> {
         c[..D::N].copy_from_slice(&cells[..D::N]);
         let nodes = [c[0] + 1, c[1] + 1, c[2] + 1];
         let slab_axis = if D::N == 3 && c[2] >= c[1] { 2 } else { 1 };
-        let middle = 3 - slab_axis;
-        let mut strides = [1usize; 3];
-        strides[middle] = nodes[0];
-        strides[slab_axis] = nodes[0] * nodes[middle];
+        let window = NodeBox {
+            lo: [0; 3],
+            hi: nodes,
+        };
         Grid {
             origin,
             cell_size,
             inv_h: 1.0 / cell_size,
             axes: c.map(|n| Axis::new(n, 1.0 / cell_size)),
             nodes,
-            strides,
+            strides: window_strides(window, slab_axis),
             slab_axis,
+            window,
+            offset: 0,
         }
+    }
+
+    /// The same grid numbering only the nodes of `window` (clipped to the grid; a box
+    /// holding no node numbers the first node alone, so that a rank without cells still
+    /// has a node column).
+    pub fn windowed(&self, window: NodeBox) -> Self {
+        let mut w = window;
+        for a in 0..3 {
+            w.hi[a] = w.hi[a].min(self.nodes[a]);
+            w.lo[a] = w.lo[a].min(w.hi[a]);
+        }
+        if w.is_empty() {
+            w = NodeBox {
+                lo: [0; 3],
+                hi: [1; 3],
+            };
+        }
+        let strides = window_strides(w, self.slab_axis);
+        Grid {
+            strides,
+            window: w,
+            offset: (0..3).map(|a| w.lo[a] * strides[a]).sum(),
+            ..self.clone()
+        }
+    }
+
+    /// The same grid numbering every node (ids then name nodes alike on every rank).
+    pub fn whole(&self) -> Self {
+        self.windowed(NodeBox {
+            lo: [0; 3],
+            hi: self.nodes,
+        })
+    }
+
+    /// The nodes this grid numbers.
+    pub fn window(&self) -> NodeBox {
+        self.window
+    }
+
+    /// True when the grid numbers every node.
+    pub fn is_whole(&self) -> bool {
+        self.window.lo == [0; 3] && self.window.hi == self.nodes
+    }
+
+    /// True when node (i, j, k) is in the window.
+    pub fn numbers(&self, ijk: [usize; 3]) -> bool {
+        (0..3).all(|a| (self.window.lo[a]..self.window.hi[a]).contains(&ijk[a]))
+    }
+
+    /// The id of node (i, j, k), `None` outside the window.
+    pub fn checked_node_id(&self, ijk: [usize; 3]) -> Option<usize> {
+        self.numbers(ijk).then(|| self.node_id(ijk))
     }
 
     /// Cells along each axis (unused axes: 0).
@@ -170,37 +238,49 @@ impl<D: Dim> Grid<D> {
         self.axes.map(|a| a.cells)
     }
 
-    /// Total number of nodes.
+    /// Number of nodes the grid numbers (its window's; every node unless windowed).
     pub fn node_count(&self) -> usize {
-        self.nodes[0] * self.nodes[1] * self.nodes[2]
+        self.window.len()
     }
 
-    /// Id of node (i, j, k).
+    /// Id of node (i, j, k), which must be in the window.
     #[inline(always)]
     pub fn node_id(&self, ijk: [usize; 3]) -> usize {
-        ijk[0] * self.strides[0] + ijk[1] * self.strides[1] + ijk[2] * self.strides[2]
+        (ijk[0] * self.strides[0] + ijk[1] * self.strides[1] + ijk[2] * self.strides[2])
+            .wrapping_sub(self.offset)
     }
 
-    /// Nodes in one layer across the slab axis (the slab axis's stride).
+    /// What [`Grid::node_id`] subtracts from `Σ ijk[a]·strides[a]` (0 for the whole grid):
+    /// the stencils take it off once a point.
+    #[inline(always)]
+    pub fn id_offset(&self) -> usize {
+        self.offset
+    }
+
+    /// Nodes in one layer of the window across the slab axis (the slab axis's stride).
     pub fn layer(&self) -> usize {
         self.strides[self.slab_axis]
     }
 
-    /// The node ids of node `layers` along the slab axis (ids run layer by layer).
+    /// The node ids of node `layers` along the slab axis (ids run layer by layer), those in
+    /// the window.
     pub fn layer_node_ids(&self, layers: std::ops::Range<usize>) -> std::ops::Range<usize> {
-        let layer = self.layer();
-        layers.start * layer..layers.end * layer
+        let (layer, s) = (self.layer(), self.slab_axis);
+        let (lo, hi) = (self.window.lo[s], self.window.hi[s]);
+        let local = |l: usize| l.clamp(lo, hi) - lo;
+        local(layers.start) * layer..local(layers.end.max(layers.start)) * layer
     }
 
     /// Integer coordinates of a node id.
     #[inline]
     pub fn node_ijk(&self, id: usize) -> [usize; 3] {
         let (s, m) = (self.slab_axis, 3 - self.slab_axis);
+        let lo = self.window.lo;
         let mut ijk = [0; 3];
-        ijk[s] = id / self.strides[s];
+        ijk[s] = lo[s] + id / self.strides[s];
         let rest = id % self.strides[s];
-        ijk[m] = rest / self.strides[m];
-        ijk[0] = rest % self.strides[m];
+        ijk[m] = lo[m] + rest / self.strides[m];
+        ijk[0] = lo[0] + rest % self.strides[m];
         ijk
     }
 
@@ -282,13 +362,16 @@ impl<D: Dim> Grid<D> {
     }
 
     /// The nodes in node layers `slab` along the slab axis and `across` along the second
-    /// split axis, as a membership test on node ids.
+    /// split axis (those in the window), as a membership test on node ids.
     pub fn rank_nodes(&self, slab: std::ops::Range<usize>, across: std::ops::Range<usize>) -> RankNodes {
         let m = self.across_axis();
-        let all = across.start == 0 && across.end >= self.nodes[m];
+        let (lo, hi) = (self.window.lo[m], self.window.hi[m]);
+        let local = |l: usize| l.clamp(lo, hi) - lo;
+        let across = local(across.start)..local(across.end.max(across.start));
+        let all = across.start == 0 && across.end >= hi - lo;
         RankNodes {
             ids: self.layer_node_ids(slab),
-            across: (!all).then_some((across, self.strides[m], self.nodes[m])),
+            across: (!all).then_some((across, self.strides[m], hi - lo)),
         }
     }
 
@@ -375,6 +458,17 @@ impl<D: Dim> Grid<D> {
     pub fn contains(&self, x: D::Vec) -> bool {
         self.cell_of(x).is_some()
     }
+}
+
+/// The node-id steps of a window of nodes: x fastest, then the middle axis, the slab axis
+/// slowest.
+fn window_strides(window: NodeBox, slab_axis: usize) -> [usize; 3] {
+    let n = |a: usize| window.hi[a] - window.lo[a];
+    let middle = 3 - slab_axis;
+    let mut strides = [1usize; 3];
+    strides[middle] = n(0);
+    strides[slab_axis] = n(0) * n(middle);
+    strides
 }
 
 /// One axis of a grid as cell indices and shape functions use it, with the bounds they clamp
@@ -549,6 +643,59 @@ mod tests {
                 assert_eq!(g.node_id(g.node_ijk(id)), id);
             }
         }
+    }
+
+    #[test]
+    fn a_window_numbers_its_nodes_alone_and_keeps_the_whole_grids_places() {
+        for cells in [[6, 5, 7], [6, 7, 5]] {
+            let whole = Grid::<Dim3>::new(DVec3::new(-1.0, 0.0, 2.0), 0.5, cells);
+            let mut window = whole.split_box(2..5, 1..4);
+            window.lo[0] = 0;
+            let g = whole.windowed(window);
+            assert_eq!(g.node_count(), window.len());
+            assert!(!g.is_whole() && whole.is_whole() && g.whole().window() == whole.window());
+            // Ids run 0.. over the window's nodes, each at its own place in the grid.
+            for id in 0..g.node_count() {
+                let ijk = g.node_ijk(id);
+                assert!(g.numbers(ijk), "{ijk:?}");
+                assert_eq!(g.node_id(ijk), id);
+                assert_eq!(g.checked_node_id(ijk), Some(id));
+                assert_eq!(g.node_position(ijk), whole.node_position(ijk));
+                assert_eq!(g.node_share(id), whole.node_share(whole.node_id(ijk)));
+            }
+            assert_eq!(g.checked_node_id([0, 0, 0]), None);
+            // A box's rows and a range of layers name the same nodes in both numberings.
+            let b = g.reach([1, 2, 2], [3, 3, 3], 3);
+            let b = NodeBox {
+                lo: b.lo.map(|l| l.max(1)),
+                hi: b.hi,
+            };
+            let b = NodeBox {
+                lo: std::array::from_fn(|a| b.lo[a].max(window.lo[a])),
+                hi: std::array::from_fn(|a| b.hi[a].min(window.hi[a])),
+            };
+            let here: Vec<[usize; 3]> = b.rows(&g).flatten().map(|i| g.node_ijk(i)).collect();
+            let there: Vec<[usize; 3]> = b.rows(&whole).flatten().map(|i| whole.node_ijk(i)).collect();
+            assert_eq!(here, there);
+            let s = g.slab_axis;
+            let layers: Vec<usize> = g.layer_node_ids(3..5).map(|i| g.node_ijk(i)[s]).collect();
+            assert!(layers.iter().all(|l| (3..5).contains(l)) && layers.len() == 2 * g.layer());
+            // A rank's nodes by layers along both split axes, as a test on the window's ids.
+            let (slab, across) = (3..5, 2..3);
+            let mine = g.rank_nodes(slab.clone(), across.clone());
+            let m = g.across_axis();
+            for id in 0..g.node_count() {
+                let ijk = g.node_ijk(id);
+                assert_eq!(
+                    mine.contains(&id),
+                    slab.contains(&ijk[s]) && across.contains(&ijk[m]),
+                    "{ijk:?}"
+                );
+            }
+        }
+        // A window of no node numbers one, so a rank without cells keeps its columns.
+        let g = Grid::<Dim2>::new(DVec2::ZERO, 1.0, [4, 3, 0]);
+        assert_eq!(g.windowed(NodeBox::default()).node_count(), 1);
     }
 
     #[test]

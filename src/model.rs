@@ -3,7 +3,10 @@
 //! its own module; and what their control keeps through the run ([`Control`]). The
 //! numerics that solve it are [`crate::state::Numerics`].
 
+use crate::components::NodeFixity;
+use crate::dim::Dim;
 use crate::error::Refusal;
+use crate::grid::Grid;
 use crate::materials::MaterialModel;
 use serde::{Deserialize, Serialize};
 
@@ -21,6 +24,9 @@ pub struct Model {
     pub bodies: Vec<crate::rigid::RigidBody>,
     /// The scene's `Friction` faces: (normal axis, upper face, tan δ).
     pub friction_faces: Vec<(usize, bool, f64)>,
+    /// The face conditions in force: the scene's, then those of the last stage that set
+    /// any.
+    pub faces: Vec<FaceHold>,
     /// Loading stages, in order; the first is the scene as built.
     pub stages: Vec<LoadStage>,
     /// Loads applied in increments (load control), each increment to its static stop.
@@ -33,6 +39,36 @@ pub struct Model {
 }
 
 impl Model {
+    /// The held axes of every node `grid` numbers: the face conditions in force, and the
+    /// motions' nodes driven on their axes (a node in a motion's box keeps its face
+    /// conditions on the other axes: a footing on a symmetry plane keeps its roller).
+    /// Set-up, a stage's faces and a new window of a rank all take it from here.
+    pub fn node_fixity<D: Dim>(&self, grid: &Grid<D>) -> Vec<NodeFixity> {
+        let mut fixity = vec![NodeFixity(0); grid.node_count()];
+        for (id, f) in fixity.iter_mut().enumerate() {
+            let ijk = grid.node_ijk(id);
+            for face in &self.faces {
+                let layer = if face.upper { grid.axes[face.axis].cells } else { 0 };
+                if ijk[face.axis] == layer {
+                    f.0 |= face.mask;
+                    if face.friction.is_some() {
+                        f.0 |= NodeFixity::FRICTION;
+                    }
+                }
+            }
+            if self.motions.is_empty() {
+                continue;
+            }
+            let x = D::vec_to3(grid.node_position(ijk));
+            for (k, m) in self.motions.iter().enumerate() {
+                if m.holds_node(x, D::N, grid.cell_size) {
+                    *f = NodeFixity::driven(f.0 | m.drive().axes, k);
+                }
+            }
+        }
+        fixity
+    }
+
     /// True when the scene asked for mass scaling (`solver.mass_scaling`).
     pub fn mass_scaling(&self) -> bool {
         !self.inertia_factors.is_empty()
@@ -100,6 +136,20 @@ pub struct LoadSteps {
     pub pressure: f64,
 }
 
+/// One face condition, as the nodes on that face carry it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FaceHold {
+    /// The face's normal axis.
+    pub axis: usize,
+    /// The upper face (x = max) rather than the lower (x = origin).
+    pub upper: bool,
+    /// The held velocity components, one bit an axis (`NodeFixity`'s low bits): every axis
+    /// for `Fixed`, the normal one for `Roller` and `Friction`.
+    pub mask: u8,
+    /// tan δ of a `Friction` face.
+    pub friction: Option<f64>,
+}
+
 /// A loading stage: what changes when it begins; it runs to the static stop.
 #[derive(Clone, Debug, PartialEq)]
 pub struct LoadStage {
@@ -110,8 +160,8 @@ pub struct LoadStage {
     /// Point loads it sets (carriers' and traction points'), by point id in ascending
     /// order (force: N; N/m in 2D, x y z).
     pub loads: Vec<(u32, [f64; 3])>,
-    /// The face conditions it sets: each node's held axes (`NodeFixity` bits 0–2).
-    pub fixity: Option<Vec<u8>>,
+    /// The face conditions it sets, in place of those in force.
+    pub faces: Option<Vec<FaceHold>>,
     /// Gravity it sets (its ramp starts with the stage).
     pub gravity: Option<Gravity>,
     /// The water it sets (its surfaces), if it moves it.
@@ -188,6 +238,13 @@ impl MotionSpec {
     /// The velocity as a vector (m/s, x y z; free axes 0).
     pub fn vector(&self) -> [f64; 3] {
         std::array::from_fn(|a| self.velocity.get(a).copied().flatten().unwrap_or(0.0))
+    }
+
+    /// True when a node at `x` (m, x y z) is one the motion drives, in a scene of `n`
+    /// dimensions with cells of `h` (m): on or inside its box, to a billionth of a cell.
+    pub fn holds_node(&self, x: [f64; 3], n: usize, h: f64) -> bool {
+        let slack = 1e-9 * h;
+        (0..n).all(|a| x[a] >= self.min[a] - slack && x[a] <= self.max[a] + slack)
     }
 
     /// Speed along the motion (m/s).

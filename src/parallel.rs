@@ -248,7 +248,7 @@ pub fn grid_pass<D: Dim, T: NodeTarget, R: Send>(
     if b.is_empty() {
         return Vec::new();
     }
-    let (axis, layer) = (grid.slab_axis, grid.layer());
+    let axis = grid.slab_axis;
     // Sized by the box's nodes in a layer, not the grid's: a body in a big grid then makes
     // as many tasks as in a grid of its own size, not many small ones.
     let box_layer = b.len() / (b.hi[axis] - b.lo[axis]);
@@ -262,10 +262,11 @@ pub fn grid_pass<D: Dim, T: NodeTarget, R: Send>(
         .map(|layers| {
             let mut part_box = b;
             (part_box.lo[axis], part_box.hi[axis]) = (layers.start, layers.end);
-            let first = layers.start * layer;
+            let ids = grid.layer_node_ids(layers);
+            let first = ids.start;
             // SAFETY: groups cover disjoint layer ranges, hence disjoint node ranges, and the
             // kernel cannot keep its part past the call.
-            let part = unsafe { target.part(first..layers.end * layer) };
+            let part = unsafe { target.part(ids) };
             kernel(part_box, part, first)
         })
         .collect()

@@ -571,6 +571,27 @@ fn ranks_split_2_by_2_agree_with_one_rank_to_1e_10() {
             points.iter().all(|p| p.as_u64().unwrap() > 0),
             "{what}: every rank holds points ({points:?})"
         );
+        // Each rank holds the nodes its points reach, not the grid's.
+        let (nodes, all) = (
+            &many["ranks"]["nodes"],
+            many["ranks"]["grid_nodes"].as_u64().unwrap(),
+        );
+        let held: Vec<u64> = nodes
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|n| n.as_u64().unwrap())
+            .collect();
+        assert!(
+            held.iter().all(|&n| n < all) && held.iter().sum::<u64>() > all,
+            "{what}: nodes {held:?} of {all}"
+        );
+        if name == "block" {
+            // Linear shapes; 13 and 11 cell layers along z and y, both cut at 6; x whole (12
+            // nodes). A part holds what its points reach from one cell beyond its own each
+            // way: 8 node layers for a lower part (0..8), 10 for an upper one (4..14).
+            assert_eq!((held, all), (vec![768, 768, 960, 960], 2016), "{what}");
+        }
     }
     // Laid other than as many parts as ranks: refused, naming the count.
     let o = kdmpm_on(

@@ -194,11 +194,11 @@ pub fn restore_part<D: Dim>(
     check_ids(sim, &state, total).map_err(|reason| r.fault(reason))?;
     state.ranks.first_step = state.clock.step;
     sim.ctx.state = state;
-    sim.ctx.decomposition = Decomposition {
+    sim.ctx.set_decomposition(Decomposition {
         bounds,
         across,
         ..sim.ctx.decomposition.clone()
-    };
+    });
     // Nodes are zero and no box is active right after building, as after a grid reset.
     sim.ctx.state.active_nodes = NodeBox::default();
     sim.ctx.slabs = SlabCache::default();

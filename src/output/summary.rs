@@ -148,6 +148,11 @@ pub struct Ranks {
     /// Each rank's peak resident memory (bytes), set-up included, where the system reports
     /// it (0 where it does not).
     pub peak_memory_bytes: Vec<u64>,
+    /// The grid nodes each rank holds at the end (its window: the nodes its points can
+    /// reach), of `grid_nodes` in all.
+    pub nodes: Vec<u64>,
+    /// The grid's nodes.
+    pub grid_nodes: u64,
 }
 
 /// How a run ended, as `summary.json` writes it (snake case).
@@ -286,6 +291,7 @@ impl Summary {
             let mut migrations = [s.ranks.migrations as f64, comm.sent_bytes() as f64];
             comm.sum(&mut migrations);
             let peaks = comm.gather_all(&[peak.unwrap_or(0) as f64]);
+            let nodes = comm.gather_all(&[sim.ctx.grid.node_count() as f64]);
             Ranks {
                 count: comm.size(),
                 points: points.iter().map(|&p| p as u64).collect(),
@@ -296,6 +302,8 @@ impl Summary {
                 across: sim.ctx.decomposition.across.clone(),
                 bytes_per_step: migrations[1] / (s.clock.step - s.ranks.first_step).max(1) as f64,
                 peak_memory_bytes: peaks.iter().map(|&p| p as u64).collect(),
+                nodes: nodes.iter().map(|&n| n as u64).collect(),
+                grid_nodes: sim.ctx.grid.whole().node_count() as u64,
             }
         });
         let rigid_bodies = body_results(sim);

@@ -5,9 +5,9 @@ use super::initial_stress::{Ground, Layer};
 use super::loaded::LoadedScene;
 use super::region::{cell_span, region_bounds, region_contains, BodyPoint};
 use super::spec::{pad3, Dimension, Region, Scene, SolverSpec};
-use super::validate::{self, carried_state, Checked, CheckedGrid, CheckedStage, Derived, FaceHold};
+use super::validate::{self, carried_state, Checked, CheckedGrid, CheckedStage, Derived};
 use crate::components::*;
-use crate::context::Context;
+use crate::context::{spawn_nodes, Context};
 use crate::dim::{Dim, Dim2, Dim3, DimAxi, Vector};
 use crate::error::SceneError;
 use crate::grid::Grid;
@@ -154,27 +154,9 @@ impl<I: Iterator> Iterator for Counted<I> {
 
 impl<I: Iterator> ExactSizeIterator for Counted<I> {}
 
-/// The held axes of every node under the face conditions `boundaries`.
-fn face_fixity<D: Dim>(grid: &Grid<D>, faces: &[FaceHold]) -> Vec<NodeFixity> {
-    let mut fixity = vec![NodeFixity(0); grid.node_count()];
-    for face in faces {
-        let layer = if face.upper { grid.axes[face.axis].cells } else { 0 };
-        for (id, f) in fixity.iter_mut().enumerate() {
-            if grid.node_ijk(id)[face.axis] == layer {
-                f.0 |= face.mask;
-                if face.friction.is_some() {
-                    f.0 |= NodeFixity::FRICTION;
-                }
-            }
-        }
-    }
-    fixity
-}
-
 /// The scene's stages with what the check built (`checked`: materials and faces) and their
 /// loads by carrier id (`load_ids`).
-fn stages<D: Dim>(
-    grid: &Grid<D>,
+fn stages(
     loaded: &LoadedScene,
     checked: Vec<CheckedStage>,
     load_ids: &[(String, u32)],
@@ -219,7 +201,7 @@ fn stages<D: Dim>(
             start: 0.0,
         });
         out.push(LoadStage {
-            fixity: faces.map(|f| face_fixity(grid, &f).into_iter().map(|f| f.0).collect()),
+            faces,
             gravity,
             name: st.name.clone(),
             materials,
@@ -304,7 +286,6 @@ fn build_dim<D: Dim>(
     let s: &Scene = &loaded.scene;
     let grid = new_grid::<D>(&checked_grid);
     let mut world = World::new();
-    spawn_nodes(&mut world, &grid, &checked_grid.faces);
     let decomposition = split(s, &grid, part);
     let keep = |x: [f64; 3]| decomposition.holds(grid.split_cell(D::vec_from(x)));
     let Bodies {
@@ -346,7 +327,8 @@ fn build_dim<D: Dim>(
             .iter()
             .filter_map(|f| f.friction.map(|mu| (f.axis, f.upper, mu)))
             .collect(),
-        stages: stages(&grid, loaded, checked_stages, &load_ids, &placed.shares),
+        faces: checked_grid.faces.clone(),
+        stages: stages(loaded, checked_stages, &load_ids, &placed.shares),
         load_steps: placed.steps,
         pressures: placed.pressures,
         inertia_factors: if s.solver.mass_scaling {
@@ -374,7 +356,7 @@ fn build_dim<D: Dim>(
     };
     let state = initial_state(s);
     let materials = table.into_iter().map(|(_, m)| m).collect();
-    let ctx = Context {
+    let mut ctx = Context {
         world,
         grid,
         materials,
@@ -386,6 +368,9 @@ fn build_dim<D: Dim>(
         decomposition,
         exchanged: 0,
     };
+    // A rank numbers and stores only the nodes its part holds.
+    ctx.grid = ctx.grid.windowed(ctx.node_window());
+    spawn_nodes(&mut ctx.world, &ctx.grid, &ctx.model);
     Ok((
         Simulation {
             ctx,
@@ -526,23 +511,6 @@ fn new_grid<D: Dim>(checked: &CheckedGrid) -> Grid<D> {
         axis.particle_half_width = w;
     }
     grid
-}
-
-/// Spawns the grid's nodes, one archetype, in id order, held by the face conditions.
-fn spawn_nodes<D: Dim>(world: &mut World, grid: &Grid<D>, faces: &[FaceHold]) {
-    let fixity = face_fixity(grid, faces);
-    let z = D::Vec::ZERO;
-    world.spawn_batch(fixity.into_iter().map(|f| {
-        (
-            NodeMass(0.0),
-            NodeMomentum(z),
-            NodeForce(z),
-            NodeExternalForce(z),
-            NodeAcceleration(z),
-            NodeVelocity(z),
-            f,
-        )
-    }));
 }
 
 /// The split of the scene's cells over `part`'s ranks (every cell on one rank without a

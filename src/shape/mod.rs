@@ -292,9 +292,17 @@ pub fn for_each_row<D: Dim, S: Shape>(
     let sx = S::eval_1d(grid.grid_coordinate(x, 0), &grid.axes[0]);
     let sy = S::eval_1d(grid.grid_coordinate(x, 1), &grid.axes[1]);
     let [_, stride_y, stride_z] = grid.strides;
+    // Ids count from the grid's window (0 off a whole grid).
+    let x_base = sx.base.wrapping_sub(grid.id_offset());
     if D::N == 2 {
         for j in 0..S::SUPPORT {
-            row(&sx, (sy.base + j) * stride_y + sx.base, sy.w[j], sy.dw[j], 0.0);
+            row(
+                &sx,
+                ((sy.base + j) * stride_y).wrapping_add(x_base),
+                sy.w[j],
+                sy.dw[j],
+                0.0,
+            );
         }
     } else {
         let sz = S::eval_1d(grid.grid_coordinate(x, 2), &grid.axes[2]);
@@ -302,7 +310,7 @@ pub fn for_each_row<D: Dim, S: Shape>(
             for j in 0..S::SUPPORT {
                 row(
                     &sx,
-                    (sz.base + k) * stride_z + (sy.base + j) * stride_y + sx.base,
+                    ((sz.base + k) * stride_z + (sy.base + j) * stride_y).wrapping_add(x_base),
                     sy.w[j] * sz.w[k],
                     sy.dw[j] * sz.w[k],
                     sy.w[j] * sz.dw[k],

@@ -75,7 +75,7 @@ pub fn rebalance<D: Dim>(ctx: &mut Context<D>) -> bool {
     if next == *d {
         return false;
     }
-    ctx.decomposition = next;
+    ctx.set_decomposition(next);
     ctx.state.ranks.rebalances += 1;
     migrate(ctx);
     true

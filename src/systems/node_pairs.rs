@@ -22,9 +22,22 @@ use rayon::prelude::*;
 pub(crate) struct NodePairs {
     sums: Vec<[f64; 2]>,
     active: NodeBox,
+    /// The window of nodes `sums` is numbered by ([`Grid::window`]).
+    window: NodeBox,
 }
 
 impl NodePairs {
+    /// Sizes the pairs for `grid`'s nodes: all zero again when its window moved (a rank
+    /// whose cells were split anew).
+    fn fit<D: Dim>(&mut self, grid: &Grid<D>) {
+        if self.window != grid.window() {
+            self.window = grid.window();
+            self.sums.clear();
+            self.active = NodeBox::default();
+        }
+        self.sums.resize(grid.node_count(), [0.0; 2]);
+    }
+
     /// Adds the points at `x` (a column of one archetype): for each point p its value
     /// `value(p)`, computed once, goes into every node i it reaches with weight w_ip
     /// through `add(pair_i, w_ip, &value)`. Deterministic: the scatter's slabs fix each
@@ -85,7 +98,7 @@ impl NodePairs {
         x: &[Position<D::Vec>],
         add: impl Fn(usize, &mut [[f64; 2]], usize) + Sync,
     ) {
-        self.sums.resize(grid.node_count(), [0.0; 2]);
+        self.fit(grid);
         let reached = scatter(
             slabs.slabs(grid, x),
             grid,
@@ -151,7 +164,7 @@ impl NodePairs {
         if comm.size() == 1 {
             return;
         }
-        self.sums.resize(grid.node_count(), [0.0; 2]);
+        self.fit(grid);
         let sums = std::cell::RefCell::new(&mut self.sums);
         let bands = share_bands(
             grid,

@@ -12,19 +12,18 @@
 //! The driven nodes take their velocity again at the next step; a reset step moves no
 //! point, and the motion travels nothing in it.
 
-use crate::components::NodeFixity;
 use crate::context::Context;
 use crate::dim::Dim;
 use crate::error::StepError;
-use crate::infra::columns::{col_mut, nodes};
 use crate::model::{CurvePoint, MotionSpec};
 use crate::schedule::System;
 use crate::state::StopReason;
 use crate::systems::increments::Increments;
 
-/// Drives the scene's motions: marks their nodes before the first step, and after each
-/// step's convergence check advances their travel, holds them at the end of an increment
-/// and, at the static state that follows, records the curve and starts the next increment.
+/// Drives the scene's motions (their nodes are marked where the nodes are spawned,
+/// [`crate::model::Model::node_fixity`]): after each step's convergence check it advances
+/// their travel, holds them at the end of an increment and, at the static state that
+/// follows, records the curve and starts the next increment.
 #[derive(Debug)]
 pub struct PrescribedMotion {
     motions: Vec<MotionSpec>,
@@ -40,22 +39,6 @@ impl PrescribedMotion {
 impl<D: Dim> System<D> for PrescribedMotion {
     fn name(&self) -> &str {
         "prescribed_motion"
-    }
-
-    fn prepare(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
-        let grid = &ctx.grid;
-        let mut fix = col_mut::<NodeFixity>(nodes(&ctx.world));
-        for (k, m) in self.motions.iter().enumerate() {
-            for (id, f) in fix.iter_mut().enumerate() {
-                let x = D::vec_to3(grid.node_position(grid.node_ijk(id)));
-                if in_box(m, x, D::N, grid.cell_size) {
-                    // Face conditions on other axes stay (a footing on a symmetry
-                    // plane keeps its roller).
-                    *f = NodeFixity::driven(f.0 | ctx.state.control.drives[k].axes, k);
-                }
-            }
-        }
-        Ok(())
     }
 
     fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
@@ -101,11 +84,4 @@ impl<D: Dim> System<D> for PrescribedMotion {
         }
         Ok(())
     }
-}
-
-/// True when the node at `x` (m) is driven by motion `m` in `n` dimensions: on or inside
-/// its box, to round-off of the grid's coordinates (cells of `h` m).
-pub(crate) fn in_box(m: &MotionSpec, x: [f64; 3], n: usize, h: f64) -> bool {
-    let slack = 1e-9 * h;
-    (0..n).all(|a| x[a] >= m.min[a] - slack && x[a] <= m.max[a] + slack)
 }

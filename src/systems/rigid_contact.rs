@@ -36,7 +36,7 @@ use crate::components::*;
 use crate::context::Context;
 use crate::dim::{Dim, Vector};
 use crate::error::StepError;
-use crate::grid::NodeBox;
+use crate::grid::{Grid, NodeBox};
 use crate::infra::columns::{col, col_mut, nodes};
 use crate::rigid::contact::{key, remember, solve, Contact, Contacts, Memory, Slot};
 use crate::rigid::{CornerTest, Corners, Located};
@@ -69,38 +69,65 @@ impl<D: Dim, S> Default for RigidContact<D, S> {
     }
 }
 
-/// The soil's mass, momentum and force at the nodes the contacts may reach: this rank's
-/// columns with one rank; over several, every node's whole values gathered from the rank
-/// that owns it, so that every rank places and solves the same contacts in the same order
-/// (the answer one rank finds, to the order of the sums that made the nodal values).
+/// The soil's mass, momentum, force and fixity at the nodes the contacts may reach: this
+/// rank's columns with one rank; over several, every node's whole values gathered from the
+/// rank that owns it, so that every rank places and solves the same contacts in the same
+/// order (the answer one rank finds, to the order of the sums that made the nodal values).
+/// Nodes are named by [`naming`]'s grid.
 enum Soil<'a, D: Dim> {
     /// One rank: its node columns.
     Columns {
         nm: &'a [NodeMass],
         np: &'a [NodeMomentum<D::Vec>],
         nf: &'a [NodeForce<D::Vec>],
+        fix: &'a [NodeFixity],
     },
-    /// Several ranks: the node ids, ascending, and 1 + 2N values each (m, p, f).
+    /// Several ranks: the node ids, ascending, and 2 + 2N values each (m, p, f, fixity).
     Gathered { ids: Vec<usize>, values: Vec<f64> },
 }
 
+/// Values a gathered node carries: mass, momentum, force and its fixity's bits.
+fn gathered_width<D: Dim>() -> usize {
+    2 + 2 * D::N
+}
+
 impl<D: Dim> Soil<'_, D> {
-    /// Mass (kg), momentum (kg m/s) and force (N) at node `i`; nothing for a node no
-    /// contact reaches.
-    fn at(&self, i: usize) -> (f64, D::Vec, D::Vec) {
+    /// Mass (kg), momentum (kg m/s), force (N) and fixity at node `i`; nothing and free
+    /// for a node no contact reaches.
+    fn at(&self, i: usize) -> (f64, D::Vec, D::Vec, NodeFixity) {
         match self {
-            Soil::Columns { nm, np, nf } => (nm[i].0, np[i].0, nf[i].0),
+            Soil::Columns { nm, np, nf, fix } => (nm[i].0, np[i].0, nf[i].0, fix[i]),
             Soil::Gathered { ids, values } => {
-                let w = 1 + 2 * D::N;
+                let w = gathered_width::<D>();
                 let Ok(k) = ids.binary_search(&i) else {
-                    return (0.0, D::Vec::ZERO, D::Vec::ZERO);
+                    return (0.0, D::Vec::ZERO, D::Vec::ZERO, NodeFixity(0));
                 };
                 let v = &values[k * w..(k + 1) * w];
                 let vec =
                     |o: usize| D::vec_from(std::array::from_fn(|a| if a < D::N { v[o + a] } else { 0.0 }));
-                (v[0], vec(1), vec(1 + D::N))
+                (v[0], vec(1), vec(1 + D::N), NodeFixity(v[w - 1] as u8))
             }
         }
+    }
+}
+
+/// The grid whose numbering names the contacts' nodes: this rank's own with one rank; over
+/// several the whole grid's, the same on every rank, since every rank places every contact
+/// (a rank's own grid numbers only the nodes it holds).
+fn naming<D: Dim>(ctx: &Context<D>) -> Grid<D> {
+    if ctx.comm.size() == 1 {
+        ctx.grid.clone()
+    } else {
+        ctx.grid.whole()
+    }
+}
+
+/// This rank's id of node `i` of `naming`'s grid, `None` when the rank does not hold it.
+fn local_id<D: Dim>(ctx: &Context<D>, naming: &Grid<D>, i: usize) -> Option<usize> {
+    if ctx.comm.size() == 1 {
+        Some(i)
+    } else {
+        ctx.grid.checked_node_id(naming.node_ijk(i))
     }
 }
 
@@ -142,14 +169,16 @@ fn region<D: Dim>(ctx: &Context<D>) -> NodeBox {
 /// ranks, each rank gives the nodes it owns and the sums make them whole on every rank.
 fn soil<'a, D: Dim, S: Shape>(
     ctx: &Context<D>,
+    naming: &Grid<D>,
     nm: &'a [NodeMass],
     np: &'a [NodeMomentum<D::Vec>],
     nf: &'a [NodeForce<D::Vec>],
+    fix: &'a [NodeFixity],
 ) -> Soil<'a, D> {
     let Some(owned) = ctx.owned_node_ids() else {
-        return Soil::Columns { nm, np, nf };
+        return Soil::Columns { nm, np, nf, fix };
     };
-    let grid = &ctx.grid;
+    let grid = naming;
     let whole = region(ctx);
     let mut ids = Vec::new();
     for (b, body) in ctx.model.bodies.iter().enumerate() {
@@ -168,17 +197,19 @@ fn soil<'a, D: Dim, S: Shape>(
     }
     ids.sort_unstable();
     ids.dedup();
-    let w = 1 + 2 * D::N;
+    let w = gathered_width::<D>();
     let mut values = vec![0.0; ids.len() * w];
-    for (k, &i) in ids.iter().enumerate() {
-        if owned.contains(&i) {
-            let v = &mut values[k * w..(k + 1) * w];
-            v[0] = nm[i].0;
-            for a in 0..D::N {
-                v[1 + a] = np[i].0.get(a);
-                v[1 + D::N + a] = nf[i].0.get(a);
-            }
+    for (k, &g) in ids.iter().enumerate() {
+        let Some(i) = local_id(ctx, naming, g).filter(|i| owned.contains(i)) else {
+            continue;
+        };
+        let v = &mut values[k * w..(k + 1) * w];
+        v[0] = nm[i].0;
+        for a in 0..D::N {
+            v[1 + a] = np[i].0.get(a);
+            v[1 + D::N + a] = nf[i].0.get(a);
         }
+        v[w - 1] = f64::from(fix[i].0);
     }
     // One rank owns each node: its value plus zeros, the same bits on every rank.
     ctx.comm.sum(&mut values);
@@ -194,16 +225,16 @@ fn soil<'a, D: Dim, S: Shape>(
 /// and is left so.
 fn place<D: Dim, S: Shape>(
     ctx: &Context<D>,
+    naming: &Grid<D>,
     soil: &Soil<D>,
     strength: &SoilStrength,
     slot_of: &mut Vec<u32>,
 ) -> Contacts {
-    slot_of.resize(ctx.grid.node_count(), u32::MAX);
-    let fix = col::<NodeFixity>(nodes(&ctx.world));
+    slot_of.resize(naming.node_count(), u32::MAX);
     let mut placer = Placer {
         ctx,
+        grid: naming,
         soil,
-        fix: &fix,
         slot_of,
         set: Contacts::default(),
     };
@@ -222,8 +253,9 @@ fn place<D: Dim, S: Shape>(
 /// [`place`]'s working state: the contacts placed so far and each reached node's slot.
 struct Placer<'a, 'b, D: Dim> {
     ctx: &'a Context<D>,
+    /// The grid whose numbering names the nodes ([`naming`]).
+    grid: &'a Grid<D>,
     soil: &'a Soil<'b, D>,
-    fix: &'a [NodeFixity],
     slot_of: &'a mut Vec<u32>,
     set: Contacts,
 }
@@ -235,10 +267,9 @@ impl<D: Dim> Placer<'_, '_, D> {
         if self.slot_of[i] != u32::MAX {
             return self.slot_of[i] as usize;
         }
-        let (grid, st) = (&self.ctx.grid, &self.ctx.numerics);
+        let (grid, st) = (self.grid, &self.ctx.numerics);
         let drives = &self.ctx.state.control.drives;
-        let (m, p, f) = self.soil.at(i);
-        let fix = self.fix[i];
+        let (m, p, f, fix) = self.soil.at(i);
         let inertia = grid.inertia(i, m, st.virtual_mass_floor);
         // The held components as `boundary` will hold them (it runs next, so that a
         // friction face and a motion feel the contact's force).
@@ -258,7 +289,7 @@ impl<D: Dim> Placer<'_, '_, D> {
     /// (under a confining stress it does).
     fn inside_nodes(&mut self, b: usize, region: NodeBox) {
         let ctx = self.ctx;
-        let (grid, st) = (&ctx.grid, &ctx.numerics);
+        let (grid, st) = (self.grid, &ctx.numerics);
         let body = &ctx.model.bodies[b];
         let offset = ctx.state.control.bodies[b].offset;
         for i in inside_box(ctx, body, offset, region).rows(grid).flatten() {
@@ -292,7 +323,7 @@ impl<D: Dim> Placer<'_, '_, D> {
     /// caps of its part's interface (`strength` where rough).
     fn surface_samples<S: Shape>(&mut self, b: usize, strength: &SoilStrength) {
         let ctx = self.ctx;
-        let (grid, st) = (&ctx.grid, &ctx.numerics);
+        let (grid, st) = (self.grid, &ctx.numerics);
         let body = &ctx.model.bodies[b];
         let offset = ctx.state.control.bodies[b].offset;
         let bounds = (D::vec_to3(grid.origin), D::vec_to3(grid.max_corner()));
@@ -371,9 +402,11 @@ impl<D: Dim, S: Shape> System<D> for RigidContact<D, S> {
                 col::<NodeMomentum<D::Vec>>(n),
                 col::<NodeForce<D::Vec>>(n),
             );
+            let fix = col::<NodeFixity>(n);
             self.strength.gather(ctx);
-            let soil = soil::<D, S>(ctx, &nm, &np, &nf);
-            place::<D, S>(ctx, &soil, &self.strength, &mut self.slot_of)
+            let naming = naming(ctx);
+            let soil = soil::<D, S>(ctx, &naming, &nm, &np, &nf, &fix);
+            place::<D, S>(ctx, &naming, &soil, &self.strength, &mut self.slot_of)
         };
         let bodies = &ctx.model.bodies;
         let velocities: Vec<[f64; 3]> = ctx.state.control.bodies.iter().map(|b| b.velocity).collect();
@@ -390,15 +423,16 @@ impl<D: Dim, S: Shape> System<D> for RigidContact<D, S> {
         let mut nf = col_mut::<NodeForce<D::Vec>>(n);
         let mut ne = col_mut::<NodeExternalForce<D::Vec>>(n);
         // Every rank solved the same contacts; each changes the nodes it holds.
-        let held = ctx.held_node_ids();
-        for s in set
-            .slots
-            .iter()
-            .filter(|s| held.as_ref().is_none_or(|h| h.contains(&s.node)))
-        {
-            let fc = D::vec_from(std::array::from_fn(|a| s.inertia * (s.v[a] - s.v0[a]) / dt));
-            nf[s.node].0 += fc;
-            ne[s.node].0 += fc;
+        let (held, naming) = (ctx.held_node_ids(), naming(ctx));
+        for s in &set.slots {
+            let Some(i) = local_id(ctx, &naming, s.node) else {
+                continue;
+            };
+            if held.as_ref().is_none_or(|h| h.contains(&i)) {
+                let fc = D::vec_from(std::array::from_fn(|a| s.inertia * (s.v[a] - s.v0[a]) / dt));
+                nf[i].0 += fc;
+                ne[i].0 += fc;
+            }
         }
         let control = &mut ctx.state.control;
         for (b, state) in control.bodies.iter_mut().enumerate() {
@@ -446,24 +480,29 @@ pub fn project<D: Dim>(ctx: &mut Context<D>) {
     // Over several ranks each rank gives the slots' nodes it owns (mass, then velocity),
     // and the sums make them whole on every rank: all solve the same contacts.
     let (owned, held) = (ctx.owned_node_ids(), ctx.held_node_ids());
+    let naming = naming(ctx);
+    // Each slot's node as this rank numbers it, if it holds it.
+    let local: Vec<Option<usize>> = (ctx.state.control.contacts.slots.iter())
+        .map(|s| local_id(ctx, &naming, s.node))
+        .collect();
     let n = nodes(&ctx.world);
     let nm = col::<NodeMass>(n);
     let mut nv = col_mut::<NodeVelocity<D::Vec>>(n);
-    let (grid, floor) = (&ctx.grid, ctx.numerics.virtual_mass_floor);
+    let floor = ctx.numerics.virtual_mass_floor;
     let control = &mut ctx.state.control;
     let w = 1 + D::N;
     let mut values = vec![0.0; control.contacts.slots.len() * w];
-    for (s, v) in control.contacts.slots.iter().zip(values.chunks_mut(w)) {
-        if owned.as_ref().is_none_or(|o| o.contains(&s.node)) {
-            v[0] = nm[s.node].0;
-            (0..D::N).for_each(|a| v[1 + a] = nv[s.node].0.get(a));
+    for (i, v) in local.iter().zip(values.chunks_mut(w)) {
+        if let Some(i) = i.filter(|i| owned.as_ref().is_none_or(|o| o.contains(i))) {
+            v[0] = nm[i].0;
+            (0..D::N).for_each(|a| v[1 + a] = nv[i].0.get(a));
         }
     }
     ctx.comm.sum(&mut values);
     for (s, v) in control.contacts.slots.iter_mut().zip(values.chunks(w)) {
         s.v = std::array::from_fn(|a| if a < D::N { v[1 + a] } else { 0.0 });
         s.v0 = s.v;
-        s.inertia = grid.inertia(s.node, v[0], floor);
+        s.inertia = naming.inertia(s.node, v[0], floor);
     }
     let velocities: Vec<[f64; 3]> = control.bodies.iter().map(|b| b.velocity).collect();
     for p in &mut control.contacts.contacts {
@@ -475,9 +514,9 @@ pub fn project<D: Dim>(ctx: &mut Context<D>) {
         &Memory::new(),
         ctx.numerics.contact_tolerance,
     );
-    for s in &control.contacts.slots {
-        if held.as_ref().is_none_or(|h| h.contains(&s.node)) {
-            nv[s.node].0 = D::vec_from(s.v);
+    for (s, i) in control.contacts.slots.iter().zip(&local) {
+        if let Some(i) = i.filter(|i| held.as_ref().is_none_or(|h| h.contains(i))) {
+            nv[i].0 = D::vec_from(s.v);
         }
     }
 }

@@ -44,7 +44,8 @@ use crate::tensor::StoredSym;
 const REACH: usize = 2;
 
 /// Per cell round the rough samples: Σ m, Σ m c, Σ m tan φ over its points with strength.
-/// Cells are keyed by the id of their lowest node ([`Grid::cell_key`]).
+/// Cells are keyed by the id of their lowest node in the whole grid's numbering
+/// ([`Grid::whole`], [`Grid::cell_key`]), the same on every rank.
 #[derive(Debug, Default)]
 pub struct SoilStrength {
     /// Per cell key: its index in `cells` (`u32::MAX`: not summed). All `u32::MAX` for
@@ -84,7 +85,8 @@ impl SoilStrength {
         if self.uniform.is_some() {
             return;
         }
-        let grid = &ctx.grid;
+        // Cells are keyed by the whole grid's numbering, the same on every rank.
+        let grid = &ctx.grid.whole();
         self.index.resize(grid.node_count(), u32::MAX);
         let cells = grid.cells();
         for (body, state) in bodies.iter().zip(&ctx.state.control.bodies) {
@@ -125,7 +127,14 @@ impl SoilStrength {
         self.sums = vec![[0.0; 3]; self.cells.len()];
         self.bounds = vec![[f64::NEG_INFINITY; 4]; self.cells.len()];
         for arch in points_with::<Volume>(&ctx.world) {
-            with_state_column(arch, &mut Summing { ctx, strength: self });
+            with_state_column(
+                arch,
+                &mut Summing {
+                    ctx,
+                    grid,
+                    strength: self,
+                },
+            );
         }
         ctx.comm.sum(self.sums.as_flattened_mut());
         ctx.comm.max(self.bounds.as_flattened_mut());
@@ -163,7 +172,7 @@ impl SoilStrength {
 
     /// A surface sample's caps under its part's `law` (tan δ, and the adhesion a in Pa):
     /// Coulomb's own, or for a rough part the soil's beside the sample reaching `nodes`
-    /// (ids, weights), infinite (no slip) where that soil has no strength.
+    /// (ids of the whole `grid`, weights), infinite (no slip) where that soil has no strength.
     pub fn caps<D: Dim>(
         &self,
         law: InterfaceLaw,
@@ -210,6 +219,8 @@ impl SoilStrength {
 /// Adds an archetype's points in summed cells to their cell's sums.
 struct Summing<'a, D: Dim> {
     ctx: &'a Context<D>,
+    /// The whole grid, whose numbering keys the cells.
+    grid: &'a Grid<D>,
     strength: &'a mut SoilStrength,
 }
 
@@ -221,7 +232,7 @@ impl<D: Dim> WithStates for Summing<'_, D> {
             col::<MaterialId>(arch),
             col::<Stress<D::Stress>>(arch),
         );
-        let (grid, materials) = (&self.ctx.grid, &self.ctx.materials);
+        let (grid, materials) = (self.grid, &self.ctx.materials);
         let s = &mut *self.strength;
         for p in 0..xg.len() {
             let k = s.index[grid.cell_key(xg[p].0)];

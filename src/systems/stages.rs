@@ -28,16 +28,11 @@ fn apply<D: Dim>(ctx: &mut Context<D>, stage: &LoadStage, start: f64) {
     if let Some(g) = stage.gravity {
         ctx.model.gravity = Some(Gravity { start, ..g });
     }
-    if let Some(masks) = &stage.fixity {
-        let drives = &ctx.state.control.drives;
-        let mut fix = col_mut::<NodeFixity>(nodes(&ctx.world));
-        for (f, &mask) in fix.iter_mut().zip(masks) {
-            *f = match f.driver() {
-                // A motion's nodes keep its axes and its name.
-                Some(k) => NodeFixity::driven(mask | drives[k].axes, k),
-                None => NodeFixity(mask),
-            };
-        }
+    if let Some(faces) = &stage.faces {
+        // A motion's nodes keep its axes and its name.
+        ctx.model.faces = faces.clone();
+        let fixity = ctx.model.node_fixity(&ctx.grid);
+        col_mut::<NodeFixity>(nodes(&ctx.world)).copy_from_slice(&fixity);
     }
     for (id, model) in &stage.materials {
         ctx.materials[*id as usize] = model.clone();

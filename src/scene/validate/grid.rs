@@ -3,6 +3,7 @@
 use super::rules::*;
 use crate::error::Refusal;
 use crate::error::SceneError;
+pub use crate::model::FaceHold;
 use crate::rigid::check_friction_angle;
 use crate::scene::spec::{pad3, BoundarySpec, Condition};
 use crate::shape::ShapeKind;
@@ -22,20 +23,6 @@ pub struct CheckedGrid {
     pub half_width: [f64; 3],
     /// The scene's face conditions.
     pub faces: Vec<FaceHold>,
-}
-
-/// One face condition, as the nodes on that face carry it.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct FaceHold {
-    /// The face's normal axis.
-    pub axis: usize,
-    /// The upper face (x = max) rather than the lower (x = origin).
-    pub upper: bool,
-    /// The held velocity components, one bit an axis (`NodeFixity`'s low bits): every axis
-    /// for `Fixed`, the normal one for `Roller` and `Friction`.
-    pub mask: u8,
-    /// tan δ of a `Friction` face.
-    pub friction: Option<f64>,
 }
 
 /// In an axisymmetric scene the lower x face is the axis, a symmetry face: a `Roller`

@@ -93,7 +93,7 @@ pub(crate) fn check_motion_boxes<D: Dim>(
         let (mut inside, mut loaded_nodes) = (0usize, 0usize);
         for (id, o) in owner.iter_mut().enumerate() {
             let x = D::vec_to3(grid.node_position(grid.node_ijk(id)));
-            if !crate::systems::prescribed_motion::in_box(m, x, D::N, grid.cell_size) {
+            if !m.holds_node(x, D::N, grid.cell_size) {
                 continue;
             }
             if let Some(j) = *o {
