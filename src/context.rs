@@ -75,7 +75,7 @@ impl<D: Dim> Context<D> {
         for e in old {
             self.world.despawn(e).expect("listed just now");
         }
-        spawn_nodes(&mut self.world, &self.grid, &self.model);
+        spawn_nodes::<D>(&mut self.world, self.model.node_fixity(&self.grid));
         self.state.active_nodes = NodeBox::default();
         self.slabs.invalidate();
     }
@@ -86,23 +86,7 @@ impl<D: Dim> Context<D> {
     /// cells to one above, [`Grid::reach`]), which hold the bands it shares
     /// ([`Decomposition::held_nodes`]); every node along the axis no split cuts.
     pub fn node_window(&self) -> NodeBox {
-        let d = &self.decomposition;
-        if d.ranks() == 1 {
-            return self.grid.whole().window();
-        }
-        if d.is_empty() {
-            // No cells: the grid then numbers one node ([`Grid::windowed`]).
-            return NodeBox::default();
-        }
-        let g = &self.grid;
-        let [slab, across] = [SLAB, ACROSS].map(|axis| {
-            let (cells, held) = (d.cells_along(axis), d.held_nodes(axis));
-            let (lo, hi) = (cells.start.saturating_sub(1), cells.end);
-            let layers = g.axes[[g.slab_axis, g.across_axis()][axis]].cells;
-            let reach = lo.saturating_sub(1)..(hi.min(layers - 1) + d.support);
-            reach.start.min(held.start)..reach.end.max(held.end)
-        });
-        g.split_box(slab, across)
+        node_window(&self.grid, &self.decomposition)
     }
 
     /// The node ids whose values this rank holds whole when the run has several ranks
@@ -117,11 +101,30 @@ impl<D: Dim> Context<D> {
     }
 }
 
-/// Spawns the nodes `grid` numbers into `world`, one archetype in id order, zero and held
-/// as `model` holds them ([`Model::node_fixity`]).
-pub fn spawn_nodes<D: Dim>(world: &mut World, grid: &Grid<D>, model: &Model) {
+/// The nodes of `grid` a rank with cells `d` holds ([`Context::node_window`]).
+pub fn node_window<D: Dim>(grid: &Grid<D>, d: &Decomposition) -> NodeBox {
+    if d.ranks() == 1 {
+        return grid.whole().window();
+    }
+    if d.is_empty() {
+        // No cells: the grid then numbers one node ([`Grid::windowed`]).
+        return NodeBox::default();
+    }
+    let [slab, across] = [SLAB, ACROSS].map(|axis| {
+        let (cells, held) = (d.cells_along(axis), d.held_nodes(axis));
+        let (lo, hi) = (cells.start.saturating_sub(1), cells.end);
+        let layers = grid.axes[[grid.slab_axis, grid.across_axis()][axis]].cells;
+        let reach = lo.saturating_sub(1)..(hi.min(layers - 1) + d.support);
+        reach.start.min(held.start)..reach.end.max(held.end)
+    });
+    grid.split_box(slab, across)
+}
+
+/// Spawns a grid's nodes into `world`, one archetype in id order, zero and held as
+/// `fixity` (one entry a node, [`Model::node_fixity`]) says.
+pub fn spawn_nodes<D: Dim>(world: &mut World, fixity: Vec<NodeFixity>) {
     let z = D::Vec::ZERO;
-    world.spawn_batch(model.node_fixity(grid).into_iter().map(|f| {
+    world.spawn_batch(fixity.into_iter().map(|f| {
         (
             NodeMass(0.0),
             NodeMomentum(z),

@@ -39,34 +39,10 @@ pub struct Model {
 }
 
 impl Model {
-    /// The held axes of every node `grid` numbers: the face conditions in force, and the
-    /// motions' nodes driven on their axes (a node in a motion's box keeps its face
-    /// conditions on the other axes: a footing on a symmetry plane keeps its roller).
-    /// Set-up, a stage's faces and a new window of a rank all take it from here.
+    /// The held axes of every node `grid` numbers under the face conditions in force and
+    /// the motions ([`node_fixity`]).
     pub fn node_fixity<D: Dim>(&self, grid: &Grid<D>) -> Vec<NodeFixity> {
-        let mut fixity = vec![NodeFixity(0); grid.node_count()];
-        for (id, f) in fixity.iter_mut().enumerate() {
-            let ijk = grid.node_ijk(id);
-            for face in &self.faces {
-                let layer = if face.upper { grid.axes[face.axis].cells } else { 0 };
-                if ijk[face.axis] == layer {
-                    f.0 |= face.mask;
-                    if face.friction.is_some() {
-                        f.0 |= NodeFixity::FRICTION;
-                    }
-                }
-            }
-            if self.motions.is_empty() {
-                continue;
-            }
-            let x = D::vec_to3(grid.node_position(ijk));
-            for (k, m) in self.motions.iter().enumerate() {
-                if m.holds_node(x, D::N, grid.cell_size) {
-                    *f = NodeFixity::driven(f.0 | m.drive().axes, k);
-                }
-            }
-        }
-        fixity
+        node_fixity(grid, &self.faces, &self.motions)
     }
 
     /// True when the scene asked for mass scaling (`solver.mass_scaling`).
@@ -91,6 +67,36 @@ impl Model {
             }
         }
     }
+}
+
+/// The held axes of every node `grid` numbers: the face conditions `faces`, and the nodes of
+/// `motions` driven on their axes (a node in a motion's box keeps its face conditions on the
+/// other axes: a footing on a symmetry plane keeps its roller). Set-up, a stage's faces and
+/// a new window of a rank all take it from here.
+pub fn node_fixity<D: Dim>(grid: &Grid<D>, faces: &[FaceHold], motions: &[MotionSpec]) -> Vec<NodeFixity> {
+    let mut fixity = vec![NodeFixity(0); grid.node_count()];
+    for (id, f) in fixity.iter_mut().enumerate() {
+        let ijk = grid.node_ijk(id);
+        for face in faces {
+            let layer = if face.upper { grid.axes[face.axis].cells } else { 0 };
+            if ijk[face.axis] == layer {
+                f.0 |= face.mask;
+                if face.friction.is_some() {
+                    f.0 |= NodeFixity::FRICTION;
+                }
+            }
+        }
+        if motions.is_empty() {
+            continue;
+        }
+        let x = D::vec_to3(grid.node_position(ijk));
+        for (k, m) in motions.iter().enumerate() {
+            if m.holds_node(x, D::N, grid.cell_size) {
+                *f = NodeFixity::driven(f.0 | m.drive().axes, k);
+            }
+        }
+    }
+    fixity
 }
 
 /// Gravity acting on all points (m/s²), applied at once or ramped linearly.

@@ -7,14 +7,14 @@ use super::region::{cell_span, region_bounds, region_contains, BodyPoint};
 use super::spec::{pad3, Dimension, Region, Scene, SolverSpec};
 use super::validate::{self, carried_state, Checked, CheckedGrid, CheckedStage, Derived};
 use crate::components::*;
-use crate::context::{spawn_nodes, Context};
+use crate::context::{node_window, spawn_nodes, Context};
 use crate::dim::{Dim, Dim2, Dim3, DimAxi, Vector};
 use crate::error::SceneError;
 use crate::grid::Grid;
 use crate::infra::columns::fill;
 use crate::infra::decomposition::{Decomposition, Split, ACROSS, SLAB};
 use crate::materials::{MaterialModel, MaterialState, StateVisitor};
-use crate::model::{Control, Gravity, LoadStage, Model, MotionSpec};
+use crate::model::{node_fixity, Control, Gravity, LoadStage, Model, MotionSpec};
 use crate::parallel::SlabCache;
 use crate::rigid::{RigidBody, Samples};
 use crate::shape::{for_each_node, Linear, QuadraticBSpline, ShapeKind, UniformGimp};
@@ -287,6 +287,11 @@ fn build_dim<D: Dim>(
     let grid = new_grid::<D>(&checked_grid);
     let mut world = World::new();
     let decomposition = split(s, &grid, part);
+    // A rank numbers and stores only the nodes its part holds; set-up places points on the
+    // whole grid.
+    let nodes = grid.windowed(node_window(&grid, &decomposition));
+    let fixity = node_fixity(&nodes, &checked_grid.faces, &s.motions);
+    spawn_nodes::<D>(&mut world, fixity);
     let keep = |x: [f64; 3]| decomposition.holds(grid.split_cell(D::vec_from(x)));
     let Bodies {
         ids: body_ids,
@@ -356,9 +361,9 @@ fn build_dim<D: Dim>(
     };
     let state = initial_state(s);
     let materials = table.into_iter().map(|(_, m)| m).collect();
-    let mut ctx = Context {
+    let ctx = Context {
         world,
-        grid,
+        grid: nodes,
         materials,
         numerics,
         model,
@@ -368,9 +373,6 @@ fn build_dim<D: Dim>(
         decomposition,
         exchanged: 0,
     };
-    // A rank numbers and stores only the nodes its part holds.
-    ctx.grid = ctx.grid.windowed(ctx.node_window());
-    spawn_nodes(&mut ctx.world, &ctx.grid, &ctx.model);
     Ok((
         Simulation {
             ctx,
