@@ -246,6 +246,11 @@ impl<D: Dim> Grid<D> {
     /// Id of node (i, j, k), which must be in the window.
     #[inline(always)]
     pub fn node_id(&self, ijk: [usize; 3]) -> usize {
+        debug_assert!(
+            self.numbers(ijk),
+            "node {ijk:?} outside the window {:?}",
+            self.window
+        );
         (ijk[0] * self.strides[0] + ijk[1] * self.strides[1] + ijk[2] * self.strides[2])
             .wrapping_sub(self.offset)
     }

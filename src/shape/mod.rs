@@ -292,7 +292,17 @@ pub fn for_each_row<D: Dim, S: Shape>(
     let sx = S::eval_1d(grid.grid_coordinate(x, 0), &grid.axes[0]);
     let sy = S::eval_1d(grid.grid_coordinate(x, 1), &grid.axes[1]);
     let [_, stride_y, stride_z] = grid.strides;
-    // Ids count from the grid's window (0 off a whole grid).
+    // Ids count from the grid's window (0 off a whole grid), which holds the stencil.
+    debug_assert!({
+        let sz = if D::N == 3 {
+            S::eval_1d(grid.grid_coordinate(x, 2), &grid.axes[2]).base
+        } else {
+            0
+        };
+        let last = |b: usize, a: usize| if a < D::N { b + S::SUPPORT - 1 } else { b };
+        grid.numbers([sx.base, sy.base, sz])
+            && grid.numbers([last(sx.base, 0), last(sy.base, 1), last(sz, 2)])
+    });
     let x_base = sx.base.wrapping_sub(grid.id_offset());
     if D::N == 2 {
         for j in 0..S::SUPPORT {
