@@ -36,6 +36,7 @@ pub mod point_loads;
 pub mod pore_pressure_field;
 pub mod prescribed_motion;
 pub mod remap;
+pub mod remap_contact;
 pub mod rigid_contact;
 pub mod rigid_control;
 pub mod shared;
@@ -63,6 +64,7 @@ pub use point_loads::PointLoads;
 pub use pore_pressure_field::PorePressureField;
 pub use prescribed_motion::PrescribedMotion;
 pub use remap::Remap;
+pub use remap_contact::RemapContact;
 pub use rigid_contact::RigidContact;
 pub use rigid_control::RigidControl;
 pub use spatial_sort::SpatialSort;
@@ -313,6 +315,10 @@ fn straining<D: Dim, S: Shape>() -> Vec<Entry<D>> {
                     "remap",
                     "MUSL strains and moves the points with the remapped velocity",
                 ),
+                (
+                    "remap_contact",
+                    "the points move with the remapped velocity the contacts hold",
+                ),
             ],
             "velocity gradient, position update",
             |_, _| Box::new(Kinematics::<D, S>::both()),
@@ -524,6 +530,17 @@ fn relaxing<D: Dim, S: Shape>() -> Vec<Entry<D>> {
             ],
             "MUSL: point velocities back to the grid",
             |_, _| Box::new(Remap::<D, S>::default()),
+        ),
+        e(
+            "remap_contact",
+            St::Remap,
+            Needed(
+                |n, m, _| n.scheme == Scheme::Musl && !m.bodies.is_empty(),
+                "the scheme is Musl and the scene has rigid bodies",
+            ),
+            &[("remap", "it holds the contacts on the remapped velocities")],
+            "MUSL: the rigid bodies' contacts held again on the remapped velocities",
+            |_, _| Box::new(RemapContact),
         ),
         e(
             "move_points",

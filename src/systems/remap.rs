@@ -13,8 +13,9 @@ use crate::shape::{for_each_node, Shape};
 use crate::systems::exchange::{exchange_again, MOMENTUM};
 use std::marker::PhantomData;
 
-/// p_i = Σ_p w_ip m_p v_p with the new v_p, then v_i = p_i/m_i with boundary conditions.
-/// After a kinetic-damping reset all v_p are zero, and so is the remapped field.
+/// p_i = Σ_p w_ip m_p v_p with the new v_p, then v_i = p_i/m_i with boundary conditions
+/// (the rigid bodies' contacts are held on it next, by `remap_contact`). After a
+/// kinetic-damping reset all v_p are zero, and so is the remapped field.
 #[derive(Debug)]
 pub struct Remap<D: Dim, S> {
     _marker: PhantomData<fn() -> (D, S)>,
@@ -76,17 +77,12 @@ impl<D: Dim, S: Shape> System<D> for Remap<D, S> {
         }
         exchange_again(ctx, MOMENTUM);
         velocity_from_momentum(ctx);
-        super::rigid_contact::project(ctx);
         Ok(())
     }
     fn traffic(&self, ctx: &Context<D>) -> Option<Traffic> {
         let (w, n) = (&ctx.world, ctx.state.active_nodes.len());
         if ctx.state.resets.this_step {
             return Some(Traffic::NONE.write_nodes::<NodeVelocity<D::Vec>>(n));
-        }
-        // The rigid bodies' second contact pass is not counted.
-        if !ctx.state.control.contacts.contacts.is_empty() {
-            return None;
         }
         let mut t = Traffic::NONE
             // Zeroed, then the scatter's sums.

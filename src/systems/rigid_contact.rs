@@ -30,7 +30,7 @@
 //! body applies it, to its external force (K_F counts it as applied load, W_ext its work).
 //! Σ f_c, in sample order, is the force the body exerts on the soil, summed per body and
 //! per part; the soil's resistance on the body is the opposite. MUSL maps the points' new
-//! velocities back to the grid (`remap`); [`project`] holds the same contacts there.
+//! velocities back to the grid (`remap`); `remap_contact` holds the same contacts there.
 
 use crate::components::*;
 use crate::context::Context;
@@ -38,7 +38,7 @@ use crate::dim::{Dim, Vector};
 use crate::error::StepError;
 use crate::grid::{Grid, NodeBox};
 use crate::infra::columns::{col, col_mut, nodes};
-use crate::rigid::contact::{key, remember, solve, Contact, Contacts, Memory, Slot};
+use crate::rigid::contact::{key, remember, solve, Contact, Contacts, Slot};
 use crate::rigid::{CornerTest, Corners, Located};
 use crate::schedule::System;
 use crate::shape::{for_each_node, Shape};
@@ -114,7 +114,7 @@ impl<D: Dim> Soil<'_, D> {
 /// The grid whose numbering names the contacts' nodes: this rank's own with one rank; over
 /// several the whole grid's, the same on every rank, since every rank places every contact
 /// (a rank's own grid numbers only the nodes it holds).
-fn naming<D: Dim>(ctx: &Context<D>) -> Grid<D> {
+pub(crate) fn naming<D: Dim>(ctx: &Context<D>) -> Grid<D> {
     if ctx.comm.size() == 1 {
         ctx.grid.clone()
     } else {
@@ -123,7 +123,7 @@ fn naming<D: Dim>(ctx: &Context<D>) -> Grid<D> {
 }
 
 /// This rank's id of node `i` of `naming`'s grid, `None` when the rank does not hold it.
-fn local_id<D: Dim>(ctx: &Context<D>, naming: &Grid<D>, i: usize) -> Option<usize> {
+pub(crate) fn local_id<D: Dim>(ctx: &Context<D>, naming: &Grid<D>, i: usize) -> Option<usize> {
     if ctx.comm.size() == 1 {
         Some(i)
     } else {
@@ -463,60 +463,5 @@ impl<D: Dim, S: Shape> System<D> for RigidContact<D, S> {
         }
         control.contacts = set;
         Ok(())
-    }
-}
-
-/// Holds this step's contacts on the nodal velocities built again from the points (MUSL's
-/// remap), each node's change weighted by its mass: the soil at each sample loses its
-/// velocity into the body and its slip as the interface's friction allows. The adhesion's
-/// impulse for the step, a·A_s·Δt, was spent in `rigid_contact`'s solve, the one whose
-/// impulses are the body's force: granted again here it held the soil with up to twice
-/// the adhesion, the second half counted nowhere (a block on an adhesive base never came
-/// to rest, K_F held at 1.2 %).
-pub fn project<D: Dim>(ctx: &mut Context<D>) {
-    if ctx.state.control.contacts.contacts.is_empty() {
-        return;
-    }
-    // Over several ranks each rank gives the slots' nodes it owns (mass, then velocity),
-    // and the sums make them whole on every rank: all solve the same contacts.
-    let (owned, held) = (ctx.owned_node_ids(), ctx.held_node_ids());
-    let naming = naming(ctx);
-    // Each slot's node as this rank numbers it, if it holds it.
-    let local: Vec<Option<usize>> = (ctx.state.control.contacts.slots.iter())
-        .map(|s| local_id(ctx, &naming, s.node))
-        .collect();
-    let n = nodes(&ctx.world);
-    let nm = col::<NodeMass>(n);
-    let mut nv = col_mut::<NodeVelocity<D::Vec>>(n);
-    let floor = ctx.numerics.virtual_mass_floor;
-    let control = &mut ctx.state.control;
-    let w = 1 + D::N;
-    let mut values = vec![0.0; control.contacts.slots.len() * w];
-    for (i, v) in local.iter().zip(values.chunks_mut(w)) {
-        if let Some(i) = i.filter(|i| owned.as_ref().is_none_or(|o| o.contains(i))) {
-            v[0] = nm[i].0;
-            (0..D::N).for_each(|a| v[1 + a] = nv[i].0.get(a));
-        }
-    }
-    ctx.comm.sum(&mut values);
-    for (s, v) in control.contacts.slots.iter_mut().zip(values.chunks(w)) {
-        s.v = std::array::from_fn(|a| if a < D::N { v[1 + a] } else { 0.0 });
-        s.v0 = s.v;
-        s.inertia = naming.inertia(s.node, v[0], floor);
-    }
-    let velocities: Vec<[f64; 3]> = control.bodies.iter().map(|b| b.velocity).collect();
-    for p in &mut control.contacts.contacts {
-        p.adhesion = 0.0;
-    }
-    solve(
-        &mut control.contacts,
-        &velocities,
-        &Memory::new(),
-        ctx.numerics.contact_tolerance,
-    );
-    for (s, i) in control.contacts.slots.iter().zip(&local) {
-        if let Some(i) = i.filter(|i| held.as_ref().is_none_or(|h| h.contains(i))) {
-            nv[i].0 = D::vec_from(s.v);
-        }
     }
 }
