@@ -104,7 +104,7 @@ impl<D: Dim> Context<D> {
 /// The nodes of `grid` a rank with cells `d` holds ([`Context::node_window`]).
 pub fn node_window<D: Dim>(grid: &Grid<D>, d: &Decomposition) -> NodeBox {
     if d.ranks() == 1 {
-        return grid.whole().window();
+        return grid.all_nodes();
     }
     if d.is_empty() {
         // No cells: the grid then numbers one node ([`Grid::windowed`]).

@@ -206,10 +206,15 @@ impl<D: Dim> Grid<D> {
 
     /// The same grid numbering every node (ids then name nodes alike on every rank).
     pub fn whole(&self) -> Self {
-        self.windowed(NodeBox {
+        self.windowed(self.all_nodes())
+    }
+
+    /// Every node of the grid, whatever the window.
+    pub fn all_nodes(&self) -> NodeBox {
+        NodeBox {
             lo: [0; 3],
             hi: self.nodes,
-        })
+        }
     }
 
     /// The nodes this grid numbers.
@@ -219,7 +224,7 @@ impl<D: Dim> Grid<D> {
 
     /// True when the grid numbers every node.
     pub fn is_whole(&self) -> bool {
-        self.window.lo == [0; 3] && self.window.hi == self.nodes
+        self.window == self.all_nodes()
     }
 
     /// True when node (i, j, k) is in the window.

@@ -303,7 +303,7 @@ impl Summary {
                 bytes_per_step: migrations[1] / (s.clock.step - s.ranks.first_step).max(1) as f64,
                 peak_memory_bytes: peaks.iter().map(|&p| p as u64).collect(),
                 nodes: nodes.iter().map(|&n| n as u64).collect(),
-                grid_nodes: sim.ctx.grid.whole().node_count() as u64,
+                grid_nodes: sim.ctx.grid.all_nodes().len() as u64,
             }
         });
         let rigid_bodies = body_results(sim);

@@ -158,11 +158,7 @@ fn region<D: Dim>(ctx: &Context<D>) -> NodeBox {
     if ctx.comm.size() == 1 {
         return ctx.state.active_nodes;
     }
-    let mut whole = NodeBox::default();
-    for a in 0..3 {
-        whole.hi[a] = if a < D::N { ctx.grid.nodes[a] } else { 1 };
-    }
-    whole
+    ctx.grid.all_nodes()
 }
 
 /// The soil's values at the nodes the contacts may reach (see [`Soil`]): over several
@@ -395,6 +391,7 @@ impl<D: Dim, S: Shape> System<D> for RigidContact<D, S> {
     fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
         // Over MPI: every force is mapped by now; the shared nodes get their whole sums.
         exchange(ctx, MASS | MOMENTUM | FORCE | EXTERNAL);
+        let naming = naming(ctx);
         let mut set = {
             let n = nodes(&ctx.world);
             let (nm, np, nf) = (
@@ -404,7 +401,6 @@ impl<D: Dim, S: Shape> System<D> for RigidContact<D, S> {
             );
             let fix = col::<NodeFixity>(n);
             self.strength.gather(ctx);
-            let naming = naming(ctx);
             let soil = soil::<D, S>(ctx, &naming, &nm, &np, &nf, &fix);
             place::<D, S>(ctx, &naming, &soil, &self.strength, &mut self.slot_of)
         };
@@ -423,7 +419,7 @@ impl<D: Dim, S: Shape> System<D> for RigidContact<D, S> {
         let mut nf = col_mut::<NodeForce<D::Vec>>(n);
         let mut ne = col_mut::<NodeExternalForce<D::Vec>>(n);
         // Every rank solved the same contacts; each changes the nodes it holds.
-        let (held, naming) = (ctx.held_node_ids(), naming(ctx));
+        let held = ctx.held_node_ids();
         for s in &set.slots {
             let Some(i) = local_id(ctx, &naming, s.node) else {
                 continue;
