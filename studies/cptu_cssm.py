@@ -31,7 +31,9 @@ Run: `python3 studies/cptu_cssm.py` prints the readings at R = 1 and 2 for the c
 `scenes/cptu_clay.ron`; `python3 studies/cptu_cssm.py R OUT [OUT ...]` sets the rows of
 each run's OUT/cpt.csv (a run of that scene with `preconsolidation=Ratio(R)`) against them,
 and with two runs whose cells halve (h, h/2, in that order) the first-order extrapolation
-2 X(h/2) - X(h) of the mean over the last four rows.
+2 X(h/2) - X(h) of the mean over the last four rows; with three (h, h/2, h/4) the order
+p = log2((X(h) - X(h/2))/(X(h/2) - X(h/4))) the three observe and the extrapolation
+X(h/4) + (X(h/4) - X(h/2))/(2^p - 1), where the two differences have one sign.
 """
 import csv
 import math
@@ -94,6 +96,24 @@ def main():
             f"extrapolated (2 X(h/2) - X(h)): N_kt {ext[0]:.2f} ({ext[0] / n_kt - 1:+.1%}), "
             f"N_du {ext[1]:.2f} ({ext[1] / n_du - 1:+.1%}), B_q {ext[2]:.2f}"
         )
+    if len(means) == 3:
+        for i, name, ref in ((0, "N_kt", n_kt), (1, "N_du", n_du), (2, "B_q", b_q)):
+            print(f"{name}: {three_cells(*(m[i] for m in means), ref)}")
+
+
+def three_cells(coarse, middle, fine, ref):
+    """The order three cells that halve observe and the limit they extrapolate to."""
+    d1, d2 = coarse - middle, middle - fine
+    if d1 == 0.0 or d2 == 0.0 or (d1 > 0.0) != (d2 > 0.0):
+        return f"{coarse:.2f}, {middle:.2f}, {fine:.2f}: not monotone, no order"
+    order = math.log2(d1 / d2)
+    if order <= 0.0:
+        return f"{coarse:.2f}, {middle:.2f}, {fine:.2f}: differences not shrinking (order {order:.2f})"
+    limit = fine + (fine - middle) / (2.0**order - 1.0)
+    return (
+        f"{coarse:.2f}, {middle:.2f}, {fine:.2f}: order {order:.2f}, "
+        f"extrapolated {limit:.2f} ({limit / ref - 1:+.1%} on SCE-CSSM)"
+    )
 
 
 if __name__ == "__main__":
