@@ -39,8 +39,8 @@
 //! A quadratic B-spline's velocity gradient varies within a cell, so with one volumetric
 //! strain rate a cell the in-cell variation of the normal strains goes into the points'
 //! deviators. Where the mean stress is small (a cohesionless soil under gravity, near its
-//! free surface) that deviator lies beyond the friction limit, the points yield every step
-//! and the soil creeps (docs/verification.md, "Why the cell means move the sand at rest").
+//! free surface) that deviator lies on the friction limit, the points yield, and on a coarse
+//! grid the soil creeps (docs/verification.md, "Why the cell means move the sand at rest").
 //!
 //! [`Material::admits`]: crate::materials::Material::admits
 
