@@ -34,6 +34,12 @@ and with two runs whose cells halve (h, h/2, in that order) the first-order extr
 2 X(h/2) - X(h) of the mean over the last four rows; with three (h, h/2, h/4) the order
 p = log2((X(h) - X(h/2))/(X(h/2) - X(h/4))) the three observe and the extrapolation
 X(h/4) + (X(h/4) - X(h/2))/(2^p - 1), where the two differences have one sign.
+`python3 studies/cptu_cssm.py --shoulder OUT H` reads the run's last points (points.vtu, or
+points_*.vtu over MPI ranks) about the cone's shoulder at the end of the push, h = H m: the
+pore pressure the scene's filter reads (within a cell of the shoulder's corner), that of
+the clay a cell thick beside the shaft at heights above the shoulder (a field u2 element
+sits on the shaft, its middle about 0.07 D above the shoulder) and on the face, and N_du
+and B_q of the shaft's reading at 0.07 D with the log's last q_t.
 """
 import csv
 import math
@@ -70,7 +76,46 @@ def logged(out):
     return rows
 
 
+def shoulder(out, h):
+    """The pore pressures about the cone's shoulder in the run's last points (see the
+    module's text), for scenes/cptu_clay.ron's cone: D = 1 m, the shoulder at (0.5, 14.0) m
+    at the start, moved down by the log's last travel."""
+    import glob
+
+    from cavity_mcc import vtu_arrays
+
+    names = sorted(glob.glob(f"{out}/points_*.vtu")) or [f"{out}/points.vtu"]
+    pts = []
+    for name in names:
+        a = vtu_arrays(name, {"points", "volume", "excess_pore_pressure"})
+        pts += [(x[0], x[1], v, u) for x, v, u in zip(a["points"], a["volume"], a["excess_pore_pressure"])]
+    with open(f"{out}/cpt.csv") as f:
+        last = list(csv.DictReader(f))[-1]
+    radius, z0 = 0.5, 14.0 - float(last["travel"])
+    apex = z0 - radius / math.tan(math.radians(30.0))
+
+    def mean(keep):
+        sel = [(v, u) for r, z, v, u in pts if keep(r, z)]
+        return sum(v * u for v, u in sel) / sum(v for v, _ in sel), len(sel)
+
+    u, n = mean(lambda r, z: math.hypot(r - radius, z - z0) <= h)
+    print(f"the filter at the shoulder's corner (within {h} m): {u / 1e3:.1f} kPa, {n} points")
+    for dz in (0.0, 0.035, 0.07, 0.14, 0.25, 0.5, 1.0):
+        u, n = mean(lambda r, z: radius < r < radius + h and abs(z - z0 - dz) < h / 2)
+        print(f"beside the shaft, {dz:5.3f} m above the shoulder: {u / 1e3:6.1f} kPa, {n} points")
+    for f in (0.25, 0.5, 0.75):
+        c = (radius * f, apex + (z0 - apex) * f)
+        u, n = mean(lambda r, z: math.hypot(r - c[0], z - c[1]) <= h)
+        print(f"the face, {f:.2f} of the way up: {u / 1e3:6.1f} kPa, {n} points")
+    u, _ = mean(lambda r, z: radius < r < radius + h and abs(z - z0 - 0.07) < h / 2)
+    net, s_u = float(last["q_t"]) - float(last["sigma_v0"]), float(last["s_u"])
+    print(f"beside the shaft at 0.07 D, depth {float(last['depth']):.2f} m: N_du {u / s_u:.2f}, B_q {u / net:.2f}")
+
+
 def main():
+    if len(sys.argv) == 4 and sys.argv[1] == "--shoulder":
+        shoulder(sys.argv[2], float(sys.argv[3]))
+        return
     if len(sys.argv) < 3:
         print("R  G at     s_u (kPa)  I_r    N_kt   N_du   B_q")
         for r_ocr in (1.0, 2.0):
