@@ -100,14 +100,15 @@ def shoulder(out, h):
 
     u, n = mean(lambda r, z: math.hypot(r - radius, z - z0) <= h)
     print(f"the filter at the shoulder's corner (within {h} m): {u / 1e3:.1f} kPa, {n} points")
+    shaft = {}
     for dz in (0.0, 0.035, 0.07, 0.14, 0.25, 0.5, 1.0):
-        u, n = mean(lambda r, z: radius < r < radius + h and abs(z - z0 - dz) < h / 2)
-        print(f"beside the shaft, {dz:5.3f} m above the shoulder: {u / 1e3:6.1f} kPa, {n} points")
+        shaft[dz], n = mean(lambda r, z: radius < r < radius + h and abs(z - z0 - dz) < h / 2)
+        print(f"beside the shaft, {dz:5.3f} m above the shoulder: {shaft[dz] / 1e3:6.1f} kPa, {n} points")
     for f in (0.25, 0.5, 0.75):
         c = (radius * f, apex + (z0 - apex) * f)
         u, n = mean(lambda r, z: math.hypot(r - c[0], z - c[1]) <= h)
         print(f"the face, {f:.2f} of the way up: {u / 1e3:6.1f} kPa, {n} points")
-    u, _ = mean(lambda r, z: radius < r < radius + h and abs(z - z0 - 0.07) < h / 2)
+    u = shaft[0.07]
     net, s_u = float(last["q_t"]) - float(last["sigma_v0"]), float(last["s_u"])
     print(f"beside the shaft at 0.07 D, depth {float(last['depth']):.2f} m: N_du {u / s_u:.2f}, B_q {u / net:.2f}")
 
