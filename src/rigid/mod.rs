@@ -367,7 +367,7 @@ impl RigidBodySpec {
                     ),
                 );
             }
-            f.check(n, |x| self.distance(x, n).0, size)
+            f.check(n, &self.parts, size)
                 .map_err(|r| r.under(&format!("filters[{k}]")))?;
         }
         if let Some(c) = &self.cpt {

@@ -249,10 +249,7 @@ impl<D: Dim> System<D> for RigidControl {
         let readings: Vec<Vec<Option<f64>>> = (self.bodies.iter().zip(&ctx.state.control.bodies))
             .map(|(spec, b)| {
                 (spec.filters.iter())
-                    .map(|f| {
-                        let x = std::array::from_fn(|a| f.at.get(a).copied().unwrap_or(0.0) + b.offset[a]);
-                        filter_reading(ctx, x)
-                    })
+                    .map(|f| filter_reading(ctx, spec, f.part(&spec.parts, D::N), f.place(), b.offset))
                     .collect()
             })
             .collect();
@@ -324,14 +321,25 @@ impl<D: Dim> System<D> for RigidControl {
     }
 }
 
-/// The pore pressure (Pa, compression positive) a filter at `x` (m, x y z) reads: the
-/// volume-weighted mean over the points within one cell of it of their water table's
-/// pressure and the excess an undrained material holds ([`crate::rigid::filter`]); `None`
-/// when no point lies that near. Over MPI ranks the sums of every rank.
-fn filter_reading<D: Dim>(ctx: &Context<D>, x: [f64; 3]) -> Option<f64> {
+/// The pore pressure (Pa, compression positive) a filter at `at` (m, x y z, in the
+/// starting frame of `body`, which has moved by `offset`) on the body's part `part` reads:
+/// the volume-weighted mean over the points within one cell of it whose nearest part of
+/// the body is `part`, of their water table's pressure and the excess an undrained
+/// material holds ([`crate::rigid::filter`]); `None` when no such point lies that near.
+/// Over MPI ranks the sums of every rank.
+fn filter_reading<D: Dim>(
+    ctx: &Context<D>,
+    body: &RigidBodySpec,
+    part: usize,
+    at: [f64; 3],
+    offset: [f64; 3],
+) -> Option<f64> {
     let mut read = Reading::<D> {
         ctx,
-        x,
+        body,
+        part,
+        at,
+        offset,
         sums: [0.0; 2],
     };
     for arch in points_with::<Volume>(&ctx.world) {
@@ -344,14 +352,19 @@ fn filter_reading<D: Dim>(ctx: &Context<D>, x: [f64; 3]) -> Option<f64> {
 /// A filter's reading, summed archetype by archetype.
 struct Reading<'a, D: Dim> {
     ctx: &'a Context<D>,
-    x: [f64; 3],
+    /// The body, its filter's part, the filter's place in the starting frame (m) and the
+    /// body's offset from it (m).
+    body: &'a RigidBodySpec,
+    part: usize,
+    at: [f64; 3],
+    offset: [f64; 3],
     /// Σ V u, Σ V.
     sums: [f64; 2],
 }
 
 impl<D: Dim> WithStates for Reading<'_, D> {
-    /// Adds the archetype's points within a cell of the filter; `states` their state column,
-    /// `None` for points without state (no excess pore pressure).
+    /// Adds the archetype's points within a cell of the filter beside its part; `states`
+    /// their state column, `None` for points without state (no excess pore pressure).
     fn with<T: MaterialState>(&mut self, arch: &hecs::Archetype, states: Option<&[T]>) {
         let (xg, vg, mg) = (
             col::<Position<D::Vec>>(arch),
@@ -362,8 +375,10 @@ impl<D: Dim> WithStates for Reading<'_, D> {
         let water = self.ctx.model.water.as_ref();
         for p in 0..xg.len() {
             let xp = D::vec_to3(xg[p].0);
-            let d2: f64 = (0..3).map(|a| (xp[a] - self.x[a]).powi(2)).sum();
-            if d2 > r2 {
+            // The point in the body's starting frame.
+            let x0: [f64; 3] = std::array::from_fn(|a| xp[a] - self.offset[a]);
+            let d2: f64 = (0..3).map(|a| (x0[a] - self.at[a]).powi(2)).sum();
+            if d2 > r2 || self.body.distance(x0, D::N).2 != self.part {
                 continue;
             }
             let hydrostatic = water.map_or(0.0, |w| w.pore_pressure(mg[p].0, xp));

@@ -957,21 +957,18 @@ fn a_second_penetrometer_log_in_one_scene_is_refused() {
     );
 }
 
-/// A wall held in a saturated sand whose water table is its top: a filter on the wall's
-/// face 2 m down reads the hydrostatic pressure of the points within a cell of it, which lie
-/// evenly above and below it: γ_w (2 m + s) with s the sand's settlement there under its
-/// buoyant weight, γ′ (4 · 2 − 2²/2) m²/M′ = 2.19 mm (γ′ = 9.81 kN/m³, M′ = 26.9 MPa):
-/// 19.641 kPa, as the row `wall.filter` of the curve; a filter above the sand reads none.
-#[test]
-fn a_filter_on_a_held_wall_reads_the_hydrostatic_pore_pressure() {
-    let scene = r#"Scene(
+/// A wall held in a saturated sand whose water table is its top (4 m; the sand from
+/// x = 1 m, 2 × 2 points a 0.25 m cell), its parts and filters as given.
+fn wall_in_water(parts: &str, filters: &str) -> String {
+    format!(
+        r#"Scene(
     dimension: 2,
     grid: (origin: [0.0, 0.0], cell_size: 0.25, cells: [16, 18]),
     shape: QuadraticBSpline,
-    materials: {
+    materials: {{
         "sand": MohrCoulomb(density: 1800.0, youngs_modulus: 2.0e7, poisson_ratio: 0.3,
             cohesion: 0.0, friction_angle: 30.0),
-    },
+    }},
     bodies: [(material: "sand", region: Box(min: [1.0, 0.0], max: [4.0, 4.0]), points_per_cell: [2, 2])],
     boundaries: [
         (face: XMin, condition: Roller),
@@ -979,18 +976,30 @@ fn a_filter_on_a_held_wall_reads_the_hydrostatic_pore_pressure() {
         (face: YMin, condition: Roller),
     ],
     gravity: (acceleration: [0.0, -9.81]),
-    water: (table: Level(4.0), saturated_density: {"sand": 2000.0}),
-    rigid_bodies: [
-        (
-            name: "wall",
-            parts: [(name: "stem", geometry: Polygon(vertices: [[0.5, 0.0], [1.0, 0.0], [1.0, 4.5], [0.5, 4.5]]))],
-            interface: Smooth,
-            filters: [(name: "filter", at: [1.0, 2.0]), (name: "dry", at: [1.0, 4.5])],
-        ),
-    ],
+    water: (table: Level(4.0), saturated_density: {{"sand": 2000.0}}),
+    rigid_bodies: [(name: "wall", parts: [{parts}], interface: Smooth, filters: [{filters}])],
     solver: (damping: Kinetic, time_step: Courant(0.5), tolerance: 1e-3, max_time: 10.0),
-)"#;
-    let s = common::run_text("filter", scene);
+)"#
+    )
+}
+
+/// The sand's settlement s (m) at height y (m) under its buoyant weight, in one-dimensional
+/// compression: γ′ (4 y − y²/2) / M′, γ′ = 9.81 kN/m³, M′ = E (1 − ν)/((1 + ν)(1 − 2ν)).
+fn settlement(y: f64) -> f64 {
+    let m = 2.0e7 * 0.7 / (1.3 * 0.4);
+    9.81e3 * (4.0 * y - 0.5 * y * y) / m
+}
+
+/// The held wall in its saturated sand: a filter on the wall's face 2 m down reads the
+/// hydrostatic pressure of the points within a cell of it, which lie evenly above and below
+/// it: γ_w (2 m + s) with s the sand's settlement there, 2.19 mm ([`settlement`]): 19.641
+/// kPa, as the row `wall.filter` of the curve; a filter above the sand reads none.
+#[test]
+fn a_filter_on_a_held_wall_reads_the_hydrostatic_pore_pressure() {
+    let stem =
+        r#"(name: "stem", geometry: Polygon(vertices: [[0.5, 0.0], [1.0, 0.0], [1.0, 4.5], [0.5, 4.5]]))"#;
+    let filters = r#"(name: "filter", at: [1.0, 2.0]), (name: "dry", at: [1.0, 4.5])"#;
+    let s = common::run_text("filter", &wall_in_water(stem, filters));
     assert!(s.converged, "{:?}", s.error);
     let rows: Vec<_> = s.curve.iter().filter(|c| c.name == "wall.filter").collect();
     assert_eq!(rows.len(), 1);
@@ -998,8 +1007,45 @@ fn a_filter_on_a_held_wall_reads_the_hydrostatic_pore_pressure() {
     eprintln!("u = {u} Pa");
     assert_eq!(rows[0].force, [0.0; 3]);
     assert!((u - 19_641.36).abs() < 0.01, "{u}");
+    assert!((u / (9.81e3 * (2.0 + settlement(2.0))) - 1.0).abs() < 1e-4, "{u}");
     // A filter with no soil within a cell of it (half a metre over the sand) reads nothing.
     let dry: Vec<_> = s.curve.iter().filter(|c| c.name == "wall.dry").collect();
     assert_eq!(dry.len(), 1);
     assert_eq!(dry[0].pressure, None);
+}
+
+/// The wall cut in two parts at 2 m, a filter on the upper part 0.1 m above the cut: it
+/// reads only the sand beside the upper part. Within a cell of it lie five such points
+/// (heights 2.0625, 2.0625, 2.1875, 2.1875, 2.3125 m at the start) and two beside the lower
+/// part (1.9375 m), which a cell-wide ball alone would add (18.679 kPa with the wall one part). Their
+/// hydrostatic pressure is γ_w (4 m − y + s(y)) ([`settlement`]): 18.049 kPa.
+#[test]
+fn a_filter_reads_only_the_soil_beside_its_own_part() {
+    let parts = r#"(name: "lower", geometry: Polygon(vertices: [[0.5, 0.0], [1.0, 0.0], [1.0, 2.0], [0.5, 2.0]])),
+        (name: "upper", geometry: Polygon(vertices: [[0.5, 2.0], [1.0, 2.0], [1.0, 4.5], [0.5, 4.5]]))"#;
+    let s = common::run_text(
+        "filter_side",
+        &wall_in_water(parts, r#"(name: "u", at: [1.0, 2.1])"#),
+    );
+    assert!(s.converged, "{:?}", s.error);
+    let rows: Vec<_> = s.curve.iter().filter(|c| c.name == "wall.u").collect();
+    assert_eq!(rows.len(), 1);
+    let u = rows[0].pressure.expect("a reading");
+    eprintln!("u = {u} Pa");
+    let heights = [2.0625, 2.0625, 2.1875, 2.1875, 2.3125];
+    let closed = 9.81e3 * heights.iter().map(|&y| 4.0 - y + settlement(y)).sum::<f64>() / 5.0;
+    assert!((u / closed - 1.0).abs() < 1e-4, "{u} against {closed}");
+    assert!((u - 18_048.32).abs() < 0.01, "{u}");
+}
+
+/// A filter where two parts meet would read the soil beside both: refused.
+#[test]
+fn a_filter_where_two_parts_meet_is_refused() {
+    let parts = r#"(name: "lower", geometry: Polygon(vertices: [[0.5, 0.0], [1.0, 0.0], [1.0, 2.0], [0.5, 2.0]])),
+        (name: "upper", geometry: Polygon(vertices: [[0.5, 2.0], [1.0, 2.0], [1.0, 4.5], [0.5, 4.5]]))"#;
+    let e = common::refusal(&wall_in_water(parts, r#"(name: "u", at: [1.0, 2.0])"#));
+    assert!(
+        e.contains("rigid_bodies[0].filters[0].at") && e.contains("[\"lower\", \"upper\"] meet"),
+        "{e}"
+    );
 }
