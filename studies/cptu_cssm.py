@@ -36,10 +36,11 @@ p = log2((X(h) - X(h/2))/(X(h/2) - X(h/4))) the three observe and the extrapolat
 X(h/4) + (X(h/4) - X(h/2))/(2^p - 1), where the two differences have one sign.
 `python3 studies/cptu_cssm.py --shoulder OUT H` reads the run's last points (points.vtu, or
 points_*.vtu over MPI ranks) about the cone's shoulder at the end of the push, h = H m: the
-pore pressure the scene's filter reads (within a cell of the shoulder's corner), that of
-the clay a cell thick beside the shaft at heights above the shoulder (a field u2 element
-sits on the shaft, its middle about 0.07 D above the shoulder) and on the face, and N_du
-and B_q of the shaft's reading at 0.07 D with the log's last q_t.
+pore pressure the scene's filter reads (the clay beside the sleeve within a cell of its
+place 0.07 D above the shoulder, where the middle of a field u2 element sits), that within a
+cell of the shoulder's corner on either side, that of the clay a cell thick beside the
+shaft at heights above the shoulder and on the face, and N_du and B_q of the filter's and
+of the shaft's reading at 0.07 D with the log's last q_t.
 """
 import csv
 import math
@@ -98,8 +99,24 @@ def shoulder(out, h):
         sel = [(v, u) for r, z, v, u in pts if keep(r, z)]
         return sum(v * u for v, u in sel) / sum(v for v, _ in sel), len(sel)
 
+    def segment(p, a, b):
+        t = ((p[0] - a[0]) * (b[0] - a[0]) + (p[1] - a[1]) * (b[1] - a[1])) / math.dist(a, b) ** 2
+        t = min(1.0, max(0.0, t))
+        return math.dist(p, (a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])))
+
+    def outside(p, poly):
+        return min(segment(p, a, b) for a, b in zip(poly, poly[1:] + poly[:1]))
+
+    tip = [(0.0, apex), (radius, z0), (0.0, z0)]
+    sleeve = [(0.0, z0), (radius, z0), (radius, z0 + 3.75), (0.0, z0 + 3.75)]
+    filt = z0 + 0.07
+    u, n = mean(
+        lambda r, z: math.hypot(r - radius, z - filt) <= h and outside((r, z), sleeve) < outside((r, z), tip)
+    )
+    u2 = u
+    print(f"the scene's filter, 0.07 m up the sleeve (within {h} m, beside the sleeve): {u / 1e3:.1f} kPa, {n} points")
     u, n = mean(lambda r, z: math.hypot(r - radius, z - z0) <= h)
-    print(f"the filter at the shoulder's corner (within {h} m): {u / 1e3:.1f} kPa, {n} points")
+    print(f"within {h} m of the shoulder's corner, either side: {u / 1e3:.1f} kPa, {n} points")
     shaft = {}
     for dz in (0.0, 0.035, 0.07, 0.14, 0.25, 0.5, 1.0):
         shaft[dz], n = mean(lambda r, z: radius < r < radius + h and abs(z - z0 - dz) < h / 2)
@@ -108,9 +125,9 @@ def shoulder(out, h):
         c = (radius * f, apex + (z0 - apex) * f)
         u, n = mean(lambda r, z: math.hypot(r - c[0], z - c[1]) <= h)
         print(f"the face, {f:.2f} of the way up: {u / 1e3:6.1f} kPa, {n} points")
-    u = shaft[0.07]
     net, s_u = float(last["q_t"]) - float(last["sigma_v0"]), float(last["s_u"])
-    print(f"beside the shaft at 0.07 D, depth {float(last['depth']):.2f} m: N_du {u / s_u:.2f}, B_q {u / net:.2f}")
+    for name, u in (("the scene's filter", u2), ("beside the shaft at 0.07 D", shaft[0.07])):
+        print(f"{name}, depth {float(last['depth']):.2f} m: N_du {u / s_u:.2f}, B_q {u / net:.2f}")
 
 
 def main():
