@@ -261,8 +261,7 @@ pub fn log_row(
     let at_apex = in_situ.at(apex + readings.travel)?;
     let u0 = match cpt.filter {
         Some(k) => {
-            let at = &body.filters[k].at;
-            let s = along(std::array::from_fn(|a| at.get(a).copied().unwrap_or(0.0)));
+            let s = along(body.filters[k].place());
             in_situ
                 .at(s + readings.travel)
                 .map_or(at_apex.pore_pressure, |g| g.pore_pressure)
