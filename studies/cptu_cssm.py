@@ -110,11 +110,10 @@ def shoulder(out, h):
     tip = [(0.0, apex), (radius, z0), (0.0, z0)]
     sleeve = [(0.0, z0), (radius, z0), (radius, z0 + 3.75), (0.0, z0 + 3.75)]
     filt = z0 + 0.07
-    u, n = mean(
+    u2, n = mean(
         lambda r, z: math.hypot(r - radius, z - filt) <= h and outside((r, z), sleeve) < outside((r, z), tip)
     )
-    u2 = u
-    print(f"the scene's filter, 0.07 m up the sleeve (within {h} m, beside the sleeve): {u / 1e3:.1f} kPa, {n} points")
+    print(f"the scene's filter, 0.07 m up the sleeve (within {h} m, beside the sleeve): {u2 / 1e3:.1f} kPa, {n} points")
     u, n = mean(lambda r, z: math.hypot(r - radius, z - z0) <= h)
     print(f"within {h} m of the shoulder's corner, either side: {u / 1e3:.1f} kPa, {n} points")
     shaft = {}

@@ -1014,6 +1014,10 @@ fn a_filter_on_a_held_wall_reads_the_hydrostatic_pore_pressure() {
     assert_eq!(dry[0].pressure, None);
 }
 
+/// The held wall cut in two parts at 2 m.
+const TWO_PARTS: &str = r#"(name: "lower", geometry: Polygon(vertices: [[0.5, 0.0], [1.0, 0.0], [1.0, 2.0], [0.5, 2.0]])),
+        (name: "upper", geometry: Polygon(vertices: [[0.5, 2.0], [1.0, 2.0], [1.0, 4.5], [0.5, 4.5]]))"#;
+
 /// The wall cut in two parts at 2 m, a filter on the upper part 0.1 m above the cut: it
 /// reads only the sand beside the upper part. Within a cell of it lie five such points
 /// (heights 2.0625, 2.0625, 2.1875, 2.1875, 2.3125 m at the start) and two beside the lower
@@ -1021,11 +1025,9 @@ fn a_filter_on_a_held_wall_reads_the_hydrostatic_pore_pressure() {
 /// hydrostatic pressure is γ_w (4 m − y + s(y)) ([`settlement`]): 18.049 kPa.
 #[test]
 fn a_filter_reads_only_the_soil_beside_its_own_part() {
-    let parts = r#"(name: "lower", geometry: Polygon(vertices: [[0.5, 0.0], [1.0, 0.0], [1.0, 2.0], [0.5, 2.0]])),
-        (name: "upper", geometry: Polygon(vertices: [[0.5, 2.0], [1.0, 2.0], [1.0, 4.5], [0.5, 4.5]]))"#;
     let s = common::run_text(
         "filter_side",
-        &wall_in_water(parts, r#"(name: "u", at: [1.0, 2.1])"#),
+        &wall_in_water(TWO_PARTS, r#"(name: "u", at: [1.0, 2.1])"#),
     );
     assert!(s.converged, "{:?}", s.error);
     let rows: Vec<_> = s.curve.iter().filter(|c| c.name == "wall.u").collect();
@@ -1041,9 +1043,7 @@ fn a_filter_reads_only_the_soil_beside_its_own_part() {
 /// A filter where two parts meet would read the soil beside both: refused.
 #[test]
 fn a_filter_where_two_parts_meet_is_refused() {
-    let parts = r#"(name: "lower", geometry: Polygon(vertices: [[0.5, 0.0], [1.0, 0.0], [1.0, 2.0], [0.5, 2.0]])),
-        (name: "upper", geometry: Polygon(vertices: [[0.5, 2.0], [1.0, 2.0], [1.0, 4.5], [0.5, 4.5]]))"#;
-    let e = common::refusal(&wall_in_water(parts, r#"(name: "u", at: [1.0, 2.0])"#));
+    let e = refusal(&wall_in_water(TWO_PARTS, r#"(name: "u", at: [1.0, 2.0])"#));
     assert!(
         e.contains("rigid_bodies[0].filters[0].at") && e.contains("[\"lower\", \"upper\"] meet"),
         "{e}"
