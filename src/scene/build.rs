@@ -3,7 +3,7 @@
 
 use super::initial_stress::{Ground, Layer};
 use super::loaded::LoadedScene;
-use super::region::{cell_span, region_bounds, region_contains, BodyPoint, Sector};
+use super::region::{cell_span, region_bounds, region_contains, BodyPoint};
 use super::spec::{pad3, Dimension, Region, Scene, SolverSpec};
 use super::validate::{self, carried_state, Checked, CheckedGrid, CheckedStage, Derived};
 use crate::components::*;
@@ -22,7 +22,6 @@ use crate::simulation::{AnySimulation, Simulation, TracedPoint};
 use crate::state::{Numerics, SolverState};
 use crate::systems::spatial_sort::sort_points;
 use crate::systems::{check_names, default_names, schedule_from_names, Needs};
-use either::Either;
 use hecs::{ColumnBatchBuilder, ColumnBatchType, Entity, World};
 
 /// Validates the scene and builds its simulation with its schedule (the default one for its
@@ -79,34 +78,14 @@ fn visit_support<D: Dim>(grid: &Grid<D>, shape: ShapeKind, x: D::Vec, mut f: imp
     }
 }
 
-/// The points filling `region` and each one's share of it (m³; m² in 2D and axisymmetry,
-/// where a point's volume is its area times its radius): the centres of equal sub-cells of
-/// every grid cell, or an annulus's rings ([`Sector::seeds`]); none in or on a rigid body.
-/// Generated on demand: a body of a million points is never held twice in memory.
+/// Positions of the points filling `region`: centres of equal sub-cells of every grid cell,
+/// generated on demand (a body of a million points is never held twice in memory).
 fn fill_points<'a, D: Dim>(
     grid: &Grid<D>,
     region: &'a Region,
     ppc: &[usize],
     rigid: &'a [crate::rigid::RigidBodySpec],
-) -> impl Iterator<Item = ([f64; 3], f64)> + Clone + 'a {
-    let n = D::N;
-    let h = grid.cell_size;
-    // A rigid body stands where it is put: no point has its centre in or on one.
-    let free = move |p: &([f64; 3], f64)| !rigid.iter().any(|b| b.distance(p.0, n).0 <= 0.0);
-    let points = match Sector::of(region) {
-        Some(sector) => Either::Left(sector.seeds(h, [ppc[0], ppc[1]])),
-        None => Either::Right(lattice(grid, region, ppc)),
-    };
-    points.filter(free)
-}
-
-/// The centres of equal sub-cells of every grid cell that lie inside `region`, each with
-/// its sub-cell's volume.
-fn lattice<'a, D: Dim>(
-    grid: &Grid<D>,
-    region: &'a Region,
-    ppc: &[usize],
-) -> impl Iterator<Item = ([f64; 3], f64)> + Clone + 'a {
+) -> impl Iterator<Item = [f64; 3]> + Clone + 'a {
     let n = D::N;
     let (lo, hi) = region_bounds(region, n);
     let mut range = [(0usize, 1usize); 3];
@@ -116,7 +95,6 @@ fn lattice<'a, D: Dim>(
     let sub = [ppc[0], ppc[1], if n == 3 { ppc[2] } else { 1 }];
     let o = D::vec_to3(grid.origin);
     let h = grid.cell_size;
-    let share = h.powi(n as i32) / sub.iter().product::<usize>() as f64;
     // Along each axis: cell index and sub-cell index, flattened.
     let along = move |a: usize| (range[a].0 * sub[a]..range[a].1 * sub[a]).map(move |q| (q, a));
     let coordinate = move |(q, a): (usize, usize)| {
@@ -127,7 +105,9 @@ fn lattice<'a, D: Dim>(
             along(0).filter_map(move |x| {
                 let z = if n == 3 { coordinate(z) } else { 0.0 };
                 let p = [coordinate(x), coordinate(y), z];
-                region_contains(region, p, n).then_some((p, share))
+                // A rigid body stands where it is put: no point has its centre in or on one.
+                let solid = rigid.iter().any(|b| b.distance(p, n).0 <= 0.0);
+                (region_contains(region, p, n) && !solid).then_some(p)
             })
         })
     })
@@ -553,7 +533,7 @@ fn split<D: Dim>(s: &Scene, grid: &Grid<D>, part: Option<RankPart>) -> Decomposi
         counts[ACROSS][c[ACROSS]] += 1;
     };
     for body in &s.bodies {
-        fill_points(grid, &body.region, &body.points_per_cell, &s.rigid_bodies).for_each(|(x, _)| count(x));
+        fill_points(grid, &body.region, &body.points_per_cell, &s.rigid_bodies).for_each(&mut count);
     }
     s.point_loads.iter().for_each(|l| count(pad3(&l.position)));
     Decomposition::balanced([&counts[SLAB], &counts[ACROSS]], split, rank, support)
@@ -572,7 +552,7 @@ fn every_point<'a, D: Dim>(
         .flat_map(move |(body, (b, ids))| {
             fill_points(grid, &b.region, &b.points_per_cell, &s.rigid_bodies)
                 .zip(ids.clone())
-                .map(move |((x, _), id)| BodyPoint { body, id, x })
+                .map(move |(x, id)| BodyPoint { body, id, x })
         })
 }
 
@@ -626,7 +606,7 @@ fn spawn_bodies<D: Dim>(
         // counted twice. Split the region or change one body's material instead.
         let earlier = &s.bodies[..b];
         let mut count = 0usize;
-        for (x, _) in points.clone() {
+        for x in points.clone() {
             if let Some(o) = earlier.iter().position(|e| region_contains(&e.region, x, n)) {
                 return Err(loaded.invalid(
                     &format!("bodies[{b}].region"),
@@ -705,8 +685,8 @@ struct Spawned {
     initial_energy: f64,
 }
 
-/// Spawns those of body `b`'s points `all` (positions, shares of the region as
-/// [`fill_points`] gives them, and ids from `first`, as many as `all.left`) at places `keep` takes, as one column batch of its material's columns.
+/// Spawns those of body `b`'s points `all` (positions and ids from `first`, as many as
+/// `all.left`) at places `keep` takes, as one column batch of its material's columns.
 #[allow(clippy::too_many_arguments)]
 fn spawn_body<D: Dim>(
     loaded: &LoadedScene,
@@ -715,11 +695,11 @@ fn spawn_body<D: Dim>(
     waters: &[(String, &crate::water::Water)],
     ground: &Ground,
     world: &mut World,
-    all: Counted<impl Iterator<Item = (([f64; 3], f64), u32)> + Clone>,
+    all: Counted<impl Iterator<Item = ([f64; 3], u32)> + Clone>,
     first: u32,
     keep: &dyn Fn([f64; 3]) -> bool,
 ) -> Result<Spawned, SceneError> {
-    let kept = all.clone().filter(|((x, _), _)| keep(*x));
+    let kept = all.clone().filter(|(x, _)| keep(*x));
     let xs = Counted {
         left: kept.clone().count(),
         inner: kept,
@@ -736,8 +716,9 @@ fn spawn_body<D: Dim>(
     let model = &table[mat].1;
     // The points carry the state of every model their material takes, from the start.
     let state = carried_state(loaded, table, &body.material).expect("validated");
+    let volume = cell_volume / body.points_per_cell.iter().product::<usize>() as f64;
     // In axisymmetry a point's volume is per radian: its area times its radius.
-    let vol_at = |(x, share): ([f64; 3], f64)| if D::AXISYMMETRIC { share * x[0] } else { share };
+    let vol_at = |x: [f64; 3]| if D::AXISYMMETRIC { volume * x[0] } else { volume };
     // Below its piezometric surface a point weighs its material's saturated density (by the
     // share of its height below the surface, for a point astride it).
     validate::check_saturated(
@@ -745,10 +726,10 @@ fn spawn_body<D: Dim>(
         waters,
         mat as u16,
         &body.material,
-        all.clone().map(|(p, _)| (p.0, vol_at(p))),
+        all.clone().map(|(x, _)| (x, vol_at(x))),
     )?;
-    let mass_at = |(x, share): ([f64; 3], f64)| {
-        let (v, rho) = (vol_at((x, share)), model.density());
+    let mass_at = |x: [f64; 3]| {
+        let (v, rho) = (vol_at(x), model.density());
         match waters.first() {
             Some((_, w)) => rho * v * w.density_factor(mat as u16, x, v),
             None => rho * v,
@@ -788,8 +769,8 @@ fn spawn_body<D: Dim>(
     }
     let batch = columns.into_batch(count as u32);
     fill(&batch, xs.clone().map(|(_, id)| PointId(id)));
-    fill(&batch, xs.clone().map(|((x, _), _)| Position(D::vec_from(x))));
-    fill(&batch, xs.clone().map(|((x, _), _)| WindowStart(D::vec_from(x))));
+    fill(&batch, xs.clone().map(|(x, _)| Position(D::vec_from(x))));
+    fill(&batch, xs.clone().map(|(x, _)| WindowStart(D::vec_from(x))));
     fill(&batch, std::iter::repeat_n(Velocity(z), count));
     let start = |x: [f64; 3]| match &body.initial_stress {
         Some(spec) => ground.stress(spec, mat as u16, x),
@@ -800,19 +781,19 @@ fn spawn_body<D: Dim>(
     // ν ≤ 0.42. The energy guard allows for it.
     let initial_energy = if body.initial_stress.is_some() {
         let m = model.p_wave_modulus();
-        all.map(|(point, _)| {
-            let (p, s) = start(point.0).mean_and_deviatoric_norm();
-            1.5 * (p * p + 1.5 * s * s) / m * vol_at(point)
+        all.map(|(x, _)| {
+            let (p, s) = start(x).mean_and_deviatoric_norm();
+            1.5 * (p * p + 1.5 * s * s) / m * vol_at(x)
         })
         .sum::<f64>()
     } else {
         0.0
     };
-    fill(&batch, xs.clone().map(|(p, _)| Mass(mass_at(p))));
-    fill(&batch, xs.clone().map(|(p, _)| Volume(vol_at(p))));
+    fill(&batch, xs.clone().map(|(x, _)| Mass(mass_at(x))));
+    fill(&batch, xs.clone().map(|(x, _)| Volume(vol_at(x))));
     fill(
         &batch,
-        xs.map(|((x, _), _)| Stress(<D::Stress as crate::tensor::StoredSym>::from_sym3(&start(x)))),
+        xs.map(|(x, _)| Stress(<D::Stress as crate::tensor::StoredSym>::from_sym3(&start(x)))),
     );
     fill(&batch, std::iter::repeat_n(VelocityGradient(D::MAT_ZERO), count));
     fill(&batch, std::iter::repeat_n(MaterialId(mat as u16), count));

@@ -19,7 +19,7 @@
 //! surface starts as if the body were not there.
 
 use crate::error::Refusal;
-use crate::scene::region::{region_contains, Sector};
+use crate::scene::region::region_contains;
 use crate::scene::spec::Region;
 use crate::tensor::Sym3;
 use crate::water::Water;
@@ -192,8 +192,6 @@ impl Ground<'_> {
                 at.sort_by(f64::total_cmp);
                 at.chunks_exact(2).map(|c| (c[0], c[1])).collect()
             }
-            // An annulus lies in the x-y plane of a 2D or axisymmetric scene: u is 0 or 1.
-            Region::Annulus { .. } => Sector::of(region).expect("an annulus").segments(u, x),
         }
     }
 }
@@ -262,25 +260,6 @@ mod tests {
         // At x = 4.5 the surface stands at 7.5 m: 6.5 m above a point at 1 m.
         assert!((g.stress(&spec, 0, [4.5, 1.0, 0.0]).yy + 130.0e3).abs() < 1e-6);
         assert!((g.stress(&spec, 0, [10.0, 1.0, 0.0]).yy + 80.0e3).abs() < 1e-6);
-    }
-
-    #[test]
-    fn under_an_arch_the_ground_above_is_the_annulus_s_height_there() {
-        // An arch of radii 1 and 2 m about (5, 0): at its crown 1 m thick.
-        let region = Region::Annulus {
-            centre: vec![5.0, 0.0],
-            radii: vec![1.0, 2.0],
-            angles: vec![0.0, 180.0],
-        };
-        let spec = InitialStress::Geostatic {
-            k0: 1.0,
-            surcharge: 0.0,
-        };
-        let g = ground(&region);
-        // 0.8 m above a point at 1.2 m in the crown; at x = 6.5, from √(4 − 1.5²) down.
-        assert!((g.stress(&spec, 0, [5.0, 1.2, 0.0]).yy + 16.0e3).abs() < 1e-6);
-        let top = (4.0f64 - 2.25).sqrt();
-        assert!((g.stress(&spec, 0, [6.5, 0.5, 0.0]).yy + 20.0e3 * (top - 0.5)).abs() < 1e-6);
     }
 
     #[test]

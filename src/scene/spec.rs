@@ -153,8 +153,7 @@ pub struct BodySpec {
     pub material: String,
     /// The region.
     pub region: Region,
-    /// Points per cell along each axis, ≥ 1 (placed at the centres of equal sub-cells; in
-    /// an `Annulus`, across and along its rings).
+    /// Points per cell along each axis, ≥ 1 (placed at the centres of equal sub-cells).
     pub points_per_cell: Vec<usize>,
     /// The stress the points start at: `Isotropic(p)` or `Geostatic(k0: …)`
     /// ([`InitialStress`]). Default: none.
@@ -180,20 +179,6 @@ pub enum Region {
         /// Extent `[z_min, z_max]` along z in 3D (m); ignored in 2D.
         #[serde(default)]
         z: Option<Vec<f64>>,
-    },
-    /// A sector of an annulus in the x-y plane (2D and axisymmetric scenes): the points
-    /// between the circles of `radii` about `centre`, from angle `angles[0]` to `angles[1]`
-    /// (degrees, anticlockwise from +x). It is filled in rings that follow its arcs, as many
-    /// rings across as `points_per_cell[0]` gives a cell and points along each ring about
-    /// `h / points_per_cell[1]` apart, each point with its own piece of the sector's area:
-    /// a cavity's or a pipe's wall carries no staircase of sub-cells.
-    Annulus {
-        /// Centre `[x, y]` (m).
-        centre: Vec<f64>,
-        /// Inner and outer radius `[r_in, r_out]` (m), 0 ≤ r_in < r_out.
-        radii: Vec<f64>,
-        /// First and last angle `[from, to]` (degrees), from < to ≤ from + 360.
-        angles: Vec<f64>,
     },
 }
 

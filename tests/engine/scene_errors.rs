@@ -256,20 +256,6 @@ fn inconsistent_scenes_are_rejected_with_the_reason() {
         &["bodies", "no body"],
     );
     rejects(
-        "annulus radii",
-        "region: Box(min: [0.0, 0.0], max: [10.0, 1.0])",
-        "region: Annulus(centre: [0.0, 0.0], radii: [1.0, 0.5], angles: [0.0, 90.0])",
-        9,
-        &["bodies[0].region.radii", "0 ≤ r_in < r_out"],
-    );
-    rejects(
-        "annulus angles",
-        "region: Box(min: [0.0, 0.0], max: [10.0, 1.0])",
-        "region: Annulus(centre: [0.0, 0.0], radii: [0.5, 1.0], angles: [90.0, 0.0])",
-        9,
-        &["bodies[0].region.angles", "from < to"],
-    );
-    rejects(
         "schedule",
         "tolerance: 0.01,",
         "tolerance: 0.01, schedule: [\"grid_reset\", \"p2g_fast\"],",

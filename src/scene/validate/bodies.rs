@@ -1,4 +1,4 @@
-//! The bodies: each region (box, polygon, annulus) inside the grid, its material and its points
+//! The bodies: each region (box, polygon) inside the grid, its material and its points
 //! per cell.
 
 use super::rules::*;
@@ -94,13 +94,6 @@ pub(super) fn check_bodies(r: &Rules) -> Result<(), SceneError> {
                     );
                 }
             }
-            Region::Annulus {
-                centre,
-                radii,
-                angles,
-            } => {
-                check_annulus(r, &format!("bodies[{b}].region"), centre, radii, angles)?;
-            }
         }
     }
     Ok(())
@@ -132,49 +125,6 @@ fn geostatic_gravity(r: &Rules, field: &str) -> Result<(), SceneError> {
                  in full from the first step (ramp_time 0)",
                 g.ramp_time
             ),
-        );
-    }
-    Ok(())
-}
-
-/// An annulus's sector: in the x-y plane of a 2D or axisymmetric scene, two entries each,
-/// 0 ≤ r_in < r_out, from < to ≤ from + 360°.
-fn check_annulus(
-    r: &Rules,
-    field: &str,
-    centre: &[f64],
-    radii: &[f64],
-    angles: &[f64],
-) -> Result<(), SceneError> {
-    if r.n == 3 {
-        return r.bad(
-            field,
-            "an annulus is a region of a 2D or axisymmetric scene; in 3D give a polygon with z".into(),
-        );
-    }
-    for (name, v, unit) in [
-        ("centre", centre, "m"),
-        ("radii", radii, "m"),
-        ("angles", angles, "°"),
-    ] {
-        if v.len() != 2 {
-            return r.bad(
-                &format!("{field}.{name}"),
-                format!("needs 2 entries, found {}", v.len()),
-            );
-        }
-        r.finite(&format!("{field}.{name}"), v, unit)?;
-    }
-    if !(non_negative(radii[0]) && radii[1] > radii[0]) {
-        return r.bad(
-            &format!("{field}.radii"),
-            format!("needs 0 ≤ r_in < r_out, found {radii:?}"),
-        );
-    }
-    if !(angles[1] > angles[0] && angles[1] - angles[0] <= 360.0) {
-        return r.bad(
-            &format!("{field}.angles"),
-            format!("needs from < to ≤ from + 360 (degrees), found {angles:?}"),
         );
     }
     Ok(())
