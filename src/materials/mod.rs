@@ -131,6 +131,13 @@ pub trait Material: Send + Sync {
     fn constant_strength(&self) -> Option<(f64, f64)> {
         None
     }
+    /// Why a point of this model may not start at `stress` (Pa, its stress column as set-up
+    /// gives it), or `None` where it may: a start outside the range the model was set for
+    /// (its stiffness past the time step's, a state with no physical meaning). Set-up
+    /// refuses such a start at the body's `initial_stress`.
+    fn start_fault(&self, _stress: &Sym3) -> Option<String> {
+        None
+    }
 }
 
 /// A material as a scene gives it: the serde struct is its schema.
@@ -343,6 +350,13 @@ macro_rules! define_materials {
             pub fn constant_strength(&self) -> Option<(f64, f64)> {
                 match self {
                     $(MaterialModel::$variant(m) => m.constant_strength(),)*
+                }
+            }
+
+            /// Why a point may not start at `stress` (see [`Material::start_fault`]).
+            pub fn start_fault(&self, stress: &Sym3) -> Option<String> {
+                match self {
+                    $(MaterialModel::$variant(m) => m.start_fault(stress),)*
                 }
             }
 

@@ -204,6 +204,19 @@ impl SceneMaterial for ModifiedCamClaySpec {
                 format!("must be > 0 Pa, found {}", self.max_mean_stress),
             );
         }
+        // The normal compression line v = N − λ ln(p′/1 kPa) leaves no voids (v = 1) at
+        // p′ = exp((N − 1)/λ) kPa: no clay the run reaches lies beyond it.
+        let no_voids = REFERENCE_PRESSURE * ((self.ncl_volume - 1.0) / self.lambda).exp();
+        if self.max_mean_stress >= no_voids {
+            return bad(
+                "max_mean_stress",
+                format!(
+                    "must stay below {no_voids:.4e} Pa, where the normal compression line \
+                     N − λ ln(p′/1 kPa) reaches v = 1 (a clay with no voids left), found {:e}",
+                    self.max_mean_stress
+                ),
+            );
+        }
         let fluid_bulk = match self.drainage {
             Drainage::Drained => 0.0,
             Drainage::Undrained { bulk_modulus }
@@ -514,6 +527,27 @@ impl Material for ModifiedCamClay {
         let gamma = self.ncl_volume - (self.lambda - self.kappa) * std::f64::consts::LN_2;
         let p_f = REFERENCE_PRESSURE * ((gamma - state.specific_volume) / self.lambda).exp();
         Some(0.5 * self.m * p_f)
+    }
+    /// A point may not start above `max_mean_stress`, the stiffness the time step is set
+    /// for, nor where the state its stress gives it has no voids (v ≤ 1: a preconsolidation
+    /// past where the normal compression line reaches v = 1).
+    fn start_fault(&self, stress: &Sym3) -> Option<String> {
+        let p = -stress.trace() / 3.0;
+        if p > self.max_mean_stress {
+            return Some(format!(
+                "the clay starts at p′ = {:.4e} Pa, above its max_mean_stress {:e} Pa, the \
+                 stiffness the time step is set for: raise max_mean_stress",
+                p, self.max_mean_stress
+            ));
+        }
+        let state = self.initial_state(stress);
+        (state.specific_volume <= 1.0).then(|| {
+            format!(
+                "the clay starts at p′ = {:.4e} Pa with p′_c = {:.4e} Pa, a specific volume of \
+                 {:.4} (v ≤ 1: no voids left): lower its preconsolidation",
+                p, state.preconsolidation, state.specific_volume
+            )
+        })
     }
     /// Undrained (water in the state): s_u on any plane, [`Material::undrained_strength`].
     /// Drained: the critical state's friction, sin φ_cs = 3M/(6 + M) (triaxial compression,

@@ -779,13 +779,23 @@ fn spawn_body<D: Dim>(
     // The strain energy of a start stress, p²/(2K) + q²/(6G) a unit volume, bounded by
     // 3(p² + q²)/(2M) from the P-wave modulus M: K ≥ M/3 for ν ≥ 0, and 6G ≥ 2M/3 for
     // ν ≤ 0.42. The energy guard allows for it.
+    // Every start stress is one the material may take (each rank checks every point, so
+    // all refuse alike).
     let initial_energy = if body.initial_stress.is_some() {
         let m = model.p_wave_modulus();
-        all.map(|(x, _)| {
-            let (p, s) = start(x).mean_and_deviatoric_norm();
-            1.5 * (p * p + 1.5 * s * s) / m * vol_at(x)
-        })
-        .sum::<f64>()
+        let mut energy = 0.0;
+        for (x, _) in all {
+            let stress = start(x);
+            if let Some(fault) = model.start_fault(&stress) {
+                return Err(loaded.invalid(
+                    &format!("bodies[{b}].initial_stress"),
+                    format!("{fault} (the point at {})", place(&x[..D::N])),
+                ));
+            }
+            let (p, s) = stress.mean_and_deviatoric_norm();
+            energy += 1.5 * (p * p + 1.5 * s * s) / m * vol_at(x);
+        }
+        energy
     } else {
         0.0
     };
@@ -925,4 +935,10 @@ fn find_traced<D: Dim>(
     }
 
     Ok(traced)
+}
+
+/// A place (m) as a message gives it: `[x, y] m` to a tenth of a millimetre.
+fn place(x: &[f64]) -> String {
+    let c: Vec<String> = x.iter().map(|c| format!("{c:.4}")).collect();
+    format!("[{}] m", c.join(", "))
 }

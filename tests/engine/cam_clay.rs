@@ -481,6 +481,44 @@ fn a_stage_clay_too_stiff_for_the_time_step_is_refused_at_its_stiffness_field() 
     assert!(err.contains("P-wave speed"), "{err}");
 }
 
+/// A clay the scene starts outside the range it was set for is refused at set-up with the
+/// field and the reason, not run: the cavity's clay (N = 3, λ = 0.25) has no voids left on
+/// its normal compression line past exp(8) kPa = 2.98 MPa; started above its
+/// `max_mean_stress` it would be stiffer than the time step was set for; and at 200 kPa
+/// with p′_c = 30 × 200 kPa its specific volume N − (λ − κ) ln 6 000 − κ ln 200 = 0.995.
+#[test]
+fn a_clay_started_outside_its_range_is_refused_with_the_reason() {
+    let refused = |sets: &[&str]| {
+        let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+        let loaded = LoadedScene::from_file(&scene("cavity_clay.ron"), &sets).expect("parses");
+        kdmpm::scene::build(&loaded).err().expect("refused").to_string()
+    };
+    let err = refused(&["materials.clay.max_mean_stress=3.0e6"]);
+    assert!(
+        err.contains("materials.clay.max_mean_stress")
+            && err.contains("2.9810e6 Pa")
+            && err.contains("v = 1"),
+        "{err}"
+    );
+    let err = refused(&["bodies[0].initial_stress=Some(Isotropic(2.0e6))"]);
+    assert!(
+        err.contains("bodies[0].initial_stress") && err.contains("above its max_mean_stress 1e6 Pa"),
+        "{err}"
+    );
+    let err = refused(&[
+        "bodies[0].initial_stress=Some(Isotropic(2.0e5))",
+        "materials.clay.preconsolidation=Ratio(30.0)",
+    ]);
+    assert!(
+        err.contains("bodies[0].initial_stress") && err.contains("specific volume of 0.9952"),
+        "{err}"
+    );
+    // The same clay set just inside the line, at 2.9 MPa, builds.
+    let sets = ["materials.clay.max_mean_stress=2.9e6".to_string()];
+    let loaded = LoadedScene::from_file(&scene("cavity_clay.ron"), &sets).expect("parses");
+    assert!(kdmpm::scene::build(&loaded).is_ok());
+}
+
 /// Undrained expansion of a cylindrical cavity (`scenes/cavity_clay.ron`) against Collins
 /// & Yu (1996, IJNAMG 20) as `studies/cavity_mcc.py` integrates it: on cells of 0.2 m
 /// (the scene's are 0.1 m) and three stages, the cavity's pressure at the expansion a/a0
