@@ -32,7 +32,8 @@ pub(super) fn place<D: Dim, I: Iterator<Item = BodyPoint>>(
             TractionSurface::Arc { centre, radius } => {
                 on_arc::<D>(every(), loaded, i, centre, *radius).map(Loaded::Arc)
             }
-            _ => outermost::<D>(every(), loaded, i).map(Loaded::Face),
+            _ => outermost::<D>(every(), loaded, i)
+                .and_then(|c| on_surface::<D>(every(), loaded, i, &c).map(|()| Loaded::Face(c))),
         })
         .collect::<Result<Vec<_>, _>>()?;
     let wanted: std::collections::BTreeSet<u32> = columns.iter().flat_map(Loaded::ids).collect();
@@ -233,6 +234,26 @@ fn on_arc<D: Dim>(
         return Err(loaded.invalid(
             &format!("tractions[{i}].min"),
             format!("traction \"{}\": no point of a body lies in its box", t.name),
+        ));
+    }
+    // The arc must be the bodies' face: a point beyond it by more than half a sub-cell (a
+    // polygon's chords sag inside their circle by less) and within a cell means it runs
+    // through the soil.
+    if let Some((p, rho, _)) = candidates.iter().find(|(_, rho, _)| {
+        let beyond = if hole { radius - rho } else { rho - radius };
+        beyond > 0.5 * sub && beyond <= s.grid.cell_size
+    }) {
+        let side = if hole { "inside" } else { "outside" };
+        return Err(loaded.invalid(
+            &format!("tractions[{i}].surface"),
+            format!(
+                "traction \"{}\" acts on a body's face, but its arc runs through the soil: the \
+                 point at {:?} lies {side} the circle, {:.4} m from it, where the points it \
+                 presses lie on the other side",
+                t.name,
+                &p.x[..D::N],
+                (rho - radius).abs()
+            ),
         ));
     }
     let pieces = ((radius * (hi - lo) / sub).round() as usize).max(2);
@@ -498,6 +519,47 @@ fn outermost<D: Dim>(
         ));
     }
     Ok(outermost)
+}
+
+/// Refuses traction `i` where a column's outermost point in its box ([`Columns`]) is not
+/// on the body's surface: a point of the bodies `every` lies beyond it in the same column,
+/// within a cell, outside the box (the box cut the body below its face, and the load would
+/// act inside the soil).
+fn on_surface<D: Dim>(
+    every: impl Iterator<Item = BodyPoint>,
+    loaded: &LoadedScene,
+    i: usize,
+    columns: &Columns,
+) -> Result<(), SceneError> {
+    let s = &loaded.scene;
+    let n = D::N;
+    let t = &s.tractions[i];
+    let (normal, upper) = t.surface.face().expect("a face").axis_side();
+    for q in every {
+        let x = q.x;
+        let ppc = &s.bodies[q.body].points_per_cell;
+        let key: Vec<i64> = (0..n)
+            .filter(|&a| a != normal)
+            .map(|a| (x[a] / (s.grid.cell_size / ppc[a] as f64)).floor() as i64)
+            .collect();
+        let Some((top, p, ..)) = columns.get(&key) else {
+            continue;
+        };
+        let beyond = if upper { x[normal] } else { -x[normal] } - top;
+        if beyond > 0.0 && beyond <= s.grid.cell_size {
+            return Err(loaded.invalid(
+                &format!("tractions[{i}].max"),
+                format!(
+                    "traction \"{}\" acts on a body's surface, but its box ends inside the body: \
+                     the point at {:?} has soil beyond it at {:?}; reach the box past the face",
+                    t.name,
+                    &p.x[..n],
+                    &x[..n]
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// A pressed column of a traction, as [`Column::surface_point`] reads it.

@@ -104,6 +104,23 @@ fn a_traction_whose_box_holds_no_point_is_refused() {
     assert!(e.contains("tractions[0].min") && e.contains("no point"), "{e}");
 }
 
+/// A traction acts on a body's face: a box that ends inside the body, whose outermost
+/// points have soil beyond them, is refused rather than loading the soil within.
+#[test]
+fn a_traction_whose_box_ends_inside_the_body_is_refused() {
+    let bad = COLUMN_2D.replace(
+        "min: [0.0, 3.5], max: [1.0, 4.0]",
+        "min: [0.0, 2.0], max: [1.0, 2.5]",
+    );
+    let e = refusal(&bad);
+    assert!(
+        e.contains("tractions[0].max")
+            && e.contains("ends inside the body")
+            && e.contains("[0.0625, 2.4375]"),
+        "{e}"
+    );
+}
+
 /// `scenes/footing_load.ron`: a uniform strip pressure on weightless Tresca clay
 /// (c = 10 kPa) raised by 5 kPa increments. Prandtl's (2 + π) c = 51.42 kPa: the settlement
 /// stays elastic-plastic (centimetres) below it and jumps by well over an order of
@@ -290,6 +307,16 @@ fn an_arc_is_loaded_by_a_pressure_in_stages_in_a_2d_scene() {
     let e = refusal(&sphere.replacen("pressure: 100.0e3)", "pressure: 100.0e3, increments: 4)", 1));
     assert!(
         e.contains("tractions[0].increments") && e.contains("stages"),
+        "{e}"
+    );
+    // An arc through the soil, not along its face.
+    let e = refusal(&sphere.replacen(
+        "radius: 1.0), min: [0.0, 0.0], max: [1.5, 1.5]",
+        "radius: 2.0), min: [0.0, 0.0], max: [2.5, 2.5]",
+        1,
+    ));
+    assert!(
+        e.contains("tractions[0].surface") && e.contains("runs through the soil"),
         "{e}"
     );
     let e = refusal(&sphere.replacen("radius: 1.0)", "radius: 0.0)", 1));
