@@ -576,6 +576,7 @@ impl WaterSpec {
             ));
         }
         let axis = frame.axis()?;
+        let water_density = self.unit_weight / frame.gravity.expect("gravity has an axis")[axis].abs();
         let mut wet_ratio = vec![1.0; frame.materials.len()];
         let mut saturated = vec![0.0; frame.materials.len()];
         for (name, &rho) in &self.saturated_density {
@@ -591,6 +592,17 @@ impl WaterSpec {
                 return Err(Refusal::new(
                     field,
                     format!("must be at least the material's dry density ({dry} kg/m³), found {rho}"),
+                ));
+            }
+            // ρ_sat = ρ_d + n ρ_w with a porosity n ≤ 1; ρ_w = γ_w/|g|.
+            let most = dry + water_density;
+            if rho > most {
+                return Err(Refusal::new(
+                    field,
+                    format!(
+                        "must be at most the dry density plus the water's, {dry} + {water_density} = \
+                         {most} kg/m³ (a soil holds at most its own volume of water), found {rho}"
+                    ),
                 ));
             }
             wet_ratio[m] = rho / dry;

@@ -74,6 +74,10 @@ fn water_that_cannot_be_modelled_is_refused() {
             "at least the material's dry density",
         ),
         (
+            r#"(table: Level(8.0), saturated_density: {"soil": 2900.0})"#,
+            "at most the dry density plus the water's, 1800 + 1000 = 2800 kg/m³",
+        ),
+        (
             r#"(table: Level(8.0), saturated_density: {"clay": 2000.0})"#,
             "no material \"clay\"",
         ),
