@@ -2,6 +2,7 @@
 //! and the schedule. Only what the scene uses is created.
 
 use super::initial_stress::{Ground, Layer};
+use super::loaded::place_text;
 use super::loaded::LoadedScene;
 use super::region::{cell_span, region_bounds, region_contains, BodyPoint};
 use super::spec::{pad3, Dimension, Region, Scene, SolverSpec};
@@ -778,9 +779,8 @@ fn spawn_body<D: Dim>(
     };
     // The strain energy of a start stress, p²/(2K) + q²/(6G) a unit volume, bounded by
     // 3(p² + q²)/(2M) from the P-wave modulus M: K ≥ M/3 for ν ≥ 0, and 6G ≥ 2M/3 for
-    // ν ≤ 0.42. The energy guard allows for it.
-    // Every start stress is one the material may take (each rank checks every point, so
-    // all refuse alike).
+    // ν ≤ 0.42. The energy guard allows for it. The same pass asks the material whether it
+    // may start at each stress (every rank asks of every point, so all refuse alike).
     let initial_energy = if body.initial_stress.is_some() {
         let m = model.p_wave_modulus();
         let mut energy = 0.0;
@@ -789,7 +789,7 @@ fn spawn_body<D: Dim>(
             if let Some(fault) = model.start_fault(&stress) {
                 return Err(loaded.invalid(
                     &format!("bodies[{b}].initial_stress"),
-                    format!("{fault} (the point at {})", place(&x[..D::N])),
+                    format!("{fault} (the point at {})", place_text(&x[..D::N])),
                 ));
             }
             let (p, s) = stress.mean_and_deviatoric_norm();
@@ -935,10 +935,4 @@ fn find_traced<D: Dim>(
     }
 
     Ok(traced)
-}
-
-/// A place (m) as a message gives it: `[x, y] m` to a tenth of a millimetre.
-fn place(x: &[f64]) -> String {
-    let c: Vec<String> = x.iter().map(|c| format!("{c:.4}")).collect();
-    format!("[{}] m", c.join(", "))
 }

@@ -158,3 +158,9 @@ impl LoadedScene {
         }
     }
 }
+
+/// A place (m) as a message gives it: `[x, y] m`, each to a tenth of a millimetre.
+pub(super) fn place_text(x: &[f64]) -> String {
+    let c: Vec<String> = x.iter().map(|c| format!("{c:.4}")).collect();
+    format!("[{}] m", c.join(", "))
+}

@@ -1,5 +1,6 @@
 //! Tractions: a distributed load on a body's surface, carried by the outermost points.
 
+use super::loaded::place_text;
 use super::loaded::LoadedScene;
 use super::region::BodyPoint;
 use super::spec::{TractionSpec, TractionSurface};
@@ -248,10 +249,10 @@ fn on_arc<D: Dim>(
             &format!("tractions[{i}].surface"),
             format!(
                 "traction \"{}\" acts on a body's face, but its arc runs through the soil: the \
-                 point at {:?} lies {side} the circle, {:.4} m from it, where the points it \
+                 point at {} lies {side} the circle, {:.4} m from it, where the points it \
                  presses lie on the other side",
                 t.name,
-                &p.x[..D::N],
+                place_text(&p.x[..D::N]),
                 (rho - radius).abs()
             ),
         ));
@@ -480,10 +481,7 @@ fn outermost<D: Dim>(
         }
         let ppc = &s.bodies[p.body].points_per_cell;
         let sub = |a: usize| s.grid.cell_size / ppc[a] as f64;
-        let key: Vec<i64> = (0..n)
-            .filter(|&a| a != normal)
-            .map(|a| (x[a] / sub(a)).floor() as i64)
-            .collect();
+        let key = column_key(x, n, normal, sub);
         // The column's share of the surface; per radian in axisymmetry, times the
         // surface's radius: the point's own on a face across the axis, the edge of its
         // sub-cell on a face normal to r.
@@ -538,28 +536,36 @@ fn on_surface<D: Dim>(
     for q in every {
         let x = q.x;
         let ppc = &s.bodies[q.body].points_per_cell;
-        let key: Vec<i64> = (0..n)
-            .filter(|&a| a != normal)
-            .map(|a| (x[a] / (s.grid.cell_size / ppc[a] as f64)).floor() as i64)
-            .collect();
+        let key = column_key(x, n, normal, |a| s.grid.cell_size / ppc[a] as f64);
         let Some((top, p, ..)) = columns.get(&key) else {
             continue;
         };
         let beyond = if upper { x[normal] } else { -x[normal] } - top;
         if beyond > 0.0 && beyond <= s.grid.cell_size {
+            // The box's bound on the face's side is the one that stops short of it.
+            let bound = if upper { "max" } else { "min" };
             return Err(loaded.invalid(
-                &format!("tractions[{i}].max"),
+                &format!("tractions[{i}].{bound}"),
                 format!(
                     "traction \"{}\" acts on a body's surface, but its box ends inside the body: \
-                     the point at {:?} has soil beyond it at {:?}; reach the box past the face",
+                     the point at {} has soil beyond it at {}; reach the box past the face",
                     t.name,
-                    &p.x[..n],
-                    &x[..n]
+                    place_text(&p.x[..n]),
+                    place_text(&x[..n])
                 ),
             ));
         }
     }
     Ok(())
+}
+
+/// The column of a face's points that `x` (m) lies in: its sub-cell index along each of
+/// the `n` axes but the face's `normal`, `sub(a)` the sub-cell's edge along axis a (m).
+fn column_key(x: [f64; 3], n: usize, normal: usize, sub: impl Fn(usize) -> f64) -> Vec<i64> {
+    (0..n)
+        .filter(|&a| a != normal)
+        .map(|a| (x[a] / sub(a)).floor() as i64)
+        .collect()
 }
 
 /// A pressed column of a traction, as [`Column::surface_point`] reads it.

@@ -116,7 +116,7 @@ fn a_traction_whose_box_ends_inside_the_body_is_refused() {
     assert!(
         e.contains("tractions[0].max")
             && e.contains("ends inside the body")
-            && e.contains("[0.0625, 2.4375]"),
+            && e.contains("[0.0625, 2.4375] m"),
         "{e}"
     );
 }
