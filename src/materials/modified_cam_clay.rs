@@ -532,7 +532,7 @@ impl Material for ModifiedCamClay {
     /// for, nor where the state its stress gives it has no voids (v ≤ 1: a preconsolidation
     /// past where the normal compression line reaches v = 1).
     fn start_fault(&self, stress: &Sym3) -> Option<String> {
-        let p = -stress.trace() / 3.0;
+        let (p, _, _) = invariants(stress);
         if p > self.max_mean_stress {
             return Some(format!(
                 "the clay starts at p′ = {:.4e} Pa, above its max_mean_stress {:e} Pa, the \

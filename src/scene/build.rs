@@ -2,8 +2,7 @@
 //! and the schedule. Only what the scene uses is created.
 
 use super::initial_stress::{Ground, Layer};
-use super::loaded::place_text;
-use super::loaded::LoadedScene;
+use super::loaded::{place_text, LoadedScene};
 use super::region::{cell_span, region_bounds, region_contains, BodyPoint};
 use super::spec::{pad3, Dimension, Region, Scene, SolverSpec};
 use super::validate::{self, carried_state, Checked, CheckedGrid, CheckedStage, Derived};
@@ -729,6 +728,15 @@ fn spawn_body<D: Dim>(
         &body.material,
         all.clone().map(|(x, _)| (x, vol_at(x))),
     )?;
+    let start = |x: [f64; 3]| match &body.initial_stress {
+        Some(spec) => ground.stress(spec, mat as u16, x),
+        None => crate::tensor::Sym3::ZERO,
+    };
+    let initial_energy = if body.initial_stress.is_some() {
+        start_energy::<D>(loaded, b, model, all.clone().map(|(x, _)| x), start, &vol_at)?
+    } else {
+        0.0
+    };
     let mass_at = |x: [f64; 3]| {
         let (v, rho) = (vol_at(x), model.density());
         match waters.first() {
@@ -773,32 +781,6 @@ fn spawn_body<D: Dim>(
     fill(&batch, xs.clone().map(|(x, _)| Position(D::vec_from(x))));
     fill(&batch, xs.clone().map(|(x, _)| WindowStart(D::vec_from(x))));
     fill(&batch, std::iter::repeat_n(Velocity(z), count));
-    let start = |x: [f64; 3]| match &body.initial_stress {
-        Some(spec) => ground.stress(spec, mat as u16, x),
-        None => crate::tensor::Sym3::ZERO,
-    };
-    // The strain energy of a start stress, p²/(2K) + q²/(6G) a unit volume, bounded by
-    // 3(p² + q²)/(2M) from the P-wave modulus M: K ≥ M/3 for ν ≥ 0, and 6G ≥ 2M/3 for
-    // ν ≤ 0.42. The energy guard allows for it. The same pass asks the material whether it
-    // may start at each stress (every rank asks of every point, so all refuse alike).
-    let initial_energy = if body.initial_stress.is_some() {
-        let m = model.p_wave_modulus();
-        let mut energy = 0.0;
-        for (x, _) in all {
-            let stress = start(x);
-            if let Some(fault) = model.start_fault(&stress) {
-                return Err(loaded.invalid(
-                    &format!("bodies[{b}].initial_stress"),
-                    format!("{fault} (the point at {})", place_text(&x[..D::N])),
-                ));
-            }
-            let (p, s) = stress.mean_and_deviatoric_norm();
-            energy += 1.5 * (p * p + 1.5 * s * s) / m * vol_at(x);
-        }
-        energy
-    } else {
-        0.0
-    };
     fill(&batch, xs.clone().map(|(x, _)| Mass(mass_at(x))));
     fill(&batch, xs.clone().map(|(x, _)| Volume(vol_at(x))));
     fill(
@@ -817,6 +799,35 @@ fn spawn_body<D: Dim>(
         full_node_mass: model.density() * cell_volume * radius,
         initial_energy,
     })
+}
+
+/// The strain energy body `b`'s points at places `xs` may give up from their start stresses
+/// `start(x)` (Pa), of volume `vol_at(x)` (J; J/m in 2D), refusing a start its `model` may
+/// not take (every rank asks of every point, so all refuse alike). A unit volume holds
+/// p²/(2K) + q²/(6G), bounded by 3(p² + q²)/(2M) from the P-wave modulus M: K ≥ M/3 for
+/// ν ≥ 0, and 6G ≥ 2M/3 for ν ≤ 0.42. The energy guard allows for it.
+fn start_energy<D: Dim>(
+    loaded: &LoadedScene,
+    b: usize,
+    model: &MaterialModel,
+    xs: impl Iterator<Item = [f64; 3]>,
+    start: impl Fn([f64; 3]) -> crate::tensor::Sym3,
+    vol_at: impl Fn([f64; 3]) -> f64,
+) -> Result<f64, SceneError> {
+    let m = model.p_wave_modulus();
+    let mut energy = 0.0;
+    for x in xs {
+        let stress = start(x);
+        if let Some(fault) = model.start_fault(&stress) {
+            return Err(loaded.invalid(
+                &format!("bodies[{b}].initial_stress"),
+                format!("{fault} (the point at {})", place_text(&x[..D::N])),
+            ));
+        }
+        let (p, s) = stress.mean_and_deviatoric_norm();
+        energy += 1.5 * (p * p + 1.5 * s * s) / m * vol_at(x);
+    }
+    Ok(energy)
 }
 
 /// Which nodes the points at places `xs` touch at the start.

@@ -1,7 +1,6 @@
 //! Tractions: a distributed load on a body's surface, carried by the outermost points.
 
-use super::loaded::place_text;
-use super::loaded::LoadedScene;
+use super::loaded::{place_text, LoadedScene};
 use super::region::BodyPoint;
 use super::spec::{TractionSpec, TractionSurface};
 use crate::components::*;
@@ -237,26 +236,7 @@ fn on_arc<D: Dim>(
             format!("traction \"{}\": no point of a body lies in its box", t.name),
         ));
     }
-    // The arc must be the bodies' face: a point beyond it by more than half a sub-cell (a
-    // polygon's chords sag inside their circle by less) and within a cell means it runs
-    // through the soil.
-    if let Some((p, rho, _)) = candidates.iter().find(|(_, rho, _)| {
-        let beyond = if hole { radius - rho } else { rho - radius };
-        beyond > 0.5 * sub && beyond <= s.grid.cell_size
-    }) {
-        let side = if hole { "inside" } else { "outside" };
-        return Err(loaded.invalid(
-            &format!("tractions[{i}].surface"),
-            format!(
-                "traction \"{}\" acts on a body's face, but its arc runs through the soil: the \
-                 point at {} lies {side} the circle, {:.4} m from it, where the points it \
-                 presses lie on the other side",
-                t.name,
-                place_text(&p.x[..D::N]),
-                (rho - radius).abs()
-            ),
-        ));
-    }
+    arc_on_face::<D>(loaded, i, &candidates, radius, hole, sub)?;
     let pieces = ((radius * (hi - lo) / sub).round() as usize).max(2);
     let width = (hi - lo) / pieces as f64;
     let mut nearest: Vec<Option<(f64, BodyPoint, f64)>> = vec![None; pieces];
@@ -336,6 +316,40 @@ fn on_arc<D: Dim>(
         ));
     }
     Ok(out)
+}
+
+/// Refuses traction `i`'s circle of `radius` (m) where it is not the bodies' face: one of
+/// the `candidates` (points in its box, with their radius and angle) lies on the far side
+/// of it from the pressed points (inside a `hole`'s wall, outside a disc's rim) by more
+/// than half a sub-cell `sub` (a polygon's chords sag inside their circle by less) and
+/// within a cell: the arc runs through the soil.
+fn arc_on_face<D: Dim>(
+    loaded: &LoadedScene,
+    i: usize,
+    candidates: &[(BodyPoint, f64, f64)],
+    radius: f64,
+    hole: bool,
+    sub: f64,
+) -> Result<(), SceneError> {
+    let cell = loaded.scene.grid.cell_size;
+    let Some((p, rho, _)) = candidates.iter().find(|(_, rho, _)| {
+        let beyond = if hole { radius - rho } else { rho - radius };
+        beyond > 0.5 * sub && beyond <= cell
+    }) else {
+        return Ok(());
+    };
+    let side = if hole { "inside" } else { "outside" };
+    Err(loaded.invalid(
+        &format!("tractions[{i}].surface"),
+        format!(
+            "traction \"{}\" acts on a body's face, but its arc runs through the soil: the \
+             point at {} lies {side} the circle, {:.4} m from it, where the points it presses \
+             lie on the other side",
+            loaded.scene.tractions[i].name,
+            place_text(&p.x[..D::N]),
+            (rho - radius).abs()
+        ),
+    ))
 }
 
 /// The points of the bodies `every` in traction `t`'s box with their radius and angle from
