@@ -3,6 +3,7 @@
 
 pub mod bodies;
 pub mod dir;
+pub mod field_sample;
 pub mod history;
 pub mod plots;
 pub mod progress;

@@ -5,6 +5,7 @@
 //! or a running output directory.
 
 use crate::output::dir::write_atomic;
+use crate::output::field_sample::FieldSample;
 use plotters::prelude::*;
 use std::io::Write;
 use std::path::Path;
@@ -58,82 +59,6 @@ impl History {
     }
 }
 
-/// Positions (m) and displacements (m) of every point, in file order.
-type PointField = (Vec<[f64; 3]>, Vec<[f64; 3]>);
-
-/// Positions and displacements of a run's final points: `points.vtu`, or over MPI ranks
-/// every piece `points.pvtu` names (each rank's points).
-fn read_run_field(dir: &Path) -> std::io::Result<PointField> {
-    let whole = dir.join("points.vtu");
-    let parallel = dir.join("points.pvtu");
-    if whole.exists() || !parallel.exists() {
-        return read_field(&whole);
-    }
-    let text = std::fs::read_to_string(&parallel)?;
-    let (mut x, mut u) = (Vec::new(), Vec::new());
-    for piece in text.split("Source=\"").skip(1) {
-        let name = piece.split('"').next().unwrap_or_default();
-        let (px, pu) = read_field(&dir.join(name))?;
-        x.extend(px);
-        u.extend(pu);
-    }
-    Ok((x, u))
-}
-
-/// Positions and displacements of the points of a `.vtu` this crate wrote.
-fn read_field(path: &Path) -> std::io::Result<PointField> {
-    let bytes = std::fs::read(path)?;
-    let bad = || {
-        std::io::Error::new(
-            std::io::ErrorKind::InvalidData,
-            format!("{} is not a points file of kdmpm", path.display()),
-        )
-    };
-    let open = b"<AppendedData encoding=\"raw\">";
-    let at = bytes
-        .windows(open.len())
-        .position(|w| w == open)
-        .ok_or_else(bad)?;
-    let head = std::str::from_utf8(&bytes[..at]).map_err(|_| bad())?;
-    let data_start = at
-        + open.len()
-        + bytes[at + open.len()..]
-            .iter()
-            .position(|&b| b == b'_')
-            .ok_or_else(bad)?
-        + 1;
-    let data = &bytes[data_start..];
-    let offset_of = |name: Option<&str>| -> Option<usize> {
-        let line = head.lines().find(|l| {
-            l.contains("<DataArray")
-                && match name {
-                    Some(n) => l.contains(&format!("Name=\"{n}\"")),
-                    None => !l.contains("Name="),
-                }
-        })?;
-        let start = line.find("offset=\"")? + 8;
-        line[start..start + line[start..].find('"')?].parse().ok()
-    };
-    let vectors = |offset: usize| -> Option<Vec<[f64; 3]>> {
-        let len = u64::from_le_bytes(data.get(offset..offset + 8)?.try_into().ok()?) as usize;
-        let raw = data.get(offset + 8..offset + 8 + len)?;
-        Some(
-            raw.chunks_exact(24)
-                .map(|c| {
-                    std::array::from_fn(|k| {
-                        f64::from_le_bytes(c[8 * k..8 * k + 8].try_into().unwrap_or([0; 8]))
-                    })
-                })
-                .collect(),
-        )
-    };
-    let x = offset_of(None).and_then(vectors).ok_or_else(bad)?;
-    let u = offset_of(Some("displacement"))
-        .and_then(vectors)
-        .unwrap_or_default();
-    Ok((x, u))
-}
-
 /// Draws the four figures of the run in `dir` next to its results. Returns the names
 /// written and, for a figure that could not be drawn, why (a run without `points.vtu` yet
 /// has no displacement field).
@@ -169,12 +94,12 @@ pub fn draw(dir: &Path) -> std::io::Result<(Vec<&'static str>, Vec<String>)> {
         save(FILES[2], traced_plot(&t, &traced))?;
         written.push(FILES[2]);
     }
-    match read_run_field(dir) {
-        Ok((x, u)) if !u.is_empty() => {
-            save(FILES[3], field(&x, &u))?;
+    match FieldSample::read_run(dir) {
+        Ok(Some(sample)) => {
+            save(FILES[3], field(&sample))?;
             written.push(FILES[3]);
         }
-        Ok(_) => skipped.push(format!("{}: the run keeps no displacements", FILES[3])),
+        Ok(None) => skipped.push(format!("{}: the run keeps no displacements", FILES[3])),
         Err(e) => skipped.push(format!("{}: {e}", FILES[3])),
     }
     if let Ok(curve) = History::read(&dir.join("curve.csv")) {
@@ -549,28 +474,13 @@ fn colour(s: f64) -> RGBColor {
     RGBColor(m(a.0, b.0), m(a.1, b.1), m(a.2, b.2))
 }
 
-/// Points drawn in the displacement field at most: beyond it every k-th point is drawn,
-/// so that a million-point run does not spend its end on a 90 MB picture.
-const FIELD_POINTS: usize = 50_000;
-
 /// The final points at their deformed positions (x, y), coloured by |u|, with a colour bar.
-fn field(x: &[[f64; 3]], u: &[[f64; 3]]) -> String {
-    let every = x.len().div_ceil(FIELD_POINTS).max(1);
+fn field(sample: &FieldSample) -> String {
+    let every = sample.every;
     svg((1100, 620), |root| {
         let (main, bar) = root.split_horizontally(980);
-        let mag: Vec<f64> = u
-            .iter()
-            .map(|u| (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt())
-            .collect();
-        let top = mag.iter().copied().fold(0.0f64, f64::max).max(1e-300);
-        let (mut xl, mut xh, mut yl, mut yh) =
-            (f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY);
-        for p in x {
-            xl = xl.min(p[0]);
-            xh = xh.max(p[0]);
-            yl = yl.min(p[1]);
-            yh = yh.max(p[1]);
-        }
+        let top = sample.top.max(1e-300);
+        let [xl, xh, yl, yh] = sample.bounds;
         let caption = if every > 1 {
             format!("Displacement magnitude |u| on the deformed points (one in {every} drawn)")
         } else {
@@ -600,10 +510,7 @@ fn field(x: &[[f64; 3]], u: &[[f64; 3]]) -> String {
             .disable_mesh()
             .draw()?;
         c.draw_series(
-            x.iter()
-                .zip(&mag)
-                .step_by(every)
-                .map(|(p, m)| Circle::new((p[0], p[1]), 2, colour(m / top).filled())),
+            (sample.drawn.iter()).map(|(p, m)| Circle::new((p[0], p[1]), 2, colour(m / top).filled())),
         )?;
         // The colour bar: |u| from 0 to its maximum.
         let mut b = ChartBuilder::on(&bar)
