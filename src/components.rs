@@ -51,7 +51,8 @@ pub struct PointId(pub u32);
 impl PointId {
     /// Puts `value` at this id's index of `list`, growing the list with `gap` as needed:
     /// lists indexed by id hold the points in id order whatever rows they are stored in.
-    /// Ids are dense (spawn order), so such a list is no longer than the point set.
+    /// A run's ids are dense (spawn order), so in one process such a list is no longer
+    /// than the point set; a rank holds some of them (see [`id_order`]).
     #[inline]
     pub fn place<T: Clone>(self, list: &mut Vec<T>, value: T, gap: T) {
         let i = self.0 as usize;
@@ -59,6 +60,36 @@ impl PointId {
             list.resize(i + 1, gap);
         }
         list[i] = value;
+    }
+}
+
+/// The rows of `ids` (the points' ids row by row, each id once) sorted by id, into
+/// `order`. Its memory follows the rows' count, not the ids' range: a rank of a run over
+/// MPI holds some of the run's ids, which start anywhere and, laid across two axes or
+/// after migrations, leave wide gaps. Ids spanning at most twice the rows are placed
+/// at their offset from the smallest (at most 8 B a row); sparser ones are sorted.
+pub fn id_order(ids: impl Iterator<Item = u32> + Clone, order: &mut Vec<u32>) {
+    order.clear();
+    let (n, lo, hi) = (ids.clone()).fold((0usize, u32::MAX, 0u32), |(n, lo, hi), id| {
+        (n + 1, lo.min(id), hi.max(id))
+    });
+    if n == 0 {
+        return;
+    }
+    let span = (hi - lo) as usize + 1;
+    if span <= 2 * n {
+        order.resize(span, u32::MAX);
+        for (row, id) in ids.enumerate() {
+            order[(id - lo) as usize] = row as u32;
+        }
+        order.retain(|&r| r != u32::MAX);
+    } else {
+        let mut keys: Vec<u64> = ids
+            .enumerate()
+            .map(|(row, id)| u64::from(id) << 32 | row as u64)
+            .collect();
+        keys.sort_unstable();
+        order.extend(keys.iter().map(|&k| k as u32));
     }
 }
 
@@ -166,4 +197,24 @@ macro_rules! point_components_and_states {
             $(, <<$spec as $crate::materials::SceneMaterial>::Model as $crate::materials::Material>::State)*
         )
     };
+}
+
+#[cfg(test)]
+mod tests {
+    use super::id_order;
+
+    fn sorted(ids: &[u32]) -> Vec<u32> {
+        let mut order = vec![7; 3];
+        id_order(ids.iter().copied(), &mut order);
+        order
+    }
+
+    #[test]
+    fn rows_come_in_id_order_whether_a_rank_holds_a_run_or_scattered_ids() {
+        assert_eq!(sorted(&[]), Vec::<u32>::new());
+        // A run of ids from far up, with a gap: placed at their offset.
+        assert_eq!(sorted(&[1_000_003, 1_000_000, 1_000_001]), [1, 2, 0]);
+        // Ids spread wider than twice the rows: sorted.
+        assert_eq!(sorted(&[4_000_000, 9, 2_000_000, 0]), [3, 1, 2, 0]);
+    }
 }

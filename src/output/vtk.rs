@@ -264,21 +264,21 @@ struct Columns<'a, D: Dim> {
 impl<'a, D: Dim> Columns<'a, D> {
     fn of(world: &'a World, water: Option<Water>) -> Self {
         let archs: Vec<&Archetype> = points_with::<Stress<D::Stress>>(world).collect();
-        // Where the point of each id is: archetype in the high half, row in the low half (the
-        // load carriers' ids are gaps).
-        let n = archs.iter().map(|a| a.len() as usize).sum::<usize>();
-        let mut at = Vec::with_capacity(n);
-        for (a, arch) in archs.iter().enumerate() {
-            for (r, id) in col::<PointId>(arch).iter().enumerate() {
-                id.place(&mut at, (a as u64) << 32 | r as u64, NONE);
-            }
+        // The points counted over the archetypes in turn, in id order.
+        let mut starts = vec![0usize];
+        for arch in &archs {
+            starts.push(starts.last().expect("starts at 0") + arch.len() as usize);
         }
+        let n = starts[archs.len()];
+        let mut rows = Vec::new();
+        let ids: Vec<_> = archs.iter().map(|a| col::<PointId>(a)).collect();
+        id_order(ids.iter().flat_map(|c| c.iter().map(|id| id.0)), &mut rows);
         // Displacements only when the scene keeps them (`output.displacements`).
         let displacements = n > 0 && archs.iter().all(|a| a.has::<Displacement<D::Vec>>());
         Columns {
             states: state_names(&archs),
             archs,
-            order: Order(at),
+            order: Order { rows, starts },
             n,
             displacements,
             water,
@@ -306,9 +306,7 @@ impl<D: Dim> Source for Columns<'_, D> {
             Field::Position => {
                 each::<Position<D::Vec>>(archs, order, out, |out, x| f64s(out, &D::vec_to3(x.0)))
             }
-            Field::Id => order
-                .points()
-                .try_for_each(|(id, _, _)| out.write_all(&(id as u32).to_le_bytes())),
+            Field::Id => each::<PointId>(archs, order, out, |out, id| out.write_all(&id.0.to_le_bytes())),
             Field::Material => each::<MaterialId>(archs, order, out, |out, m| {
                 out.write_all(&u32::from(m.0).to_le_bytes())
             }),
@@ -332,7 +330,7 @@ impl<D: Dim> Source for Columns<'_, D> {
                 let xs: Vec<_> = archs.iter().map(|a| col::<Position<D::Vec>>(a)).collect();
                 let ms: Vec<_> = archs.iter().map(|a| col::<MaterialId>(a)).collect();
                 let ss: Vec<_> = archs.iter().map(|a| col::<Stress<D::Stress>>(a)).collect();
-                order.points().try_for_each(|(_, a, r)| {
+                order.points().try_for_each(|(a, r)| {
                     let (x, m) = (D::vec_to3(xs[a][r].0), ms[a][r].0);
                     match field {
                         Field::PorePressure => f64s(out, &[w.pore_pressure(m, x)]),
@@ -351,7 +349,7 @@ impl<D: Dim> Source for Columns<'_, D> {
                     .collect();
                 order
                     .points()
-                    .try_for_each(|(_, a, r)| f64s(out, &[plastic[a][r]]))
+                    .try_for_each(|(a, r)| f64s(out, &[plastic[a][r]]))
             }
             Field::State(k) => {
                 let name = [self.states[k]];
@@ -366,7 +364,7 @@ impl<D: Dim> Source for Columns<'_, D> {
                     .collect();
                 order
                     .points()
-                    .try_for_each(|(_, a, r)| f64s(out, &[values[a][r]]))
+                    .try_for_each(|(a, r)| f64s(out, &[values[a][r]]))
             }
         }
     }
@@ -461,14 +459,8 @@ impl Frame {
     /// [`Frame::in_id_order`] into `sorted`'s buffers, which keep their capacity (fresh
     /// memory would cost a page fault every 4 KiB).
     pub fn sort_into(&self, sorted: &mut Frame) {
-        // Ids are dense (spawn order, load carriers' ids left out): place each row at its
-        // id, then drop the gaps.
         let mut order = std::mem::take(&mut sorted.id);
-        order.clear();
-        for (row, &id) in self.id.iter().enumerate() {
-            PointId(id).place(&mut order, row as u32, u32::MAX);
-        }
-        order.retain(|&r| r != u32::MAX);
+        id_order(self.id.iter().copied(), &mut order);
         (sorted.step, sorted.time, sorted.water) = (self.step, self.time, self.water.clone());
         permute(&self.material, &order, &mut sorted.material);
         permute(&self.position, &order, &mut sorted.position);
@@ -717,20 +709,22 @@ fn f64s(out: &mut BufWriter<File>, values: &[f64]) -> std::io::Result<()> {
     Ok(())
 }
 
-/// No point has this id.
-const NONE: u64 = u64::MAX;
-
-/// Archetype and row of the point of each id (`NONE` where no point has it).
-struct Order(Vec<u64>);
+/// The points in id order, each counted over the archetypes in turn.
+struct Order {
+    /// The points' counts over the archetypes, in id order.
+    rows: Vec<u32>,
+    /// Where each archetype's points start in that count (and the total last).
+    starts: Vec<usize>,
+}
 
 impl Order {
-    /// (id, archetype, row) of every point, in id order.
-    fn points(&self) -> impl Iterator<Item = (usize, usize, usize)> + '_ {
-        self.0
-            .iter()
-            .enumerate()
-            .filter(|(_, &at)| at != NONE)
-            .map(|(id, &at)| (id, (at >> 32) as usize, (at & 0xFFFF_FFFF) as usize))
+    /// (archetype, row) of every point, in id order.
+    fn points(&self) -> impl Iterator<Item = (usize, usize)> + '_ {
+        self.rows.iter().map(|&k| {
+            let k = k as usize;
+            let a = self.starts.partition_point(|&s| s <= k) - 1;
+            (a, k - self.starts[a])
+        })
     }
 }
 
@@ -742,7 +736,7 @@ fn each<T: Component>(
     mut field: impl FnMut(&mut BufWriter<File>, &T) -> std::io::Result<()>,
 ) -> std::io::Result<()> {
     let columns: Vec<_> = archs.iter().map(|a| col::<T>(a)).collect();
-    for (_, a, r) in order.points() {
+    for (a, r) in order.points() {
         field(out, &columns[a][r])?;
     }
     Ok(())
