@@ -347,9 +347,7 @@ impl<D: Dim> Source for Columns<'_, D> {
                         e
                     })
                     .collect();
-                order
-                    .points()
-                    .try_for_each(|(a, r)| f64s(out, &[plastic[a][r]]))
+                order.points().try_for_each(|(a, r)| f64s(out, &[plastic[a][r]]))
             }
             Field::State(k) => {
                 let name = [self.states[k]];
@@ -362,9 +360,7 @@ impl<D: Dim> Source for Columns<'_, D> {
                         v
                     })
                     .collect();
-                order
-                    .points()
-                    .try_for_each(|(a, r)| f64s(out, &[values[a][r]]))
+                order.points().try_for_each(|(a, r)| f64s(out, &[values[a][r]]))
             }
         }
     }

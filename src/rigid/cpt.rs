@@ -24,7 +24,7 @@
 //! where a quantity is undefined: no s_u, q_t at or below σ_v0) and `cpt.svg` draws q_t,
 //! f_s and u2 against depth ([`crate::output::plots`]).
 
-use super::RigidBodySpec;
+use super::{Geometry, RigidBodySpec};
 use crate::error::Refusal;
 use serde::{Deserialize, Serialize};
 
@@ -108,6 +108,81 @@ impl CptSpec {
         };
         Ok(Cpt { tip, sleeve, filter })
     }
+}
+
+impl Cpt {
+    /// In an axisymmetric scene (the body pushed along the axis, forces per radian), the
+    /// `area` of the tip and of the sleeve against their shapes: the tip's projected area
+    /// ∫ r dr over the radii it spans, (r₁² − r₀²)/2, and the sleeve's lateral area ∫ r ds
+    /// over its edges that do not lie across the axis (its ends meet the tip and the
+    /// shaft). An area more than 1 % from its shape's would scale q_t or f_s by the ratio;
+    /// the field is the part's `area`. Elsewhere the areas are the scene's to give.
+    pub fn check_areas(&self, body: &RigidBodySpec) -> Result<(), Refusal> {
+        let checks = [
+            (
+                Some(self.tip),
+                "the tip's area is its projected area across the axis, ∫ r dr",
+                "q_t is the tip's force over it",
+                tip_area as fn(&Geometry) -> Option<(f64, String)>,
+            ),
+            (
+                self.sleeve,
+                "the sleeve's area is its lateral area, ∫ r ds",
+                "f_s is the sleeve's force over it",
+                sleeve_area,
+            ),
+        ];
+        for (k, what, why, of) in checks {
+            let Some(k) = k else { continue };
+            let part = &body.parts[k];
+            let (Some(given), Some((area, how))) = (part.area, of(&part.geometry)) else {
+                continue;
+            };
+            if (given - area).abs() > 0.01 * area {
+                return Err(Refusal::new(
+                    format!("parts[{k}].area"),
+                    format!(
+                        "{what} {how}, {area:.4e} m² per radian, found {given:e} (more than 1 % \
+                         off): {why}"
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// (r₁² − r₀²)/2 over the radii [r₀, r₁] a section spans (m² per radian), and how.
+fn tip_area(g: &Geometry) -> Option<(f64, String)> {
+    let (lo, hi) = g.bounds(2);
+    let (r0, r1) = (lo[0].max(0.0), hi[0]);
+    Some((0.5 * (r1 * r1 - r0 * r0), format!("over r = {r0} to {r1} m")))
+}
+
+/// ∫ r ds along a section's edges that do not lie across the axis (m² per radian), and
+/// how; none for a circle, whose section has no ends.
+fn sleeve_area(g: &Geometry) -> Option<(f64, String)> {
+    let corners: Vec<[f64; 2]> = match g {
+        Geometry::Polygon { vertices } => vertices.iter().map(|v| [v[0], v[1]]).collect(),
+        Geometry::Box { min, max } => vec![
+            [min[0], min[1]],
+            [max[0], min[1]],
+            [max[0], max[1]],
+            [min[0], max[1]],
+        ],
+        _ => return None,
+    };
+    let (lo, hi) = g.bounds(2);
+    let size = (hi[0] - lo[0]).max(hi[1] - lo[1]);
+    let mut area = 0.0;
+    for (k, a) in corners.iter().enumerate() {
+        let b = corners[(k + 1) % corners.len()];
+        let (dr, dz) = (b[0] - a[0], b[1] - a[1]);
+        if dz.abs() > 1e-9 * size {
+            area += (dr * dr + dz * dz).sqrt() * 0.5 * (a[0] + b[0]);
+        }
+    }
+    Some((area, "along its edges but its ends".to_string()))
 }
 
 /// Volume-weighted sums over one slice of the ground: Σ V, Σ V σ_v0, Σ V u0, and over the

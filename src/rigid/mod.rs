@@ -371,7 +371,10 @@ impl RigidBodySpec {
                 .map_err(|r| r.under(&format!("filters[{k}]")))?;
         }
         if let Some(c) = &self.cpt {
-            c.check(self).map_err(|r| r.under("cpt"))?;
+            let cpt = c.check(self).map_err(|r| r.under("cpt"))?;
+            if axisymmetric {
+                cpt.check_areas(self)?;
+            }
         }
         self.check_interface_and_motion(n, axisymmetric)
     }

@@ -240,6 +240,36 @@ fn axisymmetric_scenes_that_cannot_be_are_refused() {
     }
 }
 
+/// A piezocone's q_t and f_s are the tip's and the sleeve's forces over their areas: an
+/// area more than 1 % from the part's shape (the tip's ∫ r dr, the sleeve's ∫ r ds) is
+/// refused at the part's `area`, with the shape's figure; 0.4 % off is taken.
+#[test]
+fn a_piezocone_part_whose_area_is_not_its_shapes_is_refused() {
+    let text = std::fs::read_to_string(common::scene("cptu_clay.ron")).unwrap();
+    for (from, to, field, figure) in [
+        (
+            "area: 0.125,",
+            "area: 0.5,",
+            "rigid_bodies[0].parts[0].area",
+            "1.2500e-1 m² per radian",
+        ),
+        (
+            "area: 1.875,",
+            "area: 1.9,",
+            "rigid_bodies[0].parts[1].area",
+            "1.8750e0 m² per radian",
+        ),
+    ] {
+        let changed = text.replacen(from, to, 1);
+        assert_ne!(changed, text, "{from}");
+        let e = refusal(&changed);
+        assert!(e.contains(field) && e.contains(figure), "{to}: {e}");
+    }
+    let near = text.replacen("area: 1.875,", "area: 1.882,", 1);
+    let loaded = LoadedScene::from_text(std::path::Path::new("near.ron"), &near, &[]).expect("parses");
+    assert!(kdmpm::scene::build(&loaded).is_ok());
+}
+
 /// `scenes/cpt.ron` and `scenes/pile_jacking.ron` (the same grid and clay) at h = D/4,
 /// the surcharge on the top layer of points, and `travel`.
 fn at_d4(travel: &str) -> [&str; 4] {
