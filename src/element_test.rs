@@ -65,6 +65,13 @@ pub struct Row {
 pub enum ElementError {
     /// A setting of the test breaks a rule: the setting and the rule.
     Input(&'static str, String),
+    /// The sample reached a state with no physical meaning ([`MaterialState::fault`]).
+    NoState {
+        /// The increment (from 1).
+        step: usize,
+        /// Why.
+        why: String,
+    },
     /// The drained increment found no radial strain that holds the cell pressure.
     NoBalance {
         /// The increment (from 1).
@@ -78,6 +85,10 @@ impl fmt::Display for ElementError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             ElementError::Input(field, rule) => write!(f, "{field}: {rule}"),
+            ElementError::NoState { step, why } => write!(
+                f,
+                "increment {step}: the sample reached {why}: the material has no state there"
+            ),
             ElementError::NoBalance { step, residual } => write!(
                 f,
                 "increment {step}: no radial strain holds the cell pressure (off by {residual:e} \
@@ -198,6 +209,12 @@ fn run<S: MaterialState>(
     let mut state = S::default();
     // A zero increment starts a state that is set from the first stress.
     model.update(&mut stress, &Sym3::ZERO, &mut state);
+    if let Some(why) = state.fault() {
+        return Err(ElementError::Input(
+            "cell_pressure",
+            format!("the sample starts at {p0:e} Pa with {why}"),
+        ));
+    }
     let de_a = test.axial_strain / test.steps as f64;
     let (mut ea, mut ev) = (0.0, 0.0);
     let mut rows = vec![row(test, &stress, &state, ea, ev)];
@@ -223,6 +240,9 @@ fn run<S: MaterialState>(
         ea += de_a;
         ev += de_a - 2.0 * de_r;
         rows.push(row(test, &stress, &state, ea, ev));
+        if let Some(why) = state.fault() {
+            return Err(ElementError::NoState { step, why });
+        }
     }
     Ok(rows)
 }

@@ -70,6 +70,11 @@ pub trait MaterialState: bytemuck::Pod + Default + PartialEq + Debug + Send + Sy
     fn fields(&self) -> Vec<(&'static str, f64)> {
         Vec::new()
     }
+    /// Why this state has no physical meaning (a clay with no voids left), or `None`: set-up
+    /// refuses such a start and an element test stops at it. None by default.
+    fn fault(&self) -> Option<String> {
+        None
+    }
 }
 
 impl MaterialState for () {

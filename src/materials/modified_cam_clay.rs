@@ -311,6 +311,16 @@ impl MaterialState for CamClayState {
             ("excess_pore_pressure", self.excess_pore_pressure),
         ]
     }
+    /// A specific volume of at most 1 (a void ratio of at most 0) in a state that has been
+    /// set (p′_c > 0).
+    fn fault(&self) -> Option<String> {
+        (self.preconsolidation > 0.0 && self.specific_volume <= 1.0).then(|| {
+            format!(
+                "p′_c = {:.4e} Pa and a specific volume of {:.6} (v ≤ 1: no voids left)",
+                self.preconsolidation, self.specific_volume
+            )
+        })
+    }
 }
 
 /// The Modified Cam Clay model of a checked [`ModifiedCamClaySpec`].
@@ -540,14 +550,8 @@ impl Material for ModifiedCamClay {
                 p, self.max_mean_stress
             ));
         }
-        let state = self.initial_state(stress);
-        (state.specific_volume <= 1.0).then(|| {
-            format!(
-                "the clay starts at p′ = {:.4e} Pa with p′_c = {:.4e} Pa, a specific volume of \
-                 {:.4} (v ≤ 1: no voids left): lower its preconsolidation",
-                p, state.preconsolidation, state.specific_volume
-            )
-        })
+        (self.initial_state(stress).fault())
+            .map(|why| format!("the clay starts at p′ = {p:.4e} Pa with {why}: lower its preconsolidation"))
     }
     /// Undrained (water in the state): s_u on any plane, [`Material::undrained_strength`].
     /// Drained: the critical state's friction, sin φ_cs = 3M/(6 + M) (triaxial compression,

@@ -6,7 +6,7 @@
 //! M = 0.9, ν = 0.25, N = 3.0 at 1 kPa, Γ = N − (λ − κ) ln 2.
 
 use crate::common::{on_own_thread, rel, run, scene};
-use kdmpm::element_test::{oedometer, triaxial, Drainage, Row, Triaxial};
+use kdmpm::element_test::{oedometer, triaxial, Drainage, ElementError, Row, Triaxial};
 use kdmpm::materials::{MaterialModel, MaterialSpec};
 use kdmpm::LoadedScene;
 
@@ -510,7 +510,7 @@ fn a_clay_started_outside_its_range_is_refused_with_the_reason() {
         "materials.clay.preconsolidation=Ratio(30.0)",
     ]);
     assert!(
-        err.contains("bodies[0].initial_stress") && err.contains("specific volume of 0.9952"),
+        err.contains("bodies[0].initial_stress") && err.contains("specific volume of 0.995181"),
         "{err}"
     );
     // The same clay set just inside the line, at 2.9 MPa, builds.
@@ -581,4 +581,30 @@ fn an_undrained_cavity_expands_as_collins_and_yu_s_cam_clay() {
             "a/a0 {ratio}: {psi} Pa against {collins_yu}"
         );
     }
+}
+
+/// A drained test from p′₀ = 2 MPa heads for the critical state at 3p′₀/(3 − M) = 2.86 MPa,
+/// where v = Γ − λ ln 2 857 = 0.87 with Γ = N − (λ − κ) ln 2: the clay runs out of voids on
+/// the way, and the test stops at the increment it does (v ≤ 1), not at a sample with a
+/// negative void ratio. From 5 MPa it starts with none: refused at the cell pressure.
+#[test]
+fn an_element_test_stops_where_the_clay_has_no_voids_left() {
+    let test = |p0: f64| Triaxial {
+        cell_pressure: p0,
+        drainage: Drainage::Drained,
+        axial_strain: 0.3,
+        steps: 3000,
+    };
+    let gamma = N - (LAMBDA - KAPPA) * 2f64.ln();
+    assert!(gamma - LAMBDA * (3.0 * 2e3 / (3.0 - M)).ln() < 1.0);
+    match triaxial(&clay(1.0), &test(2e6)) {
+        Err(ElementError::NoState { step, why }) => {
+            assert_eq!(step, 1252);
+            assert!(why.contains("no voids left"), "{why}");
+        }
+        other => panic!("{other:?}"),
+    }
+    let e = triaxial(&clay(1.0), &test(5e6)).unwrap_err();
+    assert!(matches!(e, ElementError::Input("cell_pressure", _)), "{e}");
+    assert!(triaxial(&clay(1.0), &test(1e6)).is_ok());
 }
