@@ -141,6 +141,21 @@ pub enum StepError {
         /// The point or node involved.
         location: String,
     },
+    /// A static state holds a point whose material state has no physical meaning.
+    #[error(
+        "step {step}, system `convergence`: at this static state point {point} at {position:?} \
+         has {why}: the material has no state there, and the answer would not be one"
+    )]
+    StateFault {
+        /// Step number.
+        step: u64,
+        /// The point's [`PointId`](crate::components::PointId) (the smallest over ranks).
+        point: u32,
+        /// Where it is (m).
+        position: [f64; 3],
+        /// Why ([`crate::materials::MaterialState::fault`]).
+        why: String,
+    },
     /// The kinetic energy exceeds the work done on the body: the scheme is creating energy.
     #[error(
         "step {step}, system `convergence`: kinetic energy {kinetic_energy:.4e} J exceeds {ratio:.1}× the external \

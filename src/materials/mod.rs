@@ -630,6 +630,22 @@ pub fn extend_state_fields(arch: &Archetype, names: &[&'static str], out: &mut [
     }
 }
 
+/// The first row of `arch` whose material state has no physical meaning, and why
+/// ([`MaterialState::fault`]).
+pub fn first_state_fault(arch: &Archetype) -> Option<(usize, String)> {
+    struct Find<'a>(&'a Archetype, Option<(usize, String)>);
+    impl StateVisitor for Find<'_> {
+        fn visit<S: MaterialState>(&mut self) {
+            if let (None, Some(c)) = (&self.1, self.0.get::<&S>()) {
+                self.1 = c.iter().enumerate().find_map(|(r, s)| Some((r, s.fault()?)));
+            }
+        }
+    }
+    let mut f = Find(arch, None);
+    visit_states(&mut f);
+    f.1
+}
+
 /// The first row of `arch` whose material state holds a value that is not finite.
 pub fn first_non_finite_state(arch: &Archetype) -> Option<usize> {
     struct Find<'a>(&'a Archetype, Option<usize>);

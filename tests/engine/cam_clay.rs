@@ -608,3 +608,26 @@ fn an_element_test_stops_where_the_clay_has_no_voids_left() {
     assert!(matches!(e, ElementError::Input("cell_pressure", _)), "{e}");
     assert!(triaxial(&clay(1.0), &test(1e6)).is_ok());
 }
+
+/// The oedometer pressed to 6 MPa in 750 kPa increments: its clay's normal compression
+/// line reaches v = 1 at p′ = exp((N − 1)/λ) kPa = 2.98 MPa, so the static state at 3 MPa
+/// holds points with no voids left. The run stops there with the point and the reason
+/// (not at 6 MPa with a negative void ratio), and keeps the three states before it.
+#[test]
+fn a_clay_pressed_past_its_last_void_stops_at_that_static_state() {
+    let s = run(
+        "clay_oedometer.ron",
+        &[
+            "tractions[0].pressure=6.0e6",
+            "materials.clay.max_mean_stress=2.9e6",
+        ],
+    );
+    assert!(!s.converged);
+    let e = s.error.expect("an error");
+    assert!(
+        e.contains("step 2681") && e.contains("point 40") && e.contains("no voids left"),
+        "{e}"
+    );
+    let kept: Vec<f64> = s.curve.iter().map(|c| c.pressure.unwrap()).collect();
+    assert_eq!(kept, [0.75e6, 1.5e6, 2.25e6]);
+}
