@@ -630,18 +630,19 @@ pub fn extend_state_fields(arch: &Archetype, names: &[&'static str], out: &mut [
     }
 }
 
-/// The first row of `arch` whose material state has no physical meaning, and why
-/// ([`MaterialState::fault`]).
-pub fn first_state_fault(arch: &Archetype) -> Option<(usize, String)> {
-    struct Find<'a>(&'a Archetype, Option<(usize, String)>);
+/// The rows of `arch` whose material state has no physical meaning, each with why
+/// ([`MaterialState::fault`]); none allocates nothing.
+pub fn state_faults(arch: &Archetype) -> Vec<(usize, String)> {
+    struct Find<'a>(&'a Archetype, Vec<(usize, String)>);
     impl StateVisitor for Find<'_> {
         fn visit<S: MaterialState>(&mut self) {
-            if let (None, Some(c)) = (&self.1, self.0.get::<&S>()) {
-                self.1 = c.iter().enumerate().find_map(|(r, s)| Some((r, s.fault()?)));
+            if let Some(c) = self.0.get::<&S>() {
+                let faults = c.iter().enumerate().filter_map(|(r, s)| Some((r, s.fault()?)));
+                self.1.extend(faults);
             }
         }
     }
-    let mut f = Find(arch, None);
+    let mut f = Find(arch, Vec::new());
     visit_states(&mut f);
     f.1
 }

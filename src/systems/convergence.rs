@@ -330,32 +330,26 @@ impl<D: Dim> System<D> for Convergence {
 fn state_faults<D: Dim>(ctx: &Context<D>) -> Result<(), StepError> {
     let mut first: Option<(u32, [f64; 3], String)> = None;
     for arch in points_with::<Position<D::Vec>>(&ctx.world) {
-        if let Some((r, why)) = crate::materials::first_state_fault(arch) {
+        for (r, why) in crate::materials::state_faults(arch) {
             let id = col::<PointId>(arch)[r].0;
             if first.as_ref().is_none_or(|f| id < f.0) {
                 first = Some((id, D::vec_to3(col::<Position<D::Vec>>(arch)[r].0), why));
             }
         }
     }
-    // The ranks' smallest faulty id (none: +∞), and that point's place.
-    let mine = first.as_ref().map_or(f64::INFINITY, |f| f64::from(f.0));
-    let ids = ctx.comm.gather_all(&[mine]);
-    let Some((rank, &id)) = ids.iter().enumerate().min_by(|a, b| a.1.total_cmp(b.1)) else {
-        return Ok(());
-    };
+    // The ranks' smallest faulty id (none: +∞); its rank says why and where.
+    let mut least = [-first.as_ref().map_or(f64::INFINITY, |f| f64::from(f.0))];
+    ctx.comm.max(&mut least);
+    let id = -least[0];
     if id.is_infinite() {
         return Ok(());
     }
-    let place = first
-        .as_ref()
-        .filter(|f| f64::from(f.0) == id)
-        .map_or([0.0; 3], |f| f.1);
-    let places = ctx.comm.gather_all(&place);
+    let owned = first.filter(|f| f64::from(f.0) == id);
+    let (rank, why) = (ctx.comm)
+        .first_message(owned.as_ref().map(|f| f.2.as_str()))
+        .expect("the rank that holds the point says why");
+    let places = ctx.comm.gather_all(&owned.map_or([0.0; 3], |f| f.1));
     let position = [places[3 * rank], places[3 * rank + 1], places[3 * rank + 2]];
-    let why = match first {
-        Some((i, _, why)) if f64::from(i) == id => why,
-        _ => format!("a state with no physical meaning (said by rank {rank}, which holds it)"),
-    };
     Err(StepError::StateFault {
         step: ctx.state.clock.step,
         point: id as u32,
