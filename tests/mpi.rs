@@ -955,3 +955,42 @@ fn a_study_launching_its_runs_on_2_ranks_tabulates_one_ranks_answers() {
     assert_eq!(o.status.code(), Some(2), "{e}");
     assert!(e.contains("--launcher"), "{e}");
 }
+
+/// The oedometer's clay pressed past v = 1 (cell 0.125 m, 240 and 16 points on the two
+/// ranks): on 2 ranks the run stops at one rank's static state, naming one rank's point
+/// (the smallest faulty id over the ranks) with its reason, exit 1.
+#[test]
+fn a_clay_with_no_voids_left_stops_2_ranks_where_it_stops_one() {
+    let scene = common::scene("clay_oedometer.ron");
+    let fault = |ranks: usize| {
+        let out = common::scratch("mpi", &format!("no-voids-{ranks}"));
+        let mut args = vec![
+            "run",
+            scene.to_str().expect("UTF-8"),
+            "--out",
+            out.to_str().expect("UTF-8"),
+        ];
+        let sets = [
+            "tractions[0].pressure=6.0e6",
+            "materials.clay.max_mean_stress=2.9e6",
+            "grid.cell_size=0.125",
+            "grid.cells=[8, 12]",
+            "tractions[0].min=[0.0, 0.875]",
+        ];
+        for s in &sets {
+            args.extend(["--set", s]);
+        }
+        let o = kdmpm_on(ranks, &args);
+        assert_eq!(o.status.code(), Some(1), "{}", String::from_utf8_lossy(&o.stderr));
+        let summary: Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+        summary["error"].as_str().expect("the error").to_string()
+    };
+    let (one, two) = (fault(1), fault(2));
+    for e in [&one, &two] {
+        assert!(
+            e.contains("step 1557") && e.contains("point 144") && e.contains("no voids left"),
+            "{e}"
+        );
+    }
+}
