@@ -629,3 +629,38 @@ fn volumetric_smoothing_on_a_dilatant_soil_is_refused() {
         &["solver.anti_locking", "\"clay\" dilates", "ψ = 0"],
     );
 }
+
+/// `kdmpm triaxial` writes triaxial.csv only for a test that ran to its end: one that
+/// stops (the oedometer's clay from 2 MPa runs out of voids at increment 1 252, exit 1)
+/// removes the csv an earlier test left in the same directory, so that it is not read as
+/// this test's. A test refused at its input (exit 2) writes nothing.
+#[test]
+fn a_triaxial_test_that_stops_leaves_no_earlier_csv_behind() {
+    let scene = common::scene("clay_oedometer.ron");
+    let out = common::scratch("robustness", "triaxial-stale");
+    let test = |p0: &str| {
+        let args = [
+            "triaxial",
+            scene.to_str().unwrap(),
+            "--material",
+            "clay",
+            "--cell-pressure",
+            p0,
+            "--steps",
+            "1500",
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        kdmpm_within(&args, &[], Duration::from_secs(60))
+    };
+    let csv = out.join("triaxial.csv");
+    assert_eq!(test("1e5").status.code(), Some(0));
+    assert!(csv.exists());
+    let o = test("2e6");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("no voids left"), "{err}");
+    assert!(!csv.exists());
+    assert_eq!(test("5e6").status.code(), Some(2));
+    assert!(!csv.exists());
+}

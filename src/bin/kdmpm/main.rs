@@ -109,12 +109,22 @@ fn triaxial(args: cli::TriaxialArgs) -> Result<(), Fault> {
         axial_strain,
         steps,
     };
-    let rows = kdmpm::element_test::triaxial(&model, &test).map_err(|e| match e {
-        kdmpm::element_test::ElementError::Input(..) => Fault::bad(e),
-        _ => Fault(e.to_string(), Ending::Failed),
-    })?;
     let out = out.unwrap_or_else(|| PathBuf::from("out").join(format!("triaxial-{material}")));
     let path = out.join("triaxial.csv");
+    let rows = kdmpm::element_test::triaxial(&model, &test).map_err(|e| match e {
+        kdmpm::element_test::ElementError::Input(..) => Fault::bad(e),
+        // A test that stopped leaves no earlier test's rows looking like its own.
+        _ => match std::fs::remove_file(&path) {
+            Err(r) if r.kind() != std::io::ErrorKind::NotFound => Fault(
+                format!(
+                    "{e}; {} of an earlier test could not be removed: {r}",
+                    path.display()
+                ),
+                Ending::Failed,
+            ),
+            _ => Fault(e.to_string(), Ending::Failed),
+        },
+    })?;
     std::fs::create_dir_all(&out)
         .and_then(|_| kdmpm::element_test::write_csv(&rows, &path))
         .map_err(|e| Fault(format!("cannot write {}: {e}", path.display()), Ending::Failed))?;
