@@ -100,14 +100,16 @@ const HEAD_LIMIT: u64 = 1 << 20;
 
 impl Piece {
     fn open(path: PathBuf) -> std::io::Result<Piece> {
-        let mut file = BufReader::new(File::open(&path)?);
+        // The head is read through a limit: a file of another kind, without the line that
+        // ends it, is refused after HEAD_LIMIT bytes, not read whole.
+        let mut file = BufReader::new(File::open(&path)?).take(HEAD_LIMIT);
         let mut head = String::new();
         let bad = || not_points(&path);
         // The head is XML lines up to the one that opens the appended data; after that
         // line's end, the data starts at the byte after the first `_`.
         loop {
             let mut line = Vec::new();
-            if file.read_until(b'\n', &mut line)? == 0 || head.len() as u64 > HEAD_LIMIT {
+            if file.read_until(b'\n', &mut line)? == 0 {
                 return Err(bad());
             }
             head.push_str(std::str::from_utf8(&line).map_err(|_| bad())?);
@@ -258,6 +260,10 @@ mod tests {
         write_frame(&f, &dir.as_path().join("points.vtu")).unwrap();
         assert!(FieldSample::read_run(dir.as_path()).unwrap().is_none());
         std::fs::write(dir.as_path().join("points.vtu"), "<VTKFile>\n").unwrap();
+        let e = FieldSample::read_run(dir.as_path()).unwrap_err();
+        assert!(e.to_string().ends_with("is not a points file of kdmpm"), "{e}");
+        // A head that never ends is refused at the limit.
+        std::fs::write(dir.join("points.vtu"), vec![b'x'; 2 << 20]).unwrap();
         let e = FieldSample::read_run(dir.as_path()).unwrap_err();
         assert!(e.to_string().ends_with("is not a points file of kdmpm"), "{e}");
         std::fs::remove_dir_all(&dir).unwrap();
