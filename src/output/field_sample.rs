@@ -44,6 +44,9 @@ impl FieldSample {
             .into_iter()
             .map(Piece::open)
             .collect::<std::io::Result<Vec<Piece>>>()?;
+        if pieces.iter().any(|p| p.displacement.is_none()) {
+            return Ok(None);
+        }
         let total: usize = pieces.iter().map(|p| p.points).sum();
         let mut sample = FieldSample {
             every: total.div_ceil(FIELD_POINTS).max(1),
@@ -53,15 +56,9 @@ impl FieldSample {
         };
         let mut index = 0;
         for piece in &pieces {
-            let Some(u_offset) = piece.displacement else {
-                return Ok(None);
-            };
             let mut xs = piece.vectors(piece.position)?;
-            let mut us = piece.vectors(u_offset)?;
-            if xs.count != us.count {
-                return Err(piece.bad());
-            }
-            for _ in 0..xs.count {
+            let mut us = piece.vectors(piece.displacement.expect("every piece has them"))?;
+            for _ in 0..piece.points {
                 let (x, u) = (xs.next()?, us.next()?);
                 sample.add(index, x, u);
                 index += 1;
@@ -112,8 +109,9 @@ impl Piece {
             if file.read_until(b'\n', &mut line)? == 0 {
                 return Err(bad());
             }
-            head.push_str(std::str::from_utf8(&line).map_err(|_| bad())?);
-            if head.contains("<AppendedData encoding=\"raw\">") {
+            let line = std::str::from_utf8(&line).map_err(|_| bad())?;
+            head.push_str(line);
+            if line.contains("<AppendedData encoding=\"raw\">") {
                 break;
             }
         }
@@ -171,10 +169,7 @@ impl Piece {
         if bytes != 24 * self.points as u64 {
             return Err(self.bad());
         }
-        Ok(Vectors {
-            file,
-            count: self.points,
-        })
+        Ok(Vectors(file))
     }
 }
 
@@ -185,16 +180,13 @@ fn not_points(path: &Path) -> std::io::Error {
     )
 }
 
-/// A three-component Float64 array being read.
-struct Vectors {
-    file: BufReader<File>,
-    count: usize,
-}
+/// A three-component Float64 array being read, a record at a time.
+struct Vectors(BufReader<File>);
 
 impl Vectors {
     fn next(&mut self) -> std::io::Result<[f64; 3]> {
         let mut record = [0u8; 24];
-        self.file.read_exact(&mut record)?;
+        self.0.read_exact(&mut record)?;
         Ok(std::array::from_fn(|k| {
             f64::from_le_bytes(record[8 * k..8 * k + 8].try_into().expect("8 bytes"))
         }))

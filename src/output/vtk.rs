@@ -253,7 +253,8 @@ pub fn write_frame(frame: &Frame, path: &Path) -> std::io::Result<()> {
 /// The live point columns, in id order.
 struct Columns<'a, D: Dim> {
     archs: Vec<&'a Archetype>,
-    order: Order,
+    /// Built by the first field written: a `.pvtu`, which only names the arrays, needs none.
+    order: std::cell::OnceCell<Order>,
     n: usize,
     displacements: bool,
     water: Option<Water>,
@@ -264,21 +265,13 @@ struct Columns<'a, D: Dim> {
 impl<'a, D: Dim> Columns<'a, D> {
     fn of(world: &'a World, water: Option<Water>) -> Self {
         let archs: Vec<&Archetype> = points_with::<Stress<D::Stress>>(world).collect();
-        // The points counted over the archetypes in turn, in id order.
-        let mut starts = vec![0usize];
-        for arch in &archs {
-            starts.push(starts.last().expect("starts at 0") + arch.len() as usize);
-        }
-        let n = starts[archs.len()];
-        let mut rows = Vec::new();
-        let ids: Vec<_> = archs.iter().map(|a| col::<PointId>(a)).collect();
-        id_order(ids.iter().flat_map(|c| c.iter().map(|id| id.0)), &mut rows);
+        let n = archs.iter().map(|a| a.len() as usize).sum::<usize>();
         // Displacements only when the scene keeps them (`output.displacements`).
         let displacements = n > 0 && archs.iter().all(|a| a.has::<Displacement<D::Vec>>());
         Columns {
             states: state_names(&archs),
             archs,
-            order: Order { rows, starts },
+            order: std::cell::OnceCell::new(),
             n,
             displacements,
             water,
@@ -301,7 +294,8 @@ impl<D: Dim> Source for Columns<'_, D> {
         &self.states
     }
     fn write(&self, field: Field, out: &mut BufWriter<File>) -> std::io::Result<()> {
-        let (archs, order) = (&self.archs[..], &self.order);
+        let archs = &self.archs[..];
+        let order = self.order.get_or_init(|| Order::of(archs));
         match field {
             Field::Position => {
                 each::<Position<D::Vec>>(archs, order, out, |out, x| f64s(out, &D::vec_to3(x.0)))
@@ -714,6 +708,18 @@ struct Order {
 }
 
 impl Order {
+    /// The points of `archs`, counted over them in turn, in id order.
+    fn of(archs: &[&Archetype]) -> Order {
+        let mut starts = vec![0usize];
+        for arch in archs {
+            starts.push(starts.last().expect("starts at 0") + arch.len() as usize);
+        }
+        let mut rows = Vec::new();
+        let ids: Vec<_> = archs.iter().map(|a| col::<PointId>(a)).collect();
+        id_order(ids.iter().flat_map(|c| c.iter().map(|id| id.0)), &mut rows);
+        Order { rows, starts }
+    }
+
     /// (archetype, row) of every point, in id order.
     fn points(&self) -> impl Iterator<Item = (usize, usize)> + '_ {
         self.rows.iter().map(|&k| {

@@ -313,12 +313,9 @@ impl<D: Dim> System<D> for Convergence {
         };
         if converged {
             state_faults(ctx)?;
-        }
-        let s = &mut ctx.state;
-        if converged {
-            s.stop = Some(StopReason::Converged);
-        } else if let Some(limit) = s.clock.limit(&ctx.numerics) {
-            s.stop = Some(limit);
+            ctx.state.stop = Some(StopReason::Converged);
+        } else if let Some(limit) = ctx.state.clock.limit(&ctx.numerics) {
+            ctx.state.stop = Some(limit);
         }
         Ok(())
     }
