@@ -40,7 +40,10 @@ outer face's strain e_b = -ln(1 - (a^3 - a0^3)/b^3)/3 instead of 0 (the kinemati
 incompressible sphere hold in a finite one; only the far field's pressure now acts at b),
 and whose cavity radius comes from the volume of the cavity: the traced points `wall9`,
 `wall27`, ... `wall81` stand for the wall's 18-degree zones, a^3 = a0^3 + the zones'
-mean of rho^3 - rho0^3 weighted by their share of the sphere, cos(phi) dphi.
+mean of rho^3 - rho0^3 weighted by their share of the sphere, cos(phi) dphi. After the
+shells it reads the wall's excess pore pressure from the clay 2 to 6, 8 and 10 cells off
+the wall (`--cell H`, the run's cell, 0.1 m by default): the straight line of those points'
+pressures against their starting radius, at the wall (`wall_trend`).
 """
 import csv
 import math
@@ -139,7 +142,7 @@ def compare(path, out):
 B_SPHERE = 6.0  # m, the outer radius of scenes/cavity_sphere.ron
 
 
-def compare_sphere(path, out, near=1.075):
+def compare_sphere(path, out, near=1.075, cell=0.1):
     """The spherical run in `out` against the reference for its thick sphere; the clay's
     excess pore pressure in shells from `near` m out (past the loaded points)."""
     import json
@@ -187,6 +190,43 @@ def compare_sphere(path, out, near=1.075):
         bands = ((near, bands[0][0]),) + bands
     for band in bands:
         near_wall(path, points, grown, e_b, band)
+    for cells in ((2, 6), (2, 8), (2, 10)):
+        at_wall, line_ref, n = wall_trend(path, points, grown, e_b, cell, cells)
+        print(
+            f"the wall's excess pore pressure from the clay {cells[0]}-{cells[1]} cells off it "
+            f"({n} points, their straight line in rho0 carried to the wall): {at_wall / 1e3:.1f} kPa "
+            f"against {u / 1e3:.1f} kPa, {(at_wall / u - 1) * 100:+.1f} % (the reference's own "
+            f"values at the same points, so read: {line_ref / 1e3:.1f} kPa, {(line_ref / u - 1) * 100:+.1f} %)"
+        )
+
+
+def wall_trend(path, a, grown, e_b, cell, cells, a0=1.0):
+    """The excess pore pressure at the cavity's wall read from the clay that started
+    `cells` (from, to) cells off it, as a finite element code recovers a stress at a
+    boundary from its integration points: the least-squares straight line of each point's
+    excess pore pressure against its starting distance from the centre, at rho0 = a0. The
+    cells the arc cuts, whose points scatter, are left out. Returns the engine's line at the
+    wall, the same line through the reference's values at the same points (the reading's
+    own error, against the reference at the wall), and the number of points."""
+    xs, us, refs = [], [], []
+    for x, d, u in zip(a["points"], a["displacement"], a["excess_pore_pressure"]):
+        rho0 = math.hypot(x[0] - d[0], x[1] - d[1])
+        if not cells[0] * cell < rho0 - a0 < cells[1] * cell:
+            continue
+        rho = (rho0**3 + grown) ** (1 / 3)
+        e = math.log(rho / rho0)
+        q, p = q_at(path, 2 * e)
+        xs.append(rho0 - a0)
+        us.append(u)
+        refs.append(P0 + pressure(path, e, True, n=2000, e_b=e_b) - 2 * q / 3 - p)
+
+    def at_wall(values):
+        n = len(xs)
+        mx, mv = sum(xs) / n, sum(values) / n
+        slope = sum((x - mx) * (v - mv) for x, v in zip(xs, values)) / sum((x - mx) ** 2 for x in xs)
+        return mv - slope * mx
+
+    return at_wall(us), at_wall(refs), len(xs)
 
 
 def vtu_arrays(name, wanted):
@@ -248,7 +288,8 @@ def main():
         if "--sphere" in sys.argv[3:]:
             rest = sys.argv[3:]
             near = float(rest[rest.index("--from") + 1]) if "--from" in rest else 1.075
-            compare_sphere(path, sys.argv[2], near)
+            cell = float(rest[rest.index("--cell") + 1]) if "--cell" in rest else 0.1
+            compare_sphere(path, sys.argv[2], near, cell)
         else:
             compare(path, sys.argv[2])
         return
