@@ -144,7 +144,8 @@ B_SPHERE = 6.0  # m, the outer radius of scenes/cavity_sphere.ron
 
 def compare_sphere(path, out, near=1.075, cell=0.1):
     """The spherical run in `out` against the reference for its thick sphere; the clay's
-    excess pore pressure in shells from `near` m out (past the loaded points)."""
+    excess pore pressure in shells from `near` m out (past the loaded points), and at the
+    wall as read from the clay 2 to 6, 8 and 10 cells of `cell` m off it (`wall_trend`)."""
     import json
 
     history = {int(r["step"]): r for r in csv.DictReader(open(out + "/history.csv"))}
@@ -173,10 +174,10 @@ def compare_sphere(path, out, near=1.075, cell=0.1):
         psi = float(s["stage"].split()[0])
         ref = P0 + pressure(path, math.log(ratio), True, n=20000, e_b=e_b)
         q, p = q_at(path, 2 * math.log(ratio))
-        u = ref - 2 * q / 3 - p
+        u_wall = ref - 2 * q / 3 - p
         print(
             f"{s['stage']} | {ratio:.4f} | {psi:.1f} | {ref / 1e3:.2f} | "
-            f"{(psi * 1e3 / ref - 1) * 100:+.2f} % | {u / 1e3:.2f}"
+            f"{(psi * 1e3 / ref - 1) * 100:+.2f} % | {u_wall / 1e3:.2f}"
         )
     # The last stage's points.vtu: the excess pore pressure of the clay in shells out from
     # the wall against the reference at each point's own strain.
@@ -195,8 +196,9 @@ def compare_sphere(path, out, near=1.075, cell=0.1):
         print(
             f"the wall's excess pore pressure from the clay {cells[0]}-{cells[1]} cells off it "
             f"({n} points, their straight line in rho0 carried to the wall): {at_wall / 1e3:.1f} kPa "
-            f"against {u / 1e3:.1f} kPa, {(at_wall / u - 1) * 100:+.1f} % (the reference's own "
-            f"values at the same points, so read: {line_ref / 1e3:.1f} kPa, {(line_ref / u - 1) * 100:+.1f} %)"
+            f"against {u_wall / 1e3:.1f} kPa, {(at_wall / u_wall - 1) * 100:+.1f} % (the reference's "
+            f"own values at the same points, so read: {line_ref / 1e3:.1f} kPa, "
+            f"{(line_ref / u_wall - 1) * 100:+.1f} %)"
         )
 
 
