@@ -210,17 +210,9 @@ def wall_trend(path, a, grown, e_b, cell, cells, a0=1.0):
     cells the arc cuts, whose points scatter, are left out. Returns the engine's line at the
     wall, the same line through the reference's values at the same points (the reading's
     own error, against the reference at the wall), and the number of points."""
-    xs, us, refs = [], [], []
-    for x, d, u in zip(a["points"], a["displacement"], a["excess_pore_pressure"]):
-        rho0 = math.hypot(x[0] - d[0], x[1] - d[1])
-        if not cells[0] * cell < rho0 - a0 < cells[1] * cell:
-            continue
-        rho = (rho0**3 + grown) ** (1 / 3)
-        e = math.log(rho / rho0)
-        q, p = q_at(path, 2 * e)
-        xs.append(rho0 - a0)
-        us.append(u)
-        refs.append(P0 + pressure(path, e, True, n=2000, e_b=e_b) - 2 * q / 3 - p)
+    band = (a0 + cells[0] * cell, a0 + cells[1] * cell)
+    rho0s, engine, ref = clay_in_band(path, a, grown, e_b, band)
+    xs = [r - a0 for r in rho0s]
 
     def at_wall(values):
         n = len(xs)
@@ -228,7 +220,7 @@ def wall_trend(path, a, grown, e_b, cell, cells, a0=1.0):
         slope = sum((x - mx) * (v - mv) for x, v in zip(xs, values)) / sum((x - mx) ** 2 for x in xs)
         return mv - slope * mx
 
-    return at_wall(us), at_wall(refs), len(xs)
+    return at_wall(engine), at_wall(ref), len(xs)
 
 
 def vtu_arrays(name, wanted):
@@ -254,14 +246,13 @@ def vtu_arrays(name, wanted):
     return found
 
 
-def near_wall(path, a, grown, e_b, band):
-    """The clay that started `band` m from the centre (the first, from 1.075 m, about a cell
-    out from the cavity's wall at a0 = 1 m, past the loaded points): its excess pore
-    pressure at the last stage (mean, median, range) and the reference's mean at each
-    point's strain, e = ln(rho/rho0) with rho^3 = rho0^3 + (a^3 - a0^3),
+def clay_in_band(path, a, grown, e_b, band):
+    """The points of the clay that started `band` (from, to) m from the centre: their
+    starting radii, their excess pore pressures at the last stage and the reference's at
+    each point's strain, e = ln(rho/rho0) with rho^3 = rho0^3 + (a^3 - a0^3),
     u = sigma_r - 2q/3 - p' (sigma_r from the integral between e_b and e); `a` holds the
     last stage's points.vtu arrays (`vtu_arrays`)."""
-    engine, ref = [], []
+    rho0s, engine, ref = [], [], []
     for x, d, u in zip(a["points"], a["displacement"], a["excess_pore_pressure"]):
         rho0 = math.hypot(x[0] - d[0], x[1] - d[1])
         if not band[0] < rho0 < band[1]:
@@ -270,8 +261,18 @@ def near_wall(path, a, grown, e_b, band):
         e = math.log(rho / rho0)
         q, p = q_at(path, 2 * e)
         sigma_r = P0 + pressure(path, e, True, n=2000, e_b=e_b)
+        rho0s.append(rho0)
         engine.append(u)
         ref.append(sigma_r - 2 * q / 3 - p)
+    return rho0s, engine, ref
+
+
+def near_wall(path, a, grown, e_b, band):
+    """The clay that started `band` m from the centre (the first, from 1.075 m, about a cell
+    out from the cavity's wall at a0 = 1 m, past the loaded points): its excess pore
+    pressure at the last stage (mean, median, range) against the reference's mean
+    (`clay_in_band`)."""
+    _, engine, ref = clay_in_band(path, a, grown, e_b, band)
     if engine:
         mean = lambda v: sum(v) / len(v) / 1e3
         median = sorted(engine)[len(engine) // 2] / 1e3
