@@ -118,11 +118,17 @@ impl<'a> CornerTest<'a> {
         self.holds(node.at, node.phi, node.nearest, normal)
     }
 
+    /// Whether `x` (body frame) lies strictly inside the grid, off its faces.
+    fn within_grid(&self, x: [f64; 3]) -> bool {
+        let t = self.tolerance;
+        (0..self.n).all(|a| x[a] > self.lo[a] + t && x[a] < self.hi[a] - t)
+    }
+
     /// Whether `x` (body frame) is a point of the body's surface the soil can meet: not
     /// inside a part other than `part`, nor on or beyond a face of the grid.
     fn open(&self, x: [f64; 3], part: usize) -> bool {
         let t = self.tolerance;
-        (0..self.n).all(|a| x[a] > self.lo[a] + t && x[a] < self.hi[a] - t)
+        self.within_grid(x)
             && self
                 .parts
                 .iter()
@@ -135,8 +141,7 @@ impl<'a> CornerTest<'a> {
     /// on the axis is not another face of the clay below it).
     fn meets_soil(&self, x: [f64; 3]) -> bool {
         let t = self.tolerance;
-        (0..self.n).all(|a| x[a] > self.lo[a] + t && x[a] < self.hi[a] - t)
-            && self.parts.iter().all(|p| p.geometry.distance(x, self.n).0 > -t)
+        self.within_grid(x) && self.parts.iter().all(|p| p.geometry.distance(x, self.n).0 > -t)
     }
 
     /// Whether a sample with outward `normal` holds a node at `at` (body frame, m) that
