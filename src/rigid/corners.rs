@@ -29,14 +29,12 @@
 //! diagonally past an edge, whose nearest surface point is the edge itself, mirrors to a
 //! point as far from the side as the node is, nearer than φ: not held either.
 //!
-//! The surface is each part's own (its exact geometry: the nearest point of each part to
-//! the mirror, of each edge of a polygon), less what is not the body's surface: a point
-//! inside another part (the face a cone's tip and shaft share) or on or beyond a face of
-//! the grid (the axis of an axisymmetric cone or pile, a wall's foot on the grid's base),
-//! where no soil flows round.
+//! The surface is the one the soil meets ([`Exposed`]): each part's exact geometry (the
+//! nearest point of each part to the mirror, of each edge of a polygon), less the face a
+//! cone's tip and shaft share and what lies on a face of the grid, such as the axis.
 
-use super::geometry::polygon_edges;
-use super::{Geometry, PartSpec};
+use super::exposed::Exposed;
+use super::PartSpec;
 use serde::{Deserialize, Serialize};
 
 /// cos 45°: a surface point whose normal's cosine with a sample's is below this is
@@ -68,19 +66,8 @@ pub struct Located {
 /// A body's corner test in a grid (`systems::rigid_contact` places one per body a step).
 #[derive(Clone, Copy, Debug)]
 pub struct CornerTest<'a> {
-    /// The body's parts.
-    parts: &'a [PartSpec],
-    /// Dimensions.
-    n: usize,
-    /// The body's displacement from its starting frame (m).
-    offset: [f64; 3],
-    /// The grid's corners (m) in the body's starting frame: a surface point on or beyond a
-    /// face of the grid is not one the soil flows round.
-    lo: [f64; 3],
-    /// Upper corner, as `lo`.
-    hi: [f64; 3],
-    /// Distances below this (m) are on a face: 1e-9 cell.
-    tolerance: f64,
+    /// The body's surface the soil meets.
+    surface: Exposed<'a>,
 }
 
 impl<'a> CornerTest<'a> {
@@ -90,16 +77,11 @@ impl<'a> CornerTest<'a> {
         parts: &'a [PartSpec],
         n: usize,
         offset: [f64; 3],
-        (lo, hi): ([f64; 3], [f64; 3]),
+        bounds: ([f64; 3], [f64; 3]),
         cell: f64,
     ) -> Self {
         CornerTest {
-            parts,
-            n,
-            offset,
-            lo: std::array::from_fn(|a| lo[a] - offset[a]),
-            hi: std::array::from_fn(|a| hi[a] - offset[a]),
-            tolerance: 1e-9 * cell,
+            surface: Exposed::new(parts, n, offset, bounds, cell),
         }
     }
 
@@ -108,8 +90,9 @@ impl<'a> CornerTest<'a> {
     /// nearest surface point, the arguments of [`CornerTest::holds`] that do not depend on
     /// the sample (found once a node and step by `systems::rigid_contact`).
     pub fn locate(&self, x: [f64; 3]) -> Located {
-        let at: [f64; 3] = std::array::from_fn(|a| x[a] - self.offset[a]);
-        let (phi, nearest, _) = super::distance(self.parts, at, self.n);
+        let s = &self.surface;
+        let at: [f64; 3] = std::array::from_fn(|a| x[a] - s.offset[a]);
+        let (phi, nearest, _) = super::distance(s.parts, at, s.n);
         Located { at, phi, nearest }
     }
 
@@ -118,43 +101,21 @@ impl<'a> CornerTest<'a> {
         self.holds(node.at, node.phi, node.nearest, normal)
     }
 
-    /// Whether `x` (body frame) lies strictly inside the grid, off its faces.
-    fn within_grid(&self, x: [f64; 3]) -> bool {
-        let t = self.tolerance;
-        (0..self.n).all(|a| x[a] > self.lo[a] + t && x[a] < self.hi[a] - t)
-    }
-
-    /// Whether `x` (body frame) is a point of the body's surface the soil can meet: not
-    /// inside a part other than `part`, nor on or beyond a face of the grid.
-    fn open(&self, x: [f64; 3], part: usize) -> bool {
-        let t = self.tolerance;
-        self.within_grid(x)
-            && self
-                .parts
-                .iter()
-                .enumerate()
-                .all(|(j, p)| j == part || p.geometry.distance(x, self.n).0 > t)
-    }
-
-    /// Whether `x` (body frame), a node's nearest point of the body, is a point the soil
-    /// can meet: not inside any part, nor on or beyond a face of the grid (a cone's apex
-    /// on the axis is not another face of the clay below it).
-    fn meets_soil(&self, x: [f64; 3]) -> bool {
-        let t = self.tolerance;
-        self.within_grid(x) && self.parts.iter().all(|p| p.geometry.distance(x, self.n).0 > -t)
-    }
-
     /// Whether a sample with outward `normal` holds a node at `at` (body frame, m) that
     /// lies `phi` m from the body (outside when positive) with outward normal `nearest` at
     /// its nearest surface point: false when `nearest` is more than 45° from `normal` at a
     /// point the soil meets (the node faces another face), or when a surface point nearer
     /// the node's mirror `at − 2 φ n` than φ has a normal more than 45° from `normal`.
     pub fn holds(&self, at: [f64; 3], phi: f64, nearest: [f64; 3], normal: [f64; 3]) -> bool {
-        if phi <= self.tolerance {
+        if phi <= self.surface.tolerance {
             return true;
         }
         let facing: f64 = (0..3).map(|a| nearest[a] * normal[a]).sum();
-        if facing < CORNER && self.meets_soil(std::array::from_fn(|a| at[a] - phi * nearest[a])) {
+        if facing < CORNER
+            && self
+                .surface
+                .meets_soil(std::array::from_fn(|a| at[a] - phi * nearest[a]))
+        {
             return false;
         }
         let q: [f64; 3] = std::array::from_fn(|a| at[a] - 2.0 * phi * nearest[a]);
@@ -163,30 +124,16 @@ impl<'a> CornerTest<'a> {
         let corner = |p: [f64; 3], m: [f64; 3], k: usize| {
             let d2: f64 = (0..3).map(|a| (p[a] - q[a]).powi(2)).sum();
             let cos: f64 = (0..3).map(|a| m[a] * normal[a]).sum();
-            d2 < reach * reach && cos < CORNER && self.open(p, k)
+            d2 < reach * reach && cos < CORNER && self.surface.open(p, k)
         };
-        for (k, part) in self.parts.iter().enumerate() {
-            if let Geometry::Polygon { vertices } = &part.geometry {
-                // Each edge's nearest point: a polygon's nearest edge may be one it shares
-                // with another part, with a face of the body behind it.
-                if polygon_edges(vertices, q).any(|(_, _, p, m)| corner(p, m, k)) {
-                    return false;
-                }
-            } else {
-                let (d, m) = part.geometry.distance(q, self.n);
-                let p: [f64; 3] = std::array::from_fn(|a| q[a] - d * m[a]);
-                if corner(p, m, k) {
-                    return false;
-                }
-            }
-        }
-        true
+        !self.surface.any_nearest(q, corner)
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::rigid::Geometry;
 
     fn part(geometry: Geometry) -> PartSpec {
         PartSpec {

@@ -18,6 +18,7 @@
 pub mod contact;
 pub mod corners;
 pub mod cpt;
+pub mod exposed;
 pub mod filter;
 pub mod geometry;
 pub mod mesh;
@@ -28,6 +29,7 @@ pub mod stl;
 pub use contact::Contact;
 pub use corners::{CornerTest, Corners, Located};
 pub use cpt::{Cpt, CptSpec, InSitu};
+pub use exposed::Exposed;
 pub use filter::FilterSpec;
 pub use geometry::{Geometry, Sample};
 pub use reach::Reach;

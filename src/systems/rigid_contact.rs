@@ -39,7 +39,7 @@ use crate::error::StepError;
 use crate::grid::{Grid, NodeBox};
 use crate::infra::columns::{col, col_mut, nodes};
 use crate::rigid::contact::{key, remember, solve, Contact, Contacts, Slot};
-use crate::rigid::{CornerTest, Corners, Located};
+use crate::rigid::{CornerTest, Corners, Exposed, Located};
 use crate::schedule::System;
 use crate::shape::{for_each_node, Shape};
 use crate::systems::exchange::{exchange, EXTERNAL, FORCE, MASS, MOMENTUM};
@@ -282,22 +282,29 @@ impl<D: Dim> Placer<'_, '_, D> {
     /// Body `b`'s constraints at the nodes inside it (within `region`) that carry soil.
     /// They hold their normal velocity too: the soil's field there is the body's, and a
     /// light node that only a point's tail reaches would otherwise be free to run into it
-    /// (under a confining stress it does).
+    /// (under a confining stress it does). In a body of several parts, each bears on the
+    /// part whose surface the soil meets nearest it ([`Exposed::bearing_part`]), not on
+    /// the part it lies deepest in: a node in a pile's shaft a cell above its base carries
+    /// the clay under the base.
     fn inside_nodes(&mut self, b: usize, region: NodeBox) {
         let ctx = self.ctx;
         let (grid, st) = (self.grid, &ctx.numerics);
         let body = &ctx.model.bodies[b];
         let offset = ctx.state.control.bodies[b].offset;
+        let bounds = (D::vec_to3(grid.origin), D::vec_to3(grid.max_corner()));
+        let surface = (body.spec.parts.len() > 1)
+            .then(|| Exposed::new(&body.spec.parts, D::N, offset, bounds, grid.cell_size));
         for i in inside_box(ctx, body, offset, region).rows(grid).flatten() {
             if !grid.carries(i, self.soil.at(i).0, st.min_node_mass) {
                 continue;
             }
             let x = D::vec_to3(grid.node_position(grid.node_ijk(i)));
             let at: [f64; 3] = std::array::from_fn(|a| x[a] - offset[a]);
-            let (phi, normal, part) = body.spec.distance(at, D::N);
+            let (phi, normal, deepest) = body.spec.distance(at, D::N);
             if phi > 0.0 {
                 continue;
             }
+            let part = surface.and_then(|s| s.bearing_part(x)).unwrap_or(deepest);
             let k = self.slot(i);
             self.set.contacts.push(Contact {
                 key: key(b, false, i),
