@@ -374,8 +374,8 @@ fn a_rough_cone_tip_holds_no_more_shear_than_the_clay_beside_it() {
 /// the shaft's stress, its force per radian over R times its length in the clay, is above
 /// the interface's adhesion α c_u = 5 kPa (5.76, 5.46 kPa): the shaft's samples next to the
 /// base's corner take some of the base's bearing, a force that does not grow with the
-/// length, so the stress falls towards the cap as the pile goes in (5.11 kPa over the first
-/// 2 D at h = D/8, 4.92–5.07 kPa deeper to 10 D, docs/verification.md). Pinned.
+/// length, so the stress falls towards the cap as the pile goes in (4.98 kPa over the first
+/// 2 D at h = D/8, 4.86–4.98 kPa deeper to 10 D, docs/verification.md). Pinned.
 #[test]
 fn a_jacked_pile_carries_its_base_bearing_and_its_shaft_adhesion() {
     let s = run("pile_jacking.ron", &at_d4("rigid_bodies[0].motion.travel=0.5"));
