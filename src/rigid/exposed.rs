@@ -115,9 +115,11 @@ impl<'a> Exposed<'a> {
             if let Geometry::Polygon { vertices } = &part.geometry {
                 for (a, b, p, _) in polygon_edges(vertices, at) {
                     let (e, l) = ([b[0] - a[0], b[1] - a[1]], (b[0] - a[0]).hypot(b[1] - a[1]));
-                    let along = if p[..2] == a[..] {
+                    // At an end (a + 1·(b − a) need not round to b).
+                    let at_end = |v: [f64; 2]| (p[0] - v[0]).hypot(p[1] - v[1]) <= self.tolerance;
+                    let along = if at_end(a) {
                         hair / l
-                    } else if p[..2] == b[..] {
+                    } else if at_end(b) {
                         -hair / l
                     } else {
                         0.0
