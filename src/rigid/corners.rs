@@ -34,7 +34,6 @@
 //! cone's tip and shaft share and what lies on a face of the grid, such as the axis.
 
 use super::exposed::Exposed;
-use super::PartSpec;
 use serde::{Deserialize, Serialize};
 
 /// cos 45°: a surface point whose normal's cosine with a sample's is below this is
@@ -71,18 +70,9 @@ pub struct CornerTest<'a> {
 }
 
 impl<'a> CornerTest<'a> {
-    /// The test of a body of `parts` displaced by `offset` (m) in an `n`-dimensional grid
-    /// spanning `lo`..`hi` (m) in cells of `cell` m.
-    pub fn new(
-        parts: &'a [PartSpec],
-        n: usize,
-        offset: [f64; 3],
-        bounds: ([f64; 3], [f64; 3]),
-        cell: f64,
-    ) -> Self {
-        CornerTest {
-            surface: Exposed::new(parts, n, offset, bounds, cell),
-        }
+    /// The test of a body whose surface the soil meets is `surface`.
+    pub fn new(surface: Exposed<'a>) -> Self {
+        CornerTest { surface }
     }
 
     /// Where the node at `x` (m, in the grid's frame) stands to the body: its place in the
@@ -91,7 +81,7 @@ impl<'a> CornerTest<'a> {
     /// the sample (found once a node and step by `systems::rigid_contact`).
     pub fn locate(&self, x: [f64; 3]) -> Located {
         let s = &self.surface;
-        let at: [f64; 3] = std::array::from_fn(|a| x[a] - s.offset[a]);
+        let at = s.in_body(x);
         let (phi, nearest, _) = super::distance(s.parts, at, s.n);
         Located { at, phi, nearest }
     }
@@ -126,14 +116,14 @@ impl<'a> CornerTest<'a> {
             let cos: f64 = (0..3).map(|a| m[a] * normal[a]).sum();
             d2 < reach * reach && cos < CORNER && self.surface.open(p, k)
         };
-        !self.surface.any_nearest(q, corner)
+        !self.surface.any_nearest(q, |n| corner(n.point, n.normal, n.part))
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::rigid::Geometry;
+    use crate::rigid::{Geometry, PartSpec};
 
     fn part(geometry: Geometry) -> PartSpec {
         PartSpec {
@@ -145,7 +135,7 @@ mod tests {
     }
 
     fn corners(parts: &[PartSpec]) -> CornerTest<'_> {
-        CornerTest::new(parts, 2, [0.0; 3], ([-10.0; 3], [10.0; 3]), 1e-3)
+        CornerTest::new(Exposed::new(parts, 2, [0.0; 3], ([-10.0; 3], [10.0; 3]), 1e-3))
     }
 
     /// The axis-aligned rectangle from `lo` to `hi` (m), a part of its own.
@@ -245,7 +235,13 @@ mod tests {
             rectangle([0.0, 0.0], [0.5, 0.0625]),
             rectangle([0.0, 0.0625], [0.5, 5.0]),
         ];
-        let c = CornerTest::new(&parts, 2, [0.0; 3], ([0.0, -10.0, 0.0], [10.0; 3]), 1e-3);
+        let c = CornerTest::new(Exposed::new(
+            &parts,
+            2,
+            [0.0; 3],
+            ([0.0, -10.0, 0.0], [10.0; 3]),
+            1e-3,
+        ));
         let down = [0.0, -1.0, 0.0];
         // Under the base's middle and on the axis, a cell down: held (the base part's top,
         // the shaft's bottom and the axis are not faces the soil meets).
@@ -264,7 +260,13 @@ mod tests {
                 vec![0.0, 3.0],
             ],
         })];
-        let c = CornerTest::new(&parts, 2, [0.0; 3], ([0.0, -10.0, 0.0], [10.0; 3]), 1e-3);
+        let c = CornerTest::new(Exposed::new(
+            &parts,
+            2,
+            [0.0; 3],
+            ([0.0, -10.0, 0.0], [10.0; 3]),
+            1e-3,
+        ));
         let face = [30f64.to_radians().cos(), -0.5, 0.0];
         let at = [0.0625, -0.3, 0.0];
         let phi = (0.0625f64.powi(2) + 0.09).sqrt();

@@ -73,20 +73,39 @@ impl<'a> Exposed<'a> {
         self.within_grid(x) && self.parts.iter().all(|p| p.geometry.distance(x, self.n).0 > -t)
     }
 
-    /// Whether `f` holds for any of each part's points nearest `x` (body frame), given
-    /// with its outward normal and the part's index: a polygon's nearest point on each
-    /// edge (its nearest edge may be one it shares with another part, with a face of the
-    /// body behind it), another shape's one nearest point; in part order, stopping at the
-    /// first that `f` holds for. Not checked against [`Exposed::open`].
-    pub fn any_nearest(&self, x: [f64; 3], mut f: impl FnMut([f64; 3], [f64; 3], usize) -> bool) -> bool {
-        for (k, part) in self.parts.iter().enumerate() {
-            if let Geometry::Polygon { vertices } = &part.geometry {
-                if polygon_edges(vertices, x).any(|(_, _, p, m)| f(p, m, k)) {
+    /// `x` (m, grid frame) in the body's starting frame.
+    pub fn in_body(&self, x: [f64; 3]) -> [f64; 3] {
+        std::array::from_fn(|a| x[a] - self.offset[a])
+    }
+
+    /// Whether `f` holds for any of each part's points nearest `x` (body frame): a
+    /// polygon's nearest point on each edge (its nearest edge may be one it shares with
+    /// another part, with a face of the body behind it), another shape's one nearest
+    /// point; in part order, stopping at the first that `f` holds for. Not checked against
+    /// [`Exposed::open`].
+    pub fn any_nearest(&self, x: [f64; 3], mut f: impl FnMut(Nearest) -> bool) -> bool {
+        for (part, geometry) in self.parts.iter().map(|p| &p.geometry).enumerate() {
+            if let Geometry::Polygon { vertices } = geometry {
+                let mut edges = polygon_edges(vertices, x);
+                if edges.any(|(a, b, point, normal)| {
+                    f(Nearest {
+                        point,
+                        normal,
+                        part,
+                        edge: Some((a, b)),
+                    })
+                }) {
                     return true;
                 }
             } else {
-                let (d, m) = part.geometry.distance(x, self.n);
-                if f(std::array::from_fn(|a| x[a] - d * m[a]), m, k) {
+                let (d, normal) = geometry.distance(x, self.n);
+                let point = std::array::from_fn(|a| x[a] - d * normal[a]);
+                if f(Nearest {
+                    point,
+                    normal,
+                    part,
+                    edge: None,
+                }) {
                     return true;
                 }
             }
@@ -102,18 +121,13 @@ impl<'a> Exposed<'a> {
     /// (a cone's shoulder) is theirs while a face two parts share is neither's. `None`
     /// when no part's nearest point is one the soil meets.
     pub fn bearing_part(&self, x: [f64; 3]) -> Option<usize> {
-        let at: [f64; 3] = std::array::from_fn(|a| x[a] - self.offset[a]);
+        let at = self.in_body(x);
         let hair = 1e3 * self.tolerance;
         let mut best: Option<(f64, usize)> = None;
-        let mut consider = |p: [f64; 3], probe: [f64; 3], k: usize| {
-            let d2: f64 = (0..3).map(|a| (p[a] - at[a]).powi(2)).sum();
-            if best.is_none_or(|(b, _)| d2 < b) && self.open(probe, k) {
-                best = Some((d2, k));
-            }
-        };
-        for (k, part) in self.parts.iter().enumerate() {
-            if let Geometry::Polygon { vertices } = &part.geometry {
-                for (a, b, p, _) in polygon_edges(vertices, at) {
+        self.any_nearest(at, |n| {
+            let p = n.point;
+            let probe = match n.edge {
+                Some((a, b)) => {
                     let (e, l) = ([b[0] - a[0], b[1] - a[1]], (b[0] - a[0]).hypot(b[1] - a[1]));
                     // At an end (a + 1·(b − a) need not round to b).
                     let at_end = |v: [f64; 2]| (p[0] - v[0]).hypot(p[1] - v[1]) <= self.tolerance;
@@ -124,16 +138,31 @@ impl<'a> Exposed<'a> {
                     } else {
                         0.0
                     };
-                    consider(p, [p[0] + along * e[0], p[1] + along * e[1], 0.0], k);
+                    [p[0] + along * e[0], p[1] + along * e[1], 0.0]
                 }
-            } else {
-                let (d, m) = part.geometry.distance(at, self.n);
-                let p = std::array::from_fn(|a| at[a] - d * m[a]);
-                consider(p, p, k);
+                None => p,
+            };
+            let d2: f64 = (0..3).map(|a| (p[a] - at[a]).powi(2)).sum();
+            if best.is_none_or(|(b, _)| d2 < b) && self.open(probe, n.part) {
+                best = Some((d2, n.part));
             }
-        }
+            false
+        });
         best.map(|(_, k)| k)
     }
+}
+
+/// A part's point nearest a place ([`Exposed::any_nearest`]).
+#[derive(Clone, Copy, Debug)]
+pub struct Nearest {
+    /// The point (m, body frame).
+    pub point: [f64; 3],
+    /// The outward unit normal there.
+    pub normal: [f64; 3],
+    /// The part's index.
+    pub part: usize,
+    /// A polygon's edge the point lies on, its two ends (m, body frame).
+    pub edge: Option<([f64; 2], [f64; 2])>,
 }
 
 #[cfg(test)]

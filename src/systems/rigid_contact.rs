@@ -256,7 +256,7 @@ struct Placer<'a, 'b, D: Dim> {
     set: Contacts,
 }
 
-impl<D: Dim> Placer<'_, '_, D> {
+impl<'a, D: Dim> Placer<'a, '_, D> {
     /// The slot of node `i` (which carries mass), made at its first reach with the node's
     /// trial velocity p/m + f Δt/m̃, inertia and free axes.
     fn slot(&mut self, i: usize) -> usize {
@@ -279,6 +279,20 @@ impl<D: Dim> Placer<'_, '_, D> {
         slots.len() - 1
     }
 
+    /// Body `b`'s surface the soil meets, at its place this step.
+    fn surface(&self, b: usize) -> Exposed<'a> {
+        let (ctx, grid) = (self.ctx, self.grid);
+        let bounds = (D::vec_to3(grid.origin), D::vec_to3(grid.max_corner()));
+        let offset = ctx.state.control.bodies[b].offset;
+        Exposed::new(
+            &ctx.model.bodies[b].spec.parts,
+            D::N,
+            offset,
+            bounds,
+            grid.cell_size,
+        )
+    }
+
     /// Body `b`'s constraints at the nodes inside it (within `region`) that carry soil.
     /// They hold their normal velocity too: the soil's field there is the body's, and a
     /// light node that only a point's tail reaches would otherwise be free to run into it
@@ -291,9 +305,7 @@ impl<D: Dim> Placer<'_, '_, D> {
         let (grid, st) = (self.grid, &ctx.numerics);
         let body = &ctx.model.bodies[b];
         let offset = ctx.state.control.bodies[b].offset;
-        let bounds = (D::vec_to3(grid.origin), D::vec_to3(grid.max_corner()));
-        let surface = (body.spec.parts.len() > 1)
-            .then(|| Exposed::new(&body.spec.parts, D::N, offset, bounds, grid.cell_size));
+        let surface = (body.spec.parts.len() > 1).then(|| self.surface(b));
         for i in inside_box(ctx, body, offset, region).rows(grid).flatten() {
             if !grid.carries(i, self.soil.at(i).0, st.min_node_mass) {
                 continue;
@@ -329,9 +341,7 @@ impl<D: Dim> Placer<'_, '_, D> {
         let (grid, st) = (self.grid, &ctx.numerics);
         let body = &ctx.model.bodies[b];
         let offset = ctx.state.control.bodies[b].offset;
-        let bounds = (D::vec_to3(grid.origin), D::vec_to3(grid.max_corner()));
-        let corners = (body.spec.corners == Corners::Released)
-            .then(|| CornerTest::new(&body.spec.parts, D::N, offset, bounds, grid.cell_size));
+        let corners = (body.spec.corners == Corners::Released).then(|| CornerTest::new(self.surface(b)));
         let mut located: std::collections::HashMap<usize, Located> = Default::default();
         for (index, (s, part)) in body.samples.iter().enumerate() {
             let x3: [f64; 3] = std::array::from_fn(|a| s.x[a] + offset[a]);
