@@ -564,6 +564,45 @@ fn a_rough_wall_takes_the_sands_friction_angle() {
     assert_eq!(rough.curve, frictional.curve);
 }
 
+/// `scenes/passive_wall_cphi.ron`, coarser and shorter (h = H/10, 3 % of H): the rough wall
+/// in a weightless c–φ soil (c = 10 kPa, φ = ψ = 30°), where the theory is exact. By
+/// Caquot's corresponding states the soil is a cohesionless one under q = c cot φ, and the
+/// `Rough` face (c + σ_n tan φ) its wall with δ = φ and an adhesion c; the Prandtl fan gives
+/// the wall Lancellotta's normal stress (2002, Géotechnique 52(8), eq. 1) K_p q, so
+/// σ_n = (K_p − 1) c cot φ = 69.74 kPa and a thrust of 139.5 kN/m over H = 2 m. The static
+/// thrusts 131.3, 137.4 and 147.7 kN/m (the last +5.9 %, pinned) lie within 6 % of it; the
+/// smooth foot's 5 cm of face carries 22.6–26.5 kN/m of them where its share of σ_n is
+/// 3.5 kN/m: its corner holds the soil below the toe. The wall's shear reaches 0.85 of
+/// what the interface can carry, c H + tan φ times the thrust (docs/verification.md, "The
+/// rough wall where the theory is exact").
+#[test]
+fn a_rough_wall_in_weightless_c_phi_soil_meets_the_exact_thrust() {
+    let s = run(
+        "passive_wall_cphi.ron",
+        &[
+            "grid.cell_size=0.2",
+            "grid.cells=[65, 25]",
+            "rigid_bodies[0].motion.travel=0.06",
+        ],
+    );
+    let (c, phi, delta, height) = (10.0e3, 30f64.to_radians(), 30f64.to_radians(), 2.0);
+    let two_theta = (delta.sin() / phi.sin()).asin() + delta;
+    let kp = delta.cos() / (1.0 - phi.sin())
+        * (delta.cos() + (phi.sin().powi(2) - delta.sin().powi(2)).max(0.0).sqrt())
+        * (two_theta * phi.tan()).exp();
+    let exact = (kp - 1.0) * c / phi.tan() * height;
+    assert!((exact - 139.47e3).abs() < 10.0, "{exact}");
+    let (wall, foot) = (forces(&s, "wall", 0), forces(&s, "wall.foot", 0));
+    assert_eq!((wall.len(), foot.len()), (3, 3), "{wall:?} {foot:?}");
+    for thrust in &wall {
+        assert!(rel(*thrust, exact).abs() < 0.06, "{wall:?} against {exact}");
+    }
+    let shear = forces(&s, "wall", 1)[2].abs();
+    let cap = c * height + phi.tan() * wall[2];
+    assert!(shear > 0.8 * cap && shear <= cap, "{shear} against {cap}");
+    assert_eq!(wall[2], 147670.72962541255);
+}
+
 /// The same block with its contact solves stopped ten times sooner
 /// (`solver.contact_tolerance=1e-4` against the default 1e-5): fewer sweeps, the same
 /// sliding force to 0.5 % (14.20 against 14.14 kN/m at the last static state, pinned).
