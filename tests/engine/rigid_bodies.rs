@@ -482,6 +482,17 @@ fn a_smooth_wall_pushed_into_sand_meets_rankines_passive_thrust() {
 }
 
 /// `scenes/passive_wall_rough.ron` coarser and shorter: h = H/10, pushed 3 % of H.
+/// Lancellotta's passive coefficient for a wall's normal stress (2002, Géotechnique 52(8),
+/// eq. 1), friction angle `phi` and wall friction `delta` in radians: the Prandtl fan
+/// between two uniform zones, K_p = cos δ/(1 − sin φ) · (cos δ + √(sin²φ − sin²δ)) ·
+/// e^{2θ tan φ}, 2θ = sin⁻¹(sin δ/sin φ) + δ.
+fn lancellotta_kp(phi: f64, delta: f64) -> f64 {
+    let two_theta = (delta.sin() / phi.sin()).asin() + delta;
+    delta.cos() / (1.0 - phi.sin())
+        * (delta.cos() + (phi.sin().powi(2) - delta.sin().powi(2)).max(0.0).sqrt())
+        * (two_theta * phi.tan()).exp()
+}
+
 const COARSE_ROUGH_WALL: [&str; 3] = [
     "grid.cell_size=0.2",
     "grid.cells=[65, 25]",
@@ -506,10 +517,7 @@ fn a_rough_wall_pushed_into_sand_carries_more_than_the_smooth_one() {
     let (r, sm) = (forces(&rough, "wall", 0), forces(&smooth, "wall", 0));
     assert_eq!((r.len(), sm.len()), (3, 3), "{r:?} {sm:?}");
     let (phi, delta) = (30f64.to_radians(), 30f64.to_radians());
-    let two_theta = (delta.sin() / phi.sin()).asin() + delta;
-    let kp = delta.cos() / (1.0 - phi.sin())
-        * (delta.cos() + (phi.sin().powi(2) - delta.sin().powi(2)).max(0.0).sqrt())
-        * (two_theta * phi.tan()).exp();
+    let kp = lancellotta_kp(phi, delta);
     let weight = 0.5 * 1800.0 * 9.81 * 2.0 * 2.0;
     let lancellotta = kp * weight;
     let coulomb_kp = phi.cos().powi(2)
@@ -585,11 +593,8 @@ fn a_rough_wall_in_weightless_c_phi_soil_meets_the_exact_thrust() {
             "rigid_bodies[0].motion.travel=0.06",
         ],
     );
-    let (c, phi, delta, height) = (10.0e3, 30f64.to_radians(), 30f64.to_radians(), 2.0);
-    let two_theta = (delta.sin() / phi.sin()).asin() + delta;
-    let kp = delta.cos() / (1.0 - phi.sin())
-        * (delta.cos() + (phi.sin().powi(2) - delta.sin().powi(2)).max(0.0).sqrt())
-        * (two_theta * phi.tan()).exp();
+    let (c, phi, height) = (10.0e3, 30f64.to_radians(), 2.0);
+    let kp = lancellotta_kp(phi, phi);
     let exact = (kp - 1.0) * c / phi.tan() * height;
     assert!((exact - 139.47e3).abs() < 10.0, "{exact}");
     let (wall, foot) = (forces(&s, "wall", 0), forces(&s, "wall.foot", 0));
