@@ -111,12 +111,11 @@ impl<'a> CornerTest<'a> {
         let q: [f64; 3] = std::array::from_fn(|a| at[a] - 2.0 * phi * nearest[a]);
         let reach = phi * (1.0 - 1e-9);
         // A face nearer the mirror than φ, turned from the sample's, and the body's surface.
-        let corner = |p: [f64; 3], m: [f64; 3], k: usize| {
-            let d2: f64 = (0..3).map(|a| (p[a] - q[a]).powi(2)).sum();
-            let cos: f64 = (0..3).map(|a| m[a] * normal[a]).sum();
-            d2 < reach * reach && cos < CORNER && self.surface.open(p, k)
-        };
-        !self.surface.any_nearest(q, |n| corner(n.point, n.normal, n.part))
+        !self.surface.any_nearest(q, |n| {
+            let d2: f64 = (0..3).map(|a| (n.point[a] - q[a]).powi(2)).sum();
+            let cos: f64 = (0..3).map(|a| n.normal[a] * normal[a]).sum();
+            d2 < reach * reach && cos < CORNER && self.surface.open(n.point, n.part)
+        })
     }
 }
 
