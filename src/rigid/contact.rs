@@ -241,6 +241,76 @@ fn velocity(terms: &[Term], slots: &[Slot]) -> [f64; 3] {
     v
 }
 
+/// Which constraints reach a node that the last solve pushed from opposite sides by two
+/// bodies (the pushes of each body's constraints on the node, summed by their remembered
+/// impulses `warm`, at more than 90°): two bodies that touch, or nearly, across the node.
+///
+/// Such a pair holds the node's velocity from both sides, so any equal and opposite pair
+/// of impulses leaves the velocities unchanged and the solve cannot tell how much each
+/// pushes; started from the last step's impulses the pair grows from step to step (a wall
+/// whose foot slid on a fixed block read −10.8 MN/m against the block's +10.7,
+/// docs/scene-format.md). Started from zero each step, the sweeps build only what the soil
+/// needs. Only bodies that pushed the same nodes pay for it; a body alone, or parts of one
+/// body, keep their warm start.
+fn contested(
+    contacts: &[Contact],
+    warm: &[f64],
+    terms: &[Term],
+    starts: &[usize],
+    slots: usize,
+) -> Vec<bool> {
+    // Per node: the first body that pushed it, its pushes summed, and the other bodies'.
+    let mut owner = vec![usize::MAX; slots];
+    let mut own = vec![[0.0; 3]; slots];
+    let mut other = vec![[0.0; 3]; slots];
+    let mut shared = false;
+    for (c, p) in contacts.iter().enumerate() {
+        if warm[c] <= 0.0 {
+            continue;
+        }
+        for t in &terms[starts[c]..starts[c + 1]] {
+            let k = t.slot;
+            if owner[k] == usize::MAX {
+                owner[k] = p.body;
+            }
+            let sum = if owner[k] == p.body {
+                &mut own[k]
+            } else {
+                shared = true;
+                &mut other[k]
+            };
+            (0..3).for_each(|a| sum[a] += warm[c] * t.share * p.normal[a]);
+        }
+    }
+    if !shared {
+        return vec![false; contacts.len()];
+    }
+    // A node is contested where the two sides' pushes cancel more than they pass on to
+    // the soil: the weaker side's push exceeds the net. There the constraints of the
+    // weaker side that face the stronger side's push start cold, so the pair cannot grow
+    // across steps while one side rebuilds from zero. The side that carries the load, the
+    // weaker body's other faces and a pair that passes most of its push on (a wall a few
+    // centimetres above a base, both holding the soil at its corner) keep their warm start.
+    (contacts.iter().enumerate())
+        .map(|(c, p)| {
+            terms[starts[c]..starts[c + 1]].iter().any(|t| {
+                let k = t.slot;
+                let (mine, theirs) = if owner[k] == p.body {
+                    (own[k], other[k])
+                } else {
+                    (other[k], own[k])
+                };
+                let net: [f64; 3] = std::array::from_fn(|a| mine[a] + theirs[a]);
+                let weaker = dot(mine, mine);
+                dot(mine, theirs) < 0.0
+                    && weaker < dot(theirs, theirs)
+                    && weaker > dot(net, net)
+                    && dot(p.normal, theirs) < 0.0
+            })
+        })
+        .collect()
+}
+
 /// Projected Gauss–Seidel over the samples, each normal impulse starting at its value in
 /// `memory` (zero when it has none; the tangential ones at zero): no entry into a body
 /// moving at `body_velocity` (m/s, per body), then friction (each sample's
@@ -278,19 +348,25 @@ pub fn solve(set: &mut Contacts, body_velocity: &[[f64; 3]], memory: &Memory, to
         reference = reference.max(-dot(rel, p.normal));
     }
     let mut first = None;
-    // Warm start: each contact's normal impulse of the last solve, applied at once.
+    // Warm start: each contact's normal impulse of the last solve, applied at once, but
+    // not where two bodies hold the same nodes from opposite sides ([`contested`]).
     if !memory.is_empty() {
+        let warm: Vec<f64> = (set.contacts.iter())
+            .map(|p| match memory.binary_search_by_key(&p.key, |&(k, _)| k) {
+                Ok(j) => memory[j].1,
+                Err(_) => 0.0,
+            })
+            .collect();
+        let cold = contested(&set.contacts, &warm, &terms, &starts, slots.len());
         for (c, (p, &(s2, mass))) in set.contacts.iter_mut().zip(&normal_spread).enumerate() {
-            if s2 <= 0.0 || mass <= 0.0 {
+            if s2 <= 0.0 || mass <= 0.0 || cold[c] {
                 continue;
             }
-            if let Ok(j) = memory.binary_search_by_key(&p.key, |&(k, _)| k) {
-                let lambda = memory[j].1;
-                if lambda > 0.0 {
-                    p.normal_impulse = lambda;
-                    let took = push(of(c), slots, p.normal, lambda / mass, s2, true);
-                    (0..3).for_each(|a| p.impulse[a] += took[a]);
-                }
+            let lambda = warm[c];
+            if lambda > 0.0 {
+                p.normal_impulse = lambda;
+                let took = push(of(c), slots, p.normal, lambda / mass, s2, true);
+                (0..3).for_each(|a| p.impulse[a] += took[a]);
             }
         }
     }

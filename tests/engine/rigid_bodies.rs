@@ -608,6 +608,36 @@ fn a_rough_wall_in_weightless_c_phi_soil_meets_the_exact_thrust() {
     assert_eq!(wall[2], 147670.72962541255);
 }
 
+/// Two rigid bodies that touch hold the nodes of the face they share from either side,
+/// where any equal and opposite pair of pushes leaves the soil's velocities unchanged. The
+/// wall of `passive_wall_cphi.ron` at h = H/10, its foot sliding on a fixed smooth block
+/// under its toe (soil only in front, x ≥ 0): the block's face is vertical and smooth, so
+/// its vertical force is the corner's alone, 0.96 and 1.53 kN/m at the first two states
+/// (0.8 and 1.2 % of the wall's thrust, the second pinned). When both bodies' pushes on
+/// those nodes were warm-started from the last step, the pair grew with every step: the
+/// block read 50 and 82 kN/m here, and −10.8 MN/m against +10.7 over 0.2 m.
+#[test]
+fn two_touching_rigid_bodies_do_not_grow_a_pair_of_forces_between_them() {
+    let s = run(
+        "passive_wall_cphi.ron",
+        &[
+            "grid.cell_size=0.2",
+            "grid.cells=[65, 25]",
+            r#"bodies=[(material: "soil", region: Box(min: [0.0, 0.0], max: [10.0, 4.0]), points_per_cell: [2, 2])]"#,
+            r#"rigid_bodies=[(name: "wall", parts: [(name: "face", geometry: Polygon(vertices: [[-0.4, 2.0], [0.0, 2.0], [0.0, 4.6], [-0.4, 4.6]]))], interface: Rough, motion: (velocity: [0.01, 0.0], travel: 0.04, increment: 0.02), area: 2.0), (name: "block", parts: [(name: "top", geometry: Polygon(vertices: [[-0.4, 0.0], [0.0, 0.0], [0.0, 2.0], [-0.4, 2.0]]))], interface: Smooth)]"#,
+        ],
+    );
+    let (thrust, block) = (forces(&s, "wall", 0), forces(&s, "block", 1));
+    assert_eq!((thrust.len(), block.len()), (2, 2), "{thrust:?} {block:?}");
+    for (t, b) in thrust.iter().zip(&block) {
+        assert!(
+            b.abs() < 0.02 * t,
+            "block {block:?} against the thrust {thrust:?}"
+        );
+    }
+    assert!(rel(block[1], 1531.851228).abs() < 1e-9, "{block:?}");
+}
+
 /// The same block with its contact solves stopped ten times sooner
 /// (`solver.contact_tolerance=1e-4` against the default 1e-5): fewer sweeps, the same
 /// sliding force to 0.5 % (14.20 against 14.14 kN/m at the last static state, pinned).
