@@ -20,7 +20,9 @@
 //! hundreds of passes to share a confined soil's push among them (the T-bar's first sweep
 //! changes velocities by 6 m/s, the 200th still by 1e-4 of that); from the last step's
 //! share the first sweep changes them by 1e-4 of it. With a few cold sweeps only, part of
-//! each step's entry is left and a confined soil streams past the body.
+//! each step's entry is left and a confined soil streams past the body. Where two bodies
+//! push the same nodes from opposite sides and cancel more than they pass on, the weaker
+//! side starts cold instead ([`contested`]), so that the pair does not grow.
 //!
 //! Friction acts at a sample that presses itself, and the normal impulse its cap leans on
 //! is its nodes' (each node's share of what every constraint pushed into it, split among
@@ -249,9 +251,10 @@ fn velocity(terms: &[Term], slots: &[Slot]) -> [f64; 3] {
 /// of impulses leaves the velocities unchanged and the solve cannot tell how much each
 /// pushes; started from the last step's impulses the pair grows from step to step (a wall
 /// whose foot slid on a fixed block read −10.8 MN/m against the block's +10.7,
-/// docs/scene-format.md). Started from zero each step, the sweeps build only what the soil
-/// needs. Only bodies that pushed the same nodes pay for it; a body alone, or parts of one
-/// body, keep their warm start.
+/// docs/scene-format.md). With one side started from zero each step the pair cannot grow
+/// across steps. Only bodies that pushed the same nodes pay for it; a body alone, or parts
+/// of one body, keep their warm start. With three or more bodies on a node, every body but
+/// the first to push it counts as one side.
 fn contested(
     contacts: &[Contact],
     warm: &[f64],
