@@ -22,7 +22,7 @@
 //! share the first sweep changes them by 1e-4 of it. With a few cold sweeps only, part of
 //! each step's entry is left and a confined soil streams past the body. Where two bodies
 //! push the same nodes from opposite sides and cancel more than they pass on, the weaker
-//! side starts cold instead ([`contested`]), so that the pair does not grow.
+//! side starts cold instead (`contested`), so that the pair does not grow.
 //!
 //! Friction acts at a sample that presses itself, and the normal impulse its cap leans on
 //! is its nodes' (each node's share of what every constraint pushed into it, split among
