@@ -44,6 +44,7 @@ use crate::schedule::System;
 use crate::shape::{for_each_node, Shape};
 use crate::systems::exchange::{exchange, EXTERNAL, FORCE, MASS, MOMENTUM};
 use crate::systems::shared::{constrain, hold, Hold};
+use crate::systems::soil_side::SoilSide;
 use crate::systems::soil_strength::SoilStrength;
 use std::marker::PhantomData;
 
@@ -56,6 +57,9 @@ pub struct RigidContact<D: Dim, S> {
     slot_of: Vec<u32>,
     /// The soil's strength round the rough samples, summed again each step.
     strength: SoilStrength,
+    /// Which face of a thin driven body the soil at its nodes lies against, summed again
+    /// each step.
+    side: SoilSide,
     _marker: PhantomData<fn() -> (D, S)>,
 }
 
@@ -64,6 +68,7 @@ impl<D: Dim, S> Default for RigidContact<D, S> {
         RigidContact {
             slot_of: Vec::new(),
             strength: SoilStrength::default(),
+            side: SoilSide::default(),
             _marker: PhantomData,
         }
     }
@@ -224,6 +229,7 @@ fn place<D: Dim, S: Shape>(
     naming: &Grid<D>,
     soil: &Soil<D>,
     strength: &SoilStrength,
+    side: &SoilSide,
     slot_of: &mut Vec<u32>,
 ) -> Contacts {
     slot_of.resize(naming.node_count(), u32::MAX);
@@ -231,6 +237,7 @@ fn place<D: Dim, S: Shape>(
         ctx,
         grid: naming,
         soil,
+        side,
         slot_of,
         set: Contacts::default(),
     };
@@ -252,6 +259,8 @@ struct Placer<'a, 'b, D: Dim> {
     /// The grid whose numbering names the nodes ([`naming`]).
     grid: &'a Grid<D>,
     soil: &'a Soil<'b, D>,
+    /// Which side of a thin body each node's soil lies against.
+    side: &'a SoilSide,
     slot_of: &'a mut Vec<u32>,
     set: Contacts,
 }
@@ -313,7 +322,8 @@ impl<'a, D: Dim> Placer<'a, '_, D> {
             let x = D::vec_to3(grid.node_position(grid.node_ijk(i)));
             let at: [f64; 3] = std::array::from_fn(|a| x[a] - offset[a]);
             let (phi, normal, deepest) = body.spec.distance(at, D::N);
-            if phi > 0.0 {
+            // Not a node whose soil lies against a face a thin body is driven away from.
+            if phi > 0.0 || self.side.lets_go(b, grid, i, normal) {
                 continue;
             }
             let part = surface.and_then(|s| s.bearing_part(x)).unwrap_or(deepest);
@@ -355,6 +365,10 @@ impl<'a, D: Dim> Placer<'a, '_, D> {
             let (mut soil_weight, mut weight) = (0.0, 0.0);
             for_each_node::<D, S>(grid, x, |i, w, _| {
                 if w <= 0.0 || !grid.carries(i, self.soil.at(i).0, st.min_node_mass) {
+                    return;
+                }
+                // Not the soil behind a face a thin body is driven away from.
+                if self.side.lets_go(b, grid, i, s.normal) {
                     return;
                 }
                 soil_weight += w;
@@ -418,8 +432,9 @@ impl<D: Dim, S: Shape> System<D> for RigidContact<D, S> {
             );
             let fix = col::<NodeFixity>(n);
             self.strength.gather(ctx);
+            self.side.gather::<D, S>(ctx, &naming);
             let soil = soil::<D, S>(ctx, &naming, &nm, &np, &nf, &fix);
-            place::<D, S>(ctx, &naming, &soil, &self.strength, &mut self.slot_of)
+            place::<D, S>(ctx, &naming, &soil, &self.strength, &self.side, &mut self.slot_of)
         };
         let bodies = &ctx.model.bodies;
         let velocities: Vec<[f64; 3]> = ctx.state.control.bodies.iter().map(|b| b.velocity).collect();

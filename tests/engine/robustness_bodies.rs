@@ -81,6 +81,56 @@ fn a_smooth_body_pulled_off_the_soil_carries_nothing() {
     assert!(s.curve.iter().all(|c| c.force == [0.0; 3]), "{:?}", s.curve);
 }
 
+/// The same strip thinner than the B-splines' reach from both its faces (three cells: 0.4,
+/// 0.25 and 0.125 m at h = 0.25 m) pulled 4 cm up off the clay: the nodes inside it and
+/// above its top carry the clay beyond its far face, and without reading which face that
+/// clay lies against the strip dragged it along (1.7 to 9.6 kN/m, docs/verification.md).
+/// It carries nothing at any static state.
+#[test]
+fn a_strip_thinner_than_the_shapes_reach_pulled_off_the_soil_carries_nothing() {
+    for top in ["4.4", "4.25", "4.125"] {
+        let text = edited(
+            "footing_rigid.ron",
+            &[
+                ("cells: [24, 18]", "cells: [24, 20]"),
+                (
+                    "velocity: [0.0, -0.01], travel: 0.1",
+                    "velocity: [0.0, 0.01], travel: 0.04",
+                ),
+                ("[1.0, 4.5], [-1.0, 4.5]", &format!("[1.0, {top}], [-1.0, {top}]")),
+            ],
+        );
+        let s = common::run_text("thin_up.ron", &text);
+        assert!(s.converged, "top {top}: {:?}", s.error);
+        assert_eq!(s.curve.len(), 4, "top {top}");
+        assert!(
+            s.curve.iter().all(|c| c.force == [0.0; 3]),
+            "top {top}: {:?}",
+            s.curve
+        );
+    }
+}
+
+/// A smooth wall a cell thick (0.2 m at h = 0.2 m) moved 4 cm away from weightless c–φ soil
+/// (c = 10 kPa, φ = 30°, only in front of it), which stands unsupported: it carries
+/// nothing. Its back face's samples and the nodes inside it reach the soil in front, and
+/// pulled on it with −2.7 to −2.8 kN/m while they held it.
+#[test]
+fn a_wall_a_cell_thick_moved_away_from_soil_that_stands_unsupported_carries_nothing() {
+    let s = common::run(
+        "passive_wall_cphi.ron",
+        &[
+            "grid.cell_size=0.2",
+            "grid.cells=[65, 25]",
+            r#"bodies=[(material: "soil", region: Box(min: [0.0, 0.0], max: [10.0, 4.0]), points_per_cell: [2, 2])]"#,
+            r#"rigid_bodies=[(name: "wall", parts: [(name: "face", geometry: Polygon(vertices: [[-0.2, 2.0], [0.0, 2.0], [0.0, 4.6], [-0.2, 4.6]]))], interface: Smooth, motion: (velocity: [-0.01, 0.0], travel: 0.04, increment: 0.01), area: 2.0)]"#,
+        ],
+    );
+    assert!(s.converged, "{:?}", s.error);
+    assert_eq!(s.curve.len(), 4);
+    assert!(s.curve.iter().all(|c| c.force == [0.0; 3]), "{:?}", s.curve);
+}
+
 /// A scene whose only rigid body holds its place applies no load: refused as such rather
 /// than run to max_steps with K_F undefined.
 #[test]
