@@ -323,7 +323,7 @@ impl<'a, D: Dim> Placer<'a, '_, D> {
             let at: [f64; 3] = std::array::from_fn(|a| x[a] - offset[a]);
             let (phi, normal, deepest) = body.spec.distance(at, D::N);
             // Not a node whose soil lies against a face a thin body is driven away from.
-            if phi > 0.0 || self.side.lets_go(b, grid, i, normal) {
+            if phi > 0.0 || self.side.lets_go(b, i, normal) {
                 continue;
             }
             let part = surface.and_then(|s| s.bearing_part(x)).unwrap_or(deepest);
@@ -368,7 +368,7 @@ impl<'a, D: Dim> Placer<'a, '_, D> {
                     return;
                 }
                 // Not the soil behind a face a thin body is driven away from.
-                if self.side.lets_go(b, grid, i, s.normal) {
+                if self.side.lets_go(b, i, s.normal) {
                     return;
                 }
                 soil_weight += w;

@@ -58,25 +58,21 @@ pub struct SoilSide {
 /// The sums N_i over a box of nodes (ids of the grid that names the contacts' nodes).
 #[derive(Debug, Default)]
 struct Table {
-    /// The box's lowest node (i, j, k).
-    lo: [usize; 3],
-    /// Nodes along each axis.
-    len: [usize; 3],
-    /// N_i (kg, x y z), x fastest.
+    /// Per node id, its index in `sums` (`u32::MAX`: outside the box).
+    index: Vec<u32>,
+    /// The box's node ids, in the order of `sums` (x fastest).
+    nodes: Vec<usize>,
+    /// N_i (kg, x y z).
     sums: Vec<[f64; 3]>,
     /// The direction the body is driven along (x y z, not unit).
     drive: [f64; 3],
 }
 
 impl Table {
-    /// The index of node (i, j, k) in `sums`, `None` outside the box.
-    fn index(&self, ijk: [usize; 3]) -> Option<usize> {
-        let mut k = 0;
-        for a in (0..3).rev() {
-            let d = ijk[a].checked_sub(self.lo[a]).filter(|&d| d < self.len[a])?;
-            k = k * self.len[a] + d;
-        }
-        Some(k)
+    /// N_i at node `i` (id), `None` outside the box.
+    fn at(&self, i: usize) -> Option<[f64; 3]> {
+        let k = *self.index.get(i)?;
+        (k != u32::MAX).then(|| self.sums[k as usize])
     }
 }
 
@@ -102,24 +98,37 @@ impl SoilSide {
         let reach = 0.5 * S::SUPPORT as f64 * h;
         for (b, body) in bodies.iter().enumerate() {
             let table = &mut self.tables[b];
+            for &i in &table.nodes {
+                table.index[i] = u32::MAX;
+            }
+            table.nodes.clear();
             table.sums.clear();
             let Some(drive) = drives[b] else { continue };
             table.drive = drive;
             let offset = ctx.state.control.bodies[b].offset;
             let (lo, hi) = body.spec.bounds(D::N);
             let o = D::vec_to3(grid.origin);
-            for a in 0..3 {
-                if a < D::N {
-                    let first = ((lo[a] + offset[a] - reach - o[a]) / h).floor().max(0.0) as usize;
-                    let last = (((hi[a] + offset[a] + reach - o[a]) / h).ceil().max(0.0) as usize)
-                        .min(grid.nodes[a] - 1);
-                    table.lo[a] = first.min(last);
-                    table.len[a] = last + 1 - table.lo[a];
-                } else {
-                    (table.lo[a], table.len[a]) = (0, 1);
+            // The nodes within half the support of the body's bounds.
+            let range = |a: usize| {
+                if a >= D::N {
+                    return 0..1;
+                }
+                let first = ((lo[a] + offset[a] - reach - o[a]) / h).floor().max(0.0) as usize;
+                let last = (((hi[a] + offset[a] + reach - o[a]) / h).ceil().max(0.0) as usize)
+                    .min(grid.nodes[a] - 1);
+                first.min(last)..last + 1
+            };
+            table.index.resize(grid.node_count(), u32::MAX);
+            for k in range(2) {
+                for j in range(1) {
+                    for i in range(0) {
+                        let id = grid.node_id([i, j, k]);
+                        table.index[id] = table.nodes.len() as u32;
+                        table.nodes.push(id);
+                    }
                 }
             }
-            table.sums.resize(table.len.iter().product(), [0.0; 3]);
+            table.sums.resize(table.nodes.len(), [0.0; 3]);
             let near = |x: [f64; 3]| {
                 (0..D::N).all(|a| {
                     x[a] >= lo[a] + offset[a] - 2.0 * reach && x[a] <= hi[a] + offset[a] + 2.0 * reach
@@ -135,8 +144,9 @@ impl SoilSide {
                     let at: [f64; 3] = std::array::from_fn(|a| x3[a] - offset[a]);
                     let (_, n, _) = body.spec.distance(at, D::N);
                     for_each_node::<D, S>(grid, x.0, |i, w, _| {
-                        if let Some(k) = table.index(grid.node_ijk(i)) {
-                            let s = &mut table.sums[k];
+                        let k = table.index[i];
+                        if k != u32::MAX {
+                            let s = &mut table.sums[k as usize];
                             (0..3).for_each(|a| s[a] += w * m.0 * n[a]);
                         }
                     });
@@ -150,14 +160,13 @@ impl SoilSide {
     /// the grid [`SoilSide::gather`] was given) lets the node go: the body is thin and
     /// driven away from the faces the node's soil lies against, which are turned from
     /// `normal` by more than about 105°. False wherever nothing was summed.
-    pub fn lets_go<D: Dim>(&self, body: usize, grid: &Grid<D>, node: usize, normal: [f64; 3]) -> bool {
-        let Some(table) = self.tables.get(body).filter(|t| !t.sums.is_empty()) else {
+    pub fn lets_go(&self, body: usize, node: usize, normal: [f64; 3]) -> bool {
+        let Some(table) = self.tables.get(body) else {
             return false;
         };
-        let Some(k) = table.index(grid.node_ijk(node)) else {
+        let Some(s) = table.at(node) else {
             return false;
         };
-        let s = table.sums[k];
         let dot = |a: [f64; 3]| s[0] * a[0] + s[1] * a[1] + s[2] * a[2];
         let size = dot(s).sqrt();
         dot(table.drive) < 0.0 && dot(normal) < OPPOSED * size
