@@ -51,7 +51,7 @@ pub struct SoilSide {
     /// Per body, the direction it is driven along (its motion's velocity or its load) when
     /// it is thin and driven; found at the first step.
     drives: Option<Vec<Option<[f64; 3]>>>,
-    /// Per body, this step's sums (empty for a body that is not thin).
+    /// Per body, this step's sums (empty for a body that is not thin and driven).
     tables: Vec<Table>,
 }
 
