@@ -36,7 +36,7 @@
 use crate::components::*;
 use crate::context::Context;
 use crate::dim::Dim;
-use crate::grid::Grid;
+use crate::grid::{Grid, NodeBox};
 use crate::infra::columns::{col, points_with};
 use crate::rigid::RigidBody;
 use crate::shape::{for_each_node, Shape};
@@ -60,7 +60,7 @@ pub struct SoilSide {
 struct Table {
     /// Per node id, its index in `sums` (`u32::MAX`: outside the box).
     index: Vec<u32>,
-    /// The box's node ids, in the order of `sums` (x fastest).
+    /// The box's node ids, in the order of `sums` (ascending).
     nodes: Vec<usize>,
     /// N_i (kg, x y z).
     sums: Vec<[f64; 3]>,
@@ -109,24 +109,20 @@ impl SoilSide {
             let (lo, hi) = body.spec.bounds(D::N);
             let o = D::vec_to3(grid.origin);
             // The nodes within half the support of the body's bounds.
-            let range = |a: usize| {
-                if a >= D::N {
-                    return 0..1;
-                }
+            let mut nodes = NodeBox {
+                lo: [0; 3],
+                hi: [1; 3],
+            };
+            for a in 0..D::N {
                 let first = ((lo[a] + offset[a] - reach - o[a]) / h).floor().max(0.0) as usize;
                 let last = (((hi[a] + offset[a] + reach - o[a]) / h).ceil().max(0.0) as usize)
                     .min(grid.nodes[a] - 1);
-                first.min(last)..last + 1
-            };
+                (nodes.lo[a], nodes.hi[a]) = (first.min(last), last + 1);
+            }
             table.index.resize(grid.node_count(), u32::MAX);
-            for k in range(2) {
-                for j in range(1) {
-                    for i in range(0) {
-                        let id = grid.node_id([i, j, k]);
-                        table.index[id] = table.nodes.len() as u32;
-                        table.nodes.push(id);
-                    }
-                }
+            for id in nodes.rows(grid).flatten() {
+                table.index[id] = table.nodes.len() as u32;
+                table.nodes.push(id);
             }
             table.sums.resize(table.nodes.len(), [0.0; 3]);
             let near = |x: [f64; 3]| {
