@@ -6,7 +6,9 @@
 //! over the free axes, the least change of kinetic energy that makes it; the impulse the
 //! soil takes is Σ m̃_i Δv_i. The nodes inside a body hold their normal velocity as
 //! constraints of their own (without them a node that only a point's tail reaches, inside
-//! the body, runs into it under a confining stress). The constraints are visited in a
+//! the body, runs into it under a confining stress). Where the soil's surface stands off
+//! the body's, a constraint lets it approach as fast as closes that gap in a step
+//! ([`Contact::closing`], [`crate::systems::soil_gap`]). The constraints are visited in a
 //! fixed order (projected Gauss–Seidel: the normal impulse summed per constraint stays
 //! ≥ 0, a surface sample's tangential one within tan δ times the normal impulse it leans
 //! on plus the adhesion cap) until no sweep changes a contact's velocity by more than
@@ -53,6 +55,8 @@ pub struct Contact {
     pub body: usize,
     /// Index of the part in the body.
     pub part: usize,
+    /// Where the constraint stands (m, x y z): the sample's place, or the node's.
+    pub at: [f64; 3],
     /// Unit outward normal of the body (x y z).
     pub normal: [f64; 3],
     /// Friction coefficient tan δ of the sample's part (a rough part's: the soil's tan φ
@@ -71,6 +75,10 @@ pub struct Contact {
     pub normal_impulse: f64,
     /// Impulse on the soil so far (N s, x y z).
     pub impulse: [f64; 3],
+    /// How fast the soil may still approach the body here (m/s): the gap between the
+    /// soil's surface and the body's over Δt, zero where the soil touches
+    /// ([`crate::systems::soil_gap`]).
+    pub closing: f64,
 }
 
 /// A node some sample reaches: its id, velocity (as solved so far and at the start),
@@ -316,7 +324,8 @@ fn contested(
 
 /// Projected Gauss–Seidel over the samples, each normal impulse starting at its value in
 /// `memory` (zero when it has none; the tangential ones at zero): no entry into a body
-/// moving at `body_velocity` (m/s, per body), then friction (each sample's
+/// moving at `body_velocity` (m/s, per body) faster than the soil's gap closes
+/// ([`Contact::closing`]), then friction (each sample's
 /// [`Contact::friction`] and [`Contact::adhesion`]) where a sample presses; until no sweep
 /// changes a contact's velocity by more than `tolerance` of the solve's scale
 /// ([`TOLERANCE`] by default).
@@ -348,7 +357,7 @@ pub fn solve(set: &mut Contacts, body_velocity: &[[f64; 3]], memory: &Memory, to
         let v = velocity(of(c), slots);
         let vb = body_velocity[p.body];
         let rel: [f64; 3] = std::array::from_fn(|a| v[a] - vb[a]);
-        reference = reference.max(-dot(rel, p.normal));
+        reference = reference.max(-dot(rel, p.normal) - p.closing);
     }
     let mut first = None;
     // Warm start: each contact's normal impulse of the last solve, applied at once, but
@@ -384,8 +393,9 @@ pub fn solve(set: &mut Contacts, body_velocity: &[[f64; 3]], memory: &Memory, to
             }
             let v = velocity(terms, slots);
             let rel: [f64; 3] = std::array::from_fn(|a| v[a] - vb[a]);
-            // The normal impulse stays ≥ 0 in total: a sample only pushes.
-            let delta = (-dot(rel, n)).max(-p.normal_impulse / mass);
+            // The soil may close its gap, no more; the normal impulse stays ≥ 0 in total:
+            // a sample only pushes.
+            let delta = (-dot(rel, n) - p.closing).max(-p.normal_impulse / mass);
             largest = largest.max(delta.abs());
             if delta != 0.0 {
                 p.normal_impulse += delta * mass;

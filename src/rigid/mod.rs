@@ -37,6 +37,19 @@ pub use reach::Reach;
 use crate::error::Refusal;
 use serde::{Deserialize, Serialize};
 
+/// Where a body's contacts take the soil's surface to be (`soil_surface` of a rigid body
+/// in a scene).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum SoilSurface {
+    /// Wherever soil reaches the nodes a constraint holds: the soil there is held off the
+    /// body whether its points touch the body or not.
+    #[default]
+    Nodes,
+    /// At the surface of the soil's points in front of a constraint: soil that stands off
+    /// the body may come back until its points' surface meets the body's.
+    Points,
+}
+
 /// A rigid body as the scene gives it.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -53,6 +66,11 @@ pub struct RigidBodySpec {
     /// let it go (`Released`, [`corners`]).
     #[serde(default)]
     pub corners: Corners,
+    /// Where its contacts take the soil's surface to be: where soil reaches the nodes they
+    /// hold (`Nodes`, the default) or at the surface of the soil's points in front of them
+    /// (`Points`, [`crate::systems::soil_gap`]).
+    #[serde(default)]
+    pub soil_surface: SoilSurface,
     /// How it moves; without one the body holds its place (a rigid base, a wall at rest)
     /// and its reaction is recorded at every static state another control reaches.
     #[serde(default)]

@@ -478,6 +478,10 @@ fn describe_bodies(bodies: &[RigidBody]) -> Vec<String> {
                 crate::rigid::Corners::Held => "",
                 crate::rigid::Corners::Released => ", corners released",
             };
+            let corners = match b.soil_surface {
+                crate::rigid::SoilSurface::Nodes => corners.to_string(),
+                crate::rigid::SoilSurface::Points => format!("{corners}, soil's surface from its points"),
+            };
             format!(
                 "\"{}\": {} part(s), {samples} contact samples, {:?} interface{corners}, {control}{filters}{cpt}",
                 b.name,

@@ -40,6 +40,7 @@ pub mod remap_contact;
 pub mod rigid_contact;
 pub mod rigid_control;
 pub mod shared;
+pub mod soil_gap;
 pub mod soil_side;
 pub mod soil_strength;
 pub mod spatial_sort;

@@ -44,6 +44,7 @@ use crate::schedule::System;
 use crate::shape::{for_each_node, Shape};
 use crate::systems::exchange::{exchange, EXTERNAL, FORCE, MASS, MOMENTUM};
 use crate::systems::shared::{constrain, hold, Hold};
+use crate::systems::soil_gap::SoilGap;
 use crate::systems::soil_side::SoilSide;
 use crate::systems::soil_strength::SoilStrength;
 use std::marker::PhantomData;
@@ -60,6 +61,8 @@ pub struct RigidContact<D: Dim, S> {
     /// Which face of a thin driven body the soil at its nodes lies against, summed again
     /// each step.
     side: SoilSide,
+    /// How far the soil's surface stands off each body's, found again each step.
+    gap: SoilGap,
     _marker: PhantomData<fn() -> (D, S)>,
 }
 
@@ -69,6 +72,7 @@ impl<D: Dim, S> Default for RigidContact<D, S> {
             slot_of: Vec::new(),
             strength: SoilStrength::default(),
             side: SoilSide::default(),
+            gap: SoilGap::default(),
             _marker: PhantomData,
         }
     }
@@ -332,6 +336,7 @@ impl<'a, D: Dim> Placer<'a, '_, D> {
                 key: key(b, false, i),
                 body: b,
                 part,
+                at: x,
                 normal,
                 friction: 0.0,
                 adhesion: 0.0,
@@ -340,6 +345,7 @@ impl<'a, D: Dim> Placer<'a, '_, D> {
                 weight: 1.0,
                 normal_impulse: 0.0,
                 impulse: [0.0; 3],
+                closing: 0.0,
             });
         }
     }
@@ -401,6 +407,7 @@ impl<'a, D: Dim> Placer<'a, '_, D> {
                 key: key(b, true, index),
                 body: b,
                 part: *part,
+                at: x3,
                 normal: s.normal,
                 friction,
                 adhesion: adhesion * area * st.dt,
@@ -409,7 +416,33 @@ impl<'a, D: Dim> Placer<'a, '_, D> {
                 weight,
                 normal_impulse: 0.0,
                 impulse: [0.0; 3],
+                closing: 0.0,
             });
+        }
+    }
+}
+
+impl<D: Dim, S> RigidContact<D, S> {
+    /// Each contact's [`Contact::closing`] for the bodies with `soil_surface: Points`: the
+    /// least gap of the soil's points in front of it, over every rank's points, over Δt;
+    /// zero where the soil touches, where no point is in front of it, and for the other
+    /// bodies.
+    fn closing(&mut self, ctx: &Context<D>, naming: &Grid<D>, set: &mut Contacts) {
+        // The same on every rank: each places every contact of every body.
+        if set.contacts.is_empty() || !SoilGap::wanted(ctx) {
+            return;
+        }
+        self.gap.gather(ctx);
+        let h = naming.cell_size;
+        // −(least gap), so that one reduction (max) takes the least over the ranks.
+        let mut far: Vec<f64> = (set.contacts.iter())
+            .map(|p| -self.gap.least(p.body, p.at, p.normal, h))
+            .collect();
+        ctx.comm.max(&mut far);
+        let dt = ctx.numerics.dt;
+        for (p, g) in set.contacts.iter_mut().zip(far) {
+            let g = -g;
+            p.closing = if g.is_finite() && g > 0.0 { g / dt } else { 0.0 };
         }
     }
 }
@@ -436,6 +469,8 @@ impl<D: Dim, S: Shape> System<D> for RigidContact<D, S> {
             let soil = soil::<D, S>(ctx, &naming, &nm, &np, &nf, &fix);
             place::<D, S>(ctx, &naming, &soil, &self.strength, &self.side, &mut self.slot_of)
         };
+        let dt = ctx.numerics.dt;
+        self.closing(ctx, &naming, &mut set);
         let bodies = &ctx.model.bodies;
         let velocities: Vec<[f64; 3]> = ctx.state.control.bodies.iter().map(|b| b.velocity).collect();
         let tolerance = ctx.numerics.contact_tolerance;
@@ -446,7 +481,6 @@ impl<D: Dim, S: Shape> System<D> for RigidContact<D, S> {
             tolerance,
         );
         ctx.state.control.contact_memory = remember(&set.contacts);
-        let dt = ctx.numerics.dt;
         let n = nodes(&ctx.world);
         let mut nf = col_mut::<NodeForce<D::Vec>>(n);
         let mut ne = col_mut::<NodeExternalForce<D::Vec>>(n);
