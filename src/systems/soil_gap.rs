@@ -31,10 +31,11 @@
 //! are not all real (at the cone's apex at D/4, 3.5 cm, a seventh of a cell, beside soil
 //! that the cone pushes), so their static states scatter more (docs/verification.md,
 //! "The rigid footing under load control"). A body with `Nodes` is not looked at, and
-//! its contacts keep their bits. The least
-//! d_p of a set of points does not depend on the order they are visited in: the same on
-//! any thread count, and over several ranks each rank takes the least of its own points
-//! and one reduction the least of all.
+//! its contacts keep their bits.
+//!
+//! The least d_p of a set of points does not depend on the order they are visited in:
+//! the same on any thread count, and over several ranks each rank takes the least of its
+//! own points and one reduction the least of all.
 
 use crate::components::*;
 use crate::context::Context;
