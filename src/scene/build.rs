@@ -478,12 +478,12 @@ fn describe_bodies(bodies: &[RigidBody]) -> Vec<String> {
                 crate::rigid::Corners::Held => "",
                 crate::rigid::Corners::Released => ", corners released",
             };
-            let corners = match b.soil_surface {
-                crate::rigid::SoilSurface::Nodes => corners.to_string(),
-                crate::rigid::SoilSurface::Points => format!("{corners}, soil's surface from its points"),
+            let surface = match b.soil_surface {
+                crate::rigid::SoilSurface::Nodes => "",
+                crate::rigid::SoilSurface::Points => ", soil's surface from its points",
             };
             format!(
-                "\"{}\": {} part(s), {samples} contact samples, {:?} interface{corners}, {control}{filters}{cpt}",
+                "\"{}\": {} part(s), {samples} contact samples, {:?} interface{corners}{surface}, {control}{filters}{cpt}",
                 b.name,
                 b.parts.len(),
                 b.interface

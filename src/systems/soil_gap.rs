@@ -172,8 +172,9 @@ impl SoilGap {
             return f64::INFINITY;
         };
         let (depth, beside) = (DEPTH * h, BESIDE * h);
-        // The cells within DEPTH + 1 cells of the constraint hold every point in front of it.
-        let reach = DEPTH.ceil() as usize + 1;
+        // A point in front of the constraint lies within √(DEPTH² + BESIDE²) cells of it
+        // (one behind it within √(1 + BESIDE²)): the cells that many away hold them all.
+        let reach = DEPTH.hypot(BESIDE).ceil() as usize;
         let mut range = [(0, 0); 3];
         for a in 0..f.n {
             let t = ((at[a] - f.lo[a]) * f.inv_h).floor() as i64;
