@@ -72,6 +72,10 @@ struct Front {
     start: Vec<u32>,
     /// Place (m) and gap d_p (m) of each point, cell by cell.
     points: Vec<([f64; 3], f64)>,
+    /// Scratch kept between steps: the points found, with their cells, in the order
+    /// found, and each cell's next free place while they are sorted.
+    found: Vec<(usize, [f64; 3], f64)>,
+    next: Vec<u32>,
 }
 
 impl Front {
@@ -127,7 +131,7 @@ impl SoilGap {
                     (f.lo[a], f.cells[a]) = (0.0, 1);
                 }
             }
-            let mut found: Vec<(usize, [f64; 3], f64)> = Vec::new();
+            f.found.clear();
             for arch in points_with::<Volume>(&ctx.world) {
                 let (xs, vs) = (col::<Position<D::Vec>>(arch), col::<Volume>(arch));
                 for (x, v) in xs.iter().zip(vs.iter()) {
@@ -142,24 +146,25 @@ impl SoilGap {
                     // axisymmetric (as volumes are), to the 1/n.
                     let size = if D::AXISYMMETRIC { v.0 / x3[0] } else { v.0 };
                     let r = 0.5 * size.powf(1.0 / D::N as f64);
-                    found.push((f.index(c), x3, phi - r));
+                    let k = f.index(c);
+                    f.found.push((k, x3, phi - r));
                 }
             }
             // By cell, in the order found within each (a counting sort).
             let count = f.cells.iter().product::<usize>();
             f.start.clear();
             f.start.resize(count + 1, 0);
-            for &(c, _, _) in &found {
+            for &(c, _, _) in &f.found {
                 f.start[c + 1] += 1;
             }
             for c in 0..count {
                 f.start[c + 1] += f.start[c];
             }
-            let mut next = f.start.clone();
-            f.points.resize(found.len(), ([0.0; 3], 0.0));
-            for (c, x, d) in found {
-                f.points[next[c] as usize] = (x, d);
-                next[c] += 1;
+            f.next.clone_from(&f.start);
+            f.points.resize(f.found.len(), ([0.0; 3], 0.0));
+            for &(c, x, d) in &f.found {
+                f.points[f.next[c] as usize] = (x, d);
+                f.next[c] += 1;
             }
         }
     }
