@@ -121,3 +121,42 @@ fn a_smooth_strip_footing_on_c_phi_soil_reaches_prandtl_reissner() {
     assert!(rel(limit, exact).abs() < 0.03, "{limit} Pa against {exact}");
     assert_eq!(s.curve.len(), 10, "ten increments, ten static states");
 }
+
+/// A weightless soil's load–settlement curve in small strain depends on the stiffness only
+/// through δ E/(c B): the equations of a perfectly plastic soil are homogeneous in the
+/// displacement scaled by c/E, whatever the flow rule, so a soil 20 times stiffer bears
+/// the same pressure at a twentieth of the settlement. The c–φ footing with ψ = 0 (the
+/// non-associated soil, `scenes/footing_cphi.ron`, tolerance 1e-3): E = 10 MPa pushed
+/// 2 and 4 cm reads 68.78 and 99.56 kPa; E = 200 MPa pushed 1 and 2 mm reads 69.05 and
+/// 99.52 kPa (+0.4 %, −0.04 %). So a soft soil's "limit" read at a fixed travel is a point
+/// early on the stiff soil's curve: at E = 10 MPa the scene's 0.2 m is E = 200 MPa's 1 cm
+/// (docs/verification.md, "Non-associated flow").
+#[test]
+fn a_stiffer_soil_bears_the_same_pressure_at_a_proportionally_smaller_settlement() {
+    // The pressure at each static state of the footing with ψ = 0, relaxed to 1e-3.
+    let pressures = |overrides: &[&str]| -> Vec<f64> {
+        let common = ["materials.soil.dilatancy_angle=0.0", "solver.tolerance=0.001"];
+        let s = run("footing_cphi.ron", &[&common[..], overrides].concat());
+        assert!(s.converged, "{:?}", s.error);
+        s.curve.iter().map(|r| r.pressure.unwrap()).collect()
+    };
+    let soft = pressures(&["motions[0].travel=0.04", "motions[0].increment=0.02"]);
+    let stiff = pressures(&[
+        "materials.soil.youngs_modulus=200.0e6",
+        "motions[0].travel=0.002",
+        "motions[0].increment=0.001",
+    ]);
+    // Deterministic runs: pinned to what they give, to round-off.
+    let pinned = [68780.55549, 99560.71252, 69052.36204, 99523.93525];
+    let got: Vec<f64> = soft.iter().chain(&stiff).copied().collect();
+    assert_eq!(got.len(), 4, "two increments each, two static states each");
+    for (got, pinned) in got.iter().zip(pinned) {
+        assert!(rel(*got, pinned).abs() < 1e-9, "{got} Pa, pinned at {pinned}");
+    }
+    for (soft, stiff) in soft.iter().zip(&stiff) {
+        assert!(
+            rel(*stiff, *soft).abs() < 0.01,
+            "{stiff} Pa at δ/20 against {soft} Pa at δ"
+        );
+    }
+}
