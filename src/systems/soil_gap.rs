@@ -72,9 +72,11 @@ struct Front {
     start: Vec<u32>,
     /// Place (m) and gap d_p (m) of each point, cell by cell.
     points: Vec<([f64; 3], f64)>,
-    /// Scratch kept between steps: the points found, with their cells, in the order
-    /// found, and each cell's next free place while they are sorted.
+    /// Scratch kept between steps: the points found (cell, place, gap), in the order
+    /// found.
     found: Vec<(usize, [f64; 3], f64)>,
+    /// Scratch kept between steps: each cell's next free place in `points` while the
+    /// found points are sorted into it.
     next: Vec<u32>,
 }
 
