@@ -34,7 +34,8 @@
 //! (`RETURNS`), the last of which scales the deviator at the cell's mean instead. Both
 //! systems group the points by the cell that holds them when they run: in USL and MUSL
 //! after the points moved, in USF before,
-//! the same cells in both, and those of the next particle-to-grid.
+//! the same cells in both, and those of the next particle-to-grid. The points that carry a
+//! traction take no part and keep their own rate and stress ([`averaged_points`]).
 //!
 //! A quadratic B-spline's velocity gradient varies within a cell, so with one volumetric
 //! strain rate a cell the in-cell variation of the normal strains goes into the points'
@@ -43,13 +44,14 @@
 //! grid the soil creeps (docs/verification.md, "Why the cell means move the sand at rest").
 //!
 //! [`Material::admits`]: crate::materials::Material::admits
+//! [`averaged_points`]: crate::systems::shared::averaged_points
 
 use crate::components::*;
 use crate::context::Context;
 use crate::dim::Dim;
 use crate::error::StepError;
 use crate::grid::Grid;
-use crate::infra::columns::{col, col_mut, points_with};
+use crate::infra::columns::{col, col_mut};
 use crate::infra::decomposition::{ACROSS, SLAB};
 use crate::materials::{visit_states, MaterialModel, MaterialState, StateVisitor};
 use crate::parallel::CHUNK;
@@ -57,6 +59,7 @@ use crate::schedule::System;
 use crate::shape::Shape;
 use crate::systems::exchange::band_boxes;
 use crate::systems::node_pairs::{set_volumetric_rates, NodePairs};
+use crate::systems::shared::averaged_points;
 use crate::tensor::{StoredSym, Sym3};
 use hecs::Archetype;
 use rayon::prelude::*;
@@ -148,7 +151,7 @@ impl<D: Dim, S: Shape> CellMean<D, S> {
     /// Σ_{p∈c} V_p q_p and Σ_{p∈c} V_p over every stressed point, then their ratio.
     fn means<Q: Send + Sync + 'static>(&mut self, ctx: &mut Context<D>, q: impl Fn(&Q) -> f64 + Sync) {
         let grid = &ctx.grid;
-        for arch in points_with::<Volume>(&ctx.world) {
+        for arch in averaged_points::<D>(&ctx.world) {
             let (xg, vg, qg) = (col::<Position<D::Vec>>(arch), col::<Volume>(arch), col::<Q>(arch));
             let (vol, qs): (&[Volume], &[Q]) = (&vg, &qg);
             self.sums
@@ -164,7 +167,7 @@ impl<D: Dim, S: Shape> CellMean<D, S> {
     fn strain(&mut self, ctx: &mut Context<D>) {
         self.means::<VelocityGradient<D::Mat>>(ctx, |l| D::volumetric_rate(&l.0));
         let (grid, sums) = (&ctx.grid, &self.sums);
-        set_volumetric_rates::<D>(&ctx.world, |x| sums.of_cell(grid, x)[0]);
+        set_volumetric_rates::<D>(averaged_points::<D>(&ctx.world), |x| sums.of_cell(grid, x)[0]);
     }
 
     /// σ_p ← σ_p + (m̄_c − m_p) I_n, and where the point's strength does not admit that,
@@ -182,7 +185,7 @@ impl<D: Dim, S: Shape> CellMean<D, S> {
             let (dirty, sums) = (&mut self.dirty, &mut self.sums);
             dirty.resize(grid.node_count(), false);
             let mut cells = Vec::new();
-            for (arch, points) in points_with::<Volume>(&ctx.world).zip(&returned) {
+            for (arch, points) in averaged_points::<D>(&ctx.world).zip(&returned) {
                 let x = col::<Position<D::Vec>>(arch);
                 for &p in points {
                     let key = grid.cell_key(x[p as usize].0);
@@ -205,7 +208,7 @@ impl<D: Dim, S: Shape> CellMean<D, S> {
                 self.index.build(&ctx.world, grid);
             }
             let index = &self.index;
-            let guards: Vec<_> = points_with::<Volume>(&ctx.world)
+            let guards: Vec<_> = averaged_points::<D>(&ctx.world)
                 .map(|arch| (col::<Volume>(arch), col::<Stress<D::Stress>>(arch)))
                 .collect();
             let columns: Vec<_> = guards.iter().map(|(v, s)| (&v[..], &s[..])).collect();
@@ -244,7 +247,7 @@ impl<D: Dim, S: Shape> CellMean<D, S> {
     /// One round of the projection over every archetype: all their points, or `only` those
     /// listed; the points returned, by archetype.
     fn project(&self, ctx: &Context<D>, only: Option<&[Vec<u32>]>, last: bool) -> Vec<Vec<u32>> {
-        points_with::<Volume>(&ctx.world)
+        averaged_points::<D>(&ctx.world)
             .enumerate()
             .map(|(a, arch)| {
                 let mut project = Project::<D> {
@@ -288,7 +291,7 @@ impl CellPoints {
         let n = grid.node_count();
         self.keys.clear();
         self.ends.clear();
-        for arch in points_with::<Volume>(world) {
+        for arch in averaged_points::<D>(world) {
             let x = col::<Position<D::Vec>>(arch);
             let from = self.keys.len();
             self.keys.resize(from + x.len(), 0);

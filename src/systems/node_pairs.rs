@@ -3,17 +3,17 @@
 //! and a maximum (mass scaling); or two sums a cell, kept at the cell's lowest node (the
 //! cell means against locking). Shared by the systems that need such a field for one step.
 
-use crate::components::{Position, VelocityGradient, Volume};
+use crate::components::{Position, VelocityGradient};
 use crate::dim::Dim;
 use crate::grid::{Grid, NodeBox};
-use crate::infra::columns::{col, col_mut, points_with};
+use crate::infra::columns::{col, col_mut};
 use crate::infra::comm::Comm;
 use crate::infra::decomposition::Decomposition;
 use crate::parallel::CHUNK;
 use crate::parallel::{fill_box, for_each_box_node, scatter, Disjoint, SlabCache};
 use crate::shape::{for_each_node, Shape};
 use crate::systems::exchange::share_bands;
-use hecs::World;
+use hecs::Archetype;
 use rayon::prelude::*;
 
 /// Per node a pair `[f64; 2]`, zero outside the box the points reached since the last
@@ -197,12 +197,15 @@ impl NodePairs {
     }
 }
 
-/// L_p ← L_p + (θ_p − tr L_p) I / n for every point with a volume, θ_p = `theta(x_p)`: the
-/// point's rate of volume change replaced, its deviatoric rate and spin kept (the nodal
+/// L_p ← L_p + (θ_p − tr L_p) I / n for every point of `archetypes`, θ_p = `theta(x_p)`:
+/// the point's rate of volume change replaced, its deviatoric rate and spin kept (the nodal
 /// smoothing and the cell means, n = `Dim::STRAIN_AXES`).
-pub(crate) fn set_volumetric_rates<D: Dim>(world: &World, theta: impl Fn(D::Vec) -> f64 + Sync) {
+pub(crate) fn set_volumetric_rates<'w, D: Dim>(
+    archetypes: impl Iterator<Item = &'w Archetype>,
+    theta: impl Fn(D::Vec) -> f64 + Sync,
+) {
     let n = D::STRAIN_AXES as f64;
-    for arch in points_with::<Volume>(world) {
+    for arch in archetypes {
         let xg = col::<Position<D::Vec>>(arch);
         let x: &[Position<D::Vec>] = &xg;
         let mut lg = col_mut::<VelocityGradient<D::Mat>>(arch);

@@ -43,12 +43,13 @@ use crate::context::Context;
 use crate::dim::Dim;
 use crate::error::StepError;
 use crate::grid::Grid;
-use crate::infra::columns::{col, col_mut, points_with};
+use crate::infra::columns::{col, col_mut};
 use crate::materials::{visit_states, MaterialState, StateVisitor};
 use crate::parallel::{SlabCache, CHUNK};
 use crate::schedule::System;
 use crate::shape::Shape;
 use crate::systems::node_pairs::NodePairs;
+use crate::systems::shared::averaged_points;
 use crate::tensor::{StoredSym, Sym3};
 use hecs::Archetype;
 use rayon::prelude::*;
@@ -82,7 +83,7 @@ impl<D: Dim, S: Shape> System<D> for PorePressureField<D, S> {
             return Ok(());
         }
         let water: Vec<bool> = ctx.materials.iter().map(|m| m.holds_water()).collect();
-        for arch in points_with::<Volume>(&ctx.world).filter(|a| !a.has::<PointLoad<D::Vec>>()) {
+        for arch in averaged_points::<D>(&ctx.world) {
             let mut gather = Gather::<D, S> {
                 arch,
                 grid: &ctx.grid,
@@ -98,7 +99,7 @@ impl<D: Dim, S: Shape> System<D> for PorePressureField<D, S> {
         // Every cell an undrained point is in has Σ V > 0; the others are never read.
         self.sums
             .map(grid, |s| [if s[1] > 0.0 { s[0] / s[1] } else { 0.0 }, s[1]]);
-        for arch in points_with::<Volume>(&ctx.world).filter(|a| !a.has::<PointLoad<D::Vec>>()) {
+        for arch in averaged_points::<D>(&ctx.world) {
             let mut spread = Spread::<D> {
                 arch,
                 grid,

@@ -7,6 +7,7 @@ use crate::context::Context;
 use crate::dim::{Dim, Vector};
 use crate::infra::columns::{col, col_mut, points_with};
 use crate::model::Drive;
+use hecs::{Archetype, World};
 
 /// How a node holds one axis.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -57,4 +58,15 @@ pub fn set_point_loads<D: Dim>(ctx: &Context<D>, loads: &[(u32, [f64; 3])], scal
             }
         }
     }
+}
+
+/// The points that the cell means and the undrained clay's cell pore pressure average:
+/// every point with a volume except those that carry a traction. A traction's points pass
+/// it to the grid as point forces inside their cells, so the soil's stress jumps across
+/// them, from the load below to none above: their own volumetric rate, mean stress and pore
+/// pressure sample that jump, not the soil, and each keeps its own. Averaged with the rest,
+/// they let an oedometer pressed at its top settle 12–40 % further (docs/verification.md,
+/// "A pressed surface under the volumetric treatments").
+pub fn averaged_points<D: Dim>(world: &World) -> impl Iterator<Item = &Archetype> {
+    points_with::<Volume>(world).filter(|a| !a.has::<PointLoad<D::Vec>>())
 }

@@ -68,7 +68,7 @@ impl<D: Dim, S: Shape> System<D> for VolumetricSmoothing<D, S> {
         sums.sum_over_ranks(grid, &ctx.comm, &ctx.decomposition);
         sums.map(grid, |s| [if s[1] > 0.0 { s[0] / s[1] } else { 0.0 }, 0.0]);
         let nodal = sums.pairs();
-        set_volumetric_rates::<D>(&ctx.world, |x| {
+        set_volumetric_rates::<D>(points_with::<Volume>(&ctx.world), |x| {
             let mut theta = 0.0;
             for_each_node::<D, S>(grid, x, |i, w, _| theta += w * nodal[i][0]);
             theta

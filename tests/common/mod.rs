@@ -22,7 +22,13 @@ pub fn run(name: &str, overrides: &[&str]) -> Summary {
 
 /// Runs the scene `text` (called `name` in messages) to its stop and returns the summary.
 pub fn run_text(name: &str, text: &str) -> Summary {
-    let loaded = LoadedScene::from_text(Path::new(name), text, &[]).expect("scene loads");
+    run_text_with(name, text, &[])
+}
+
+/// Runs the scene `text` (called `name` in messages) with `--set` overrides to its stop.
+pub fn run_text_with(name: &str, text: &str, overrides: &[&str]) -> Summary {
+    let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+    let loaded = LoadedScene::from_text(Path::new(name), text, &overrides).expect("scene loads");
     run_loaded(loaded)
 }
 
