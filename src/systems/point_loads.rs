@@ -2,12 +2,13 @@
 
 use crate::components::*;
 use crate::context::Context;
-use crate::dim::Dim;
+use crate::dim::{Dim, Vector};
 use crate::error::StepError;
 use crate::infra::columns::{col, col_mut, nodes, points_with};
 use crate::schedule::System;
 use crate::shape::{for_each_node, Shape};
 use crate::systems::exchange::{exchange, MASS};
+use crate::systems::shared::{hold, Hold};
 use std::marker::PhantomData;
 
 /// Spreads each point load F over the nodes of its support that carry mass, with the shape
@@ -16,6 +17,13 @@ use std::marker::PhantomData;
 /// A load point at the free end of a bar sits on the last node; once the bar stretches its
 /// support reaches the empty node beyond, where a share of F would be lost (massless nodes
 /// have no degrees of freedom). Renormalising keeps the whole load on the body.
+///
+/// Each component is spread over the nodes a prescribed motion does not drive along it: a
+/// driven node's force is the motion's reaction (`boundary`), so a share of a surcharge
+/// beside a node-driven footing that fell on its edge nodes would push the footing instead
+/// of the soil, and the footing would read that much less (−8 % of Prandtl's 151.4 kPa
+/// under a 100 kPa surcharge, docs/verification.md). A component whose every carrying node
+/// is driven (a load on the motion's own nodes) is spread over them all, as before.
 ///
 /// A point under a pressure ([`crate::SurfacePressures`]) carries −p times its share's area
 /// vector now, from its neighbours' places, instead of its set-up load.
@@ -76,6 +84,18 @@ impl<D: Dim, S: Shape> System<D> for PointLoads<D, S> {
                 .index(id)
                 .expect("a neighbour is under the pressure too")]
         };
+        let fix = col::<NodeFixity>(n);
+        let drives = &ctx.state.control.drives[..];
+        // The axes along which node `i` is driven by a motion, one bit an axis.
+        let driven = |i: usize| -> u8 {
+            if drives.is_empty() || fix[i].0 == 0 {
+                return 0;
+            }
+            (0..D::N).fold(0, |m, a| match hold(fix[i], a, drives) {
+                Hold::Driven(_) => m | 1 << a,
+                _ => m,
+            })
+        };
         for arch in points_with::<PointLoad<D::Vec>>(&ctx.world) {
             let x = col::<Position<D::Vec>>(arch);
             let load = col::<PointLoad<D::Vec>>(arch);
@@ -85,10 +105,18 @@ impl<D: Dim, S: Shape> System<D> for PointLoads<D, S> {
                     Some(k) => pressures.force::<D>(k, load[p].0, place),
                     None => load[p].0,
                 };
-                let mut carried = 0.0;
+                // The weights of the carrying nodes, all and (per axis) those not driven
+                // along it.
+                let (mut carried, mut free) = (0.0, [0.0; 3]);
                 for_each_node::<D, S>(grid, x[p].0, |i, w, _| {
                     if grid.carries(i, nm[i].0, min_mass) {
                         carried += w;
+                        let d = driven(i);
+                        for (a, free) in free.iter_mut().enumerate().take(D::N) {
+                            if d & 1 << a == 0 {
+                                *free += w;
+                            }
+                        }
                     }
                 });
                 if carried <= 0.0 {
@@ -98,11 +126,24 @@ impl<D: Dim, S: Shape> System<D> for PointLoads<D, S> {
                         position: D::vec_to3(x[p].0),
                     });
                 }
-                let f = load * (1.0 / carried);
+                // Axes along which some carrying node is free: their share skips the
+                // driven nodes; the others go to every carrying node. With no motion every
+                // axis is spread over `carried`, summed in the same order: the same bits.
+                let skip = (0..D::N).fold(0u8, |m, a| if free[a] > 0.0 { m | 1 << a } else { m });
+                let mut f = D::Vec::ZERO;
+                for a in 0..D::N {
+                    let over = if skip & 1 << a != 0 { free[a] } else { carried };
+                    f.set(a, load.get(a) * (1.0 / over));
+                }
                 for_each_node::<D, S>(grid, x[p].0, |i, w, _| {
                     if grid.carries(i, nm[i].0, min_mass) {
-                        nf[i].0 += f * w;
-                        ne[i].0 += f * w;
+                        let mut g = f * w;
+                        let off = driven(i) & skip;
+                        for a in (0..D::N).filter(|a| off & 1 << a != 0) {
+                            g.set(a, 0.0);
+                        }
+                        nf[i].0 += g;
+                        ne[i].0 += g;
                     }
                 });
             }

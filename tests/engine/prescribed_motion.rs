@@ -97,6 +97,32 @@ fn a_smooth_strip_footing_on_tresca_clay_reaches_prandtls_limit_pressure() {
     assert!(s.last_increment_rise.unwrap().abs() < 0.02);
 }
 
+/// A surcharge q beside a smooth strip footing on Tresca clay raises Prandtl's limit
+/// pressure to (2 + π) c + q (Prandtl 1920; Reissner 1924 for the surcharge): 71.42 kPa for
+/// q = 20 kPa. `scenes/footing.ron` with the surcharge as a pressure on the clay's top
+/// beside the footing reads 69.69 kPa (−2.4 %; the scene's own −2.1 % without it), pinned.
+/// The loaded points next to the footing's edge reach its driven nodes; while those nodes
+/// took a share of the surcharge, the motion's reaction lost it and the footing read
+/// 66.41 kPa (−7.0 %), and under q = 100 kPa 135.39 against 151.42 (docs/verification.md,
+/// "A surcharge beside the footing").
+#[test]
+fn a_surcharge_beside_a_driven_footing_loads_the_clay_and_not_the_footing() {
+    let (c, q) = (10.0e3, 20.0e3);
+    let exact = (2.0 + std::f64::consts::PI) * c + q;
+    let s = run(
+        "footing.ron",
+        &[r#"tractions=[(name: "q", surface: YMax, min: [1.0, 3.75], max: [6.0, 4.0], pressure: 20.0e3)]"#],
+    );
+    assert!(s.converged, "{:?}", s.error);
+    assert_eq!(s.steps, 8079);
+    let limit = s.limit_pressure.expect("the footing has an area");
+    assert!(
+        rel(limit, 69693.90383170592).abs() < 1e-9,
+        "{limit} Pa, pinned at 69 693.90 Pa"
+    );
+    assert!(rel(limit, exact).abs() < 0.03, "{limit} Pa against {exact}");
+}
+
 /// Prandtl–Reissner's limit pressure of a smooth strip footing on weightless c–φ soil,
 /// c N_c with N_c = (N_q − 1) cot φ, N_q = e^(π tan φ) tan²(45° + φ/2) (Prandtl 1920;
 /// Reissner 1924): 30.14 · 10 kPa = 301.4 kPa for φ = 30°. `scenes/footing_cphi.ron`
