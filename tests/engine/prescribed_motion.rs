@@ -70,6 +70,19 @@ fn a_motion_moving_sideways_off_its_axes_is_refused() {
     assert!(e.contains("motions[0].increment"), "{e}");
 }
 
+/// The limit pressure of a footing's deterministic run, after checking that it came to rest
+/// in `steps` steps at the `pinned` pressure (Pa), to round-off.
+fn pinned_limit(s: &kdmpm::Summary, steps: u64, pinned: f64) -> f64 {
+    assert!(s.converged, "{:?}", s.error);
+    assert_eq!(s.steps, steps);
+    let limit = s.limit_pressure.expect("the footing has an area");
+    assert!(
+        rel(limit, pinned).abs() < 1e-9,
+        "{limit} Pa, pinned at {pinned} Pa"
+    );
+    limit
+}
+
 /// Prandtl's limit pressure of a smooth strip footing on weightless Tresca clay,
 /// (2 + π) c (Prandtl 1920; Hill 1950), c = 10 kPa, against `scenes/footing.ron` (with
 /// volumetric smoothing): 50.33 kPa (−2.1 %), below Prandtl's, pinned. At h = 0.125 m the
@@ -80,14 +93,7 @@ fn a_motion_moving_sideways_off_its_axes_is_refused() {
 fn a_smooth_strip_footing_on_tresca_clay_reaches_prandtls_limit_pressure() {
     let prandtl = (2.0 + std::f64::consts::PI) * 10.0e3;
     let s = run("footing.ron", &[]);
-    // The run is deterministic: pinned to what it gives, to round-off.
-    assert!(s.converged, "{:?}", s.error);
-    assert_eq!(s.steps, 7753);
-    let limit = s.limit_pressure.expect("the footing has an area");
-    assert!(
-        rel(limit, 50328.638082202015).abs() < 1e-9,
-        "{limit} Pa, pinned at 50 328.64 Pa"
-    );
+    let limit = pinned_limit(&s, 7753, 50328.638082202015);
     assert!(
         (-0.03..0.0).contains(&rel(limit, prandtl)),
         "{limit} Pa against {prandtl}"
@@ -113,13 +119,7 @@ fn a_surcharge_beside_a_driven_footing_loads_the_clay_and_not_the_footing() {
         "footing.ron",
         &[r#"tractions=[(name: "q", surface: YMax, min: [1.0, 3.75], max: [6.0, 4.0], pressure: 20.0e3)]"#],
     );
-    assert!(s.converged, "{:?}", s.error);
-    assert_eq!(s.steps, 8079);
-    let limit = s.limit_pressure.expect("the footing has an area");
-    assert!(
-        rel(limit, 69693.90383170592).abs() < 1e-9,
-        "{limit} Pa, pinned at 69 693.90 Pa"
-    );
+    let limit = pinned_limit(&s, 8079, 69693.90383170592);
     assert!(rel(limit, exact).abs() < 0.03, "{limit} Pa against {exact}");
 }
 
@@ -137,13 +137,7 @@ fn a_smooth_strip_footing_on_c_phi_soil_reaches_prandtl_reissner() {
     let exact = 10.0e3 * (n_q - 1.0) / phi.tan();
     assert!((exact - 301.4e3).abs() < 100.0, "{exact}");
     let s = run("footing_cphi.ron", &["motions[0].velocity=[None, Some(-0.02)]"]);
-    assert!(s.converged, "{:?}", s.error);
-    assert_eq!(s.steps, 6858);
-    let limit = s.limit_pressure.expect("the footing has an area");
-    assert!(
-        rel(limit, 301186.77045319).abs() < 1e-9,
-        "{limit} Pa, pinned at 301 186.77 Pa"
-    );
+    let limit = pinned_limit(&s, 6858, 301186.77045319);
     assert!(rel(limit, exact).abs() < 0.03, "{limit} Pa against {exact}");
     assert_eq!(s.curve.len(), 10, "ten increments, ten static states");
 }
