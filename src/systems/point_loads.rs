@@ -21,9 +21,9 @@ use std::marker::PhantomData;
 /// Each component is spread over the nodes a prescribed motion does not drive along it: a
 /// driven node's force is the motion's reaction (`boundary`), so a share of a surcharge
 /// beside a node-driven footing that fell on its edge nodes would push the footing instead
-/// of the soil, and the footing would read that much less (−8 % of Prandtl's 151.4 kPa
-/// under a 100 kPa surcharge, docs/verification.md). A component whose every carrying node
-/// is driven (a load on the motion's own nodes) is spread over them all, as before.
+/// of the soil, and the footing would read too little (docs/verification.md, "A surcharge
+/// beside the footing"). A component whose every carrying node is driven (a load on the
+/// motion's own nodes) is spread over them all.
 ///
 /// A point under a pressure ([`crate::SurfacePressures`]) carries −p times its share's area
 /// vector now, from its neighbours' places, instead of its set-up load.

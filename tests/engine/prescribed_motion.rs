@@ -109,8 +109,7 @@ fn a_smooth_strip_footing_on_tresca_clay_reaches_prandtls_limit_pressure() {
 /// beside the footing reads 69.69 kPa (−2.4 %; the scene's own −2.1 % without it), pinned.
 /// The loaded points next to the footing's edge reach its driven nodes; while those nodes
 /// took a share of the surcharge, the motion's reaction lost it and the footing read
-/// 66.41 kPa (−7.0 %), and under q = 100 kPa 135.39 against 151.42 (docs/verification.md,
-/// "A surcharge beside the footing").
+/// 66.41 kPa (−7.0 %) (docs/verification.md, "A surcharge beside the footing").
 #[test]
 fn a_surcharge_beside_a_driven_footing_loads_the_clay_and_not_the_footing() {
     let (c, q) = (10.0e3, 20.0e3);
