@@ -26,8 +26,8 @@
 //! stress column holds σ′ − u I (tension positive): the grid's forces see the water, the
 //! clay's law sees σ′ = σ + u I. u is part of the point's state. K_f adds to the P-wave
 //! modulus and so shortens the time step as 1/√(M′ + K_f). In a run the points of a
-//! cell share their mean u after every update (`systems/pore_pressure_field.rs`). A K_f
-//! far below water's own
+//! cell share one rate of volume change before every update and their mean u after it
+//! (`systems/pore_pressure_field.rs`). A K_f far below water's own
 //! (2.2 GPa/n) but far above the clay's K′ holds the volume nearly constant at a step that
 //! stays practical (docs/verification.md measures the trade).
 //!

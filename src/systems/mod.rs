@@ -63,7 +63,7 @@ pub use nodal_velocity::NodalVelocity;
 pub use p2g::{P2g, P2gPart};
 pub use peak_watch::PeakWatch;
 pub use point_loads::PointLoads;
-pub use pore_pressure_field::PorePressureField;
+pub use pore_pressure_field::{PorePressureField, UndrainedStrain};
 pub use prescribed_motion::PrescribedMotion;
 pub use remap::Remap;
 pub use remap_contact::RemapContact;
@@ -356,6 +356,14 @@ fn straining<D: Dim, S: Shape>() -> Vec<Entry<D>> {
             |_, _| Box::new(CellMean::<D, S>::new(CellMeanPart::Strain)),
         ),
         e(
+            "undrained_strain",
+            St::Smooth,
+            Needed(|_, _, n| n.undrained, "a material holds undrained water"),
+            &[("kinematics", SMOOTHED), ("velocity_gradient", SMOOTHED)],
+            "cell mean of the undrained points' volumetric strain rate",
+            |_, _| Box::new(UndrainedStrain::<D, S>::default()),
+        ),
+        e(
             "stress_update",
             St::Stress,
             Always,
@@ -364,6 +372,7 @@ fn straining<D: Dim, S: Shape>() -> Vec<Entry<D>> {
                 ("velocity_gradient", STRAINED),
                 ("volumetric_smoothing", "the stress must see the smoothed strain"),
                 ("cell_mean_strain", "the stress must see the cell's strain"),
+                ("undrained_strain", "the stress must see the cell's strain"),
             ],
             "Jaumann rotation + material law",
             |_, _| Box::new(StressUpdate),

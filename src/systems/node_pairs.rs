@@ -204,16 +204,28 @@ pub(crate) fn set_volumetric_rates<'w, D: Dim>(
     archetypes: impl Iterator<Item = &'w Archetype>,
     theta: impl Fn(D::Vec) -> f64 + Sync,
 ) {
-    let n = D::STRAIN_AXES as f64;
     for arch in archetypes {
-        let xg = col::<Position<D::Vec>>(arch);
-        let x: &[Position<D::Vec>] = &xg;
-        let mut lg = col_mut::<VelocityGradient<D::Mat>>(arch);
-        lg.par_chunks_mut(CHUNK).enumerate().for_each(|(c, l)| {
-            for (k, lp) in l.iter_mut().enumerate() {
-                let shift = (theta(x[c * CHUNK + k].0) - D::volumetric_rate(&lp.0)) / n;
+        set_volumetric_rates_where::<D>(arch, |_, x| Some(theta(x)));
+    }
+}
+
+/// [`set_volumetric_rates`] in one archetype, for the points p whose `theta(p, x_p)` is
+/// `Some`; the others keep their own rate.
+pub(crate) fn set_volumetric_rates_where<D: Dim>(
+    arch: &Archetype,
+    theta: impl Fn(usize, D::Vec) -> Option<f64> + Sync,
+) {
+    let n = D::STRAIN_AXES as f64;
+    let xg = col::<Position<D::Vec>>(arch);
+    let x: &[Position<D::Vec>] = &xg;
+    let mut lg = col_mut::<VelocityGradient<D::Mat>>(arch);
+    lg.par_chunks_mut(CHUNK).enumerate().for_each(|(c, l)| {
+        for (k, lp) in l.iter_mut().enumerate() {
+            let p = c * CHUNK + k;
+            if let Some(theta) = theta(p, x[p].0) {
+                let shift = (theta - D::volumetric_rate(&lp.0)) / n;
                 D::add_identity(&mut lp.0, shift);
             }
-        });
-    }
+        }
+    });
 }

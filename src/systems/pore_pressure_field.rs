@@ -1,39 +1,56 @@
-//! The pore water's pressure as a field: one excess pore pressure a background cell for
-//! the points of an undrained material.
+//! The pore water as a cell field: for the points of an undrained material, one rate of
+//! volume change and one excess pore pressure a background cell.
 //!
 //! An undrained point's water takes each step's volume change as pressure,
 //! δu_p = −K_f tr(δε_p) (`materials/modified_cam_clay.rs`), K_f = K_w/n being far stiffer
 //! than the skeleton. Left to each point, that is one nearly incompressible constraint a
 //! point: four a cell in 2D on two velocity degrees of freedom a node, and the grid answers
 //! with pore pressures that alternate from point to point (a layered mode the nodal forces
-//! do not see) while their mean holds the load. Here, after the stress update, the
-//! undrained points of a cell all take the cell's volume-weighted mean,
+//! do not see) while their mean holds the load. Two systems make it the Q1/P0 count of one
+//! constraint a cell (Hughes 1980, selective reduced integration of the penalty term; the
+//! mean dilatation of Nagtegaal, Parks & Rice 1974, CMAME 4):
 //!
-//! ū_c = Σ_{p∈c} V_p u_p / Σ_{p∈c} V_p,   σ_p ← σ_p + (u_p − ū_c) I,   u_p ← ū_c,
+//! * [`UndrainedStrain`], before the stress update: the undrained points of a cell take the
+//!   cell's volume-weighted mean rate of volume change, their deviatoric rate and spin their
+//!   own,
 //!
-//! their effective stress σ′_p = σ_p + u_p I untouched (σ total, tension positive; u
-//! compression positive). With u one value a cell before the step, the step adds to it
-//! K_f times the cell's mean volume change: the Q1/P0 pressure of the pore fluid alone
-//! (Hughes 1980, selective reduced integration of the penalty term), while the skeleton
-//! keeps each point's own strain. The pressure's power in the nodal forces,
-//! Σ_p V_p ū_c tr D_p = ū_c V_c θ_c, is the power the update stores: the mean makes or
-//! loses no energy. A point that flows into another cell brings its pressure into that
-//! cell's mean, which smooths the field by as much as the soil moves past the cells.
+//!   θ_c = Σ_{p∈c} V_p tr L_p / Σ_{p∈c} V_p,   L_p ← L_p + (θ_c − tr L_p) I / n
 //!
-//! Keeping each point's own accumulated pressure apart and giving the stress its cell's
-//! mean of those (no smoothing as points change cells) was tried and dropped: the own
-//! pressures drift apart without bound in the modes the mean does not see, a point
-//! entering a cell jolts its mean, and a cone pushed into undrained clay no longer came
-//! to rest (docs/performance.md, tried and dropped). So was a nodal projection of the
-//! pressure.
+//!   (n = `Dim::STRAIN_AXES`, the hoop rate included when axisymmetric), so that the water
+//!   and the skeleton of a cell change their volume alike;
+//! * [`PorePressureField`], after it: the undrained points of a cell take the cell's
+//!   volume-weighted mean pressure,
 //!
-//! The points that carry a traction (a `PointLoad` column) keep their own pressure: they
-//! pass their load to the grid as point forces, not through their stress, and in a cell
-//! with them the mean would let the loaded points expand to zero effective stress while
-//! the ones under them compress (an undrained oedometer loaded at its top settled 7 times
-//! the element test's; docs/verification.md).
+//!   ū_c = Σ_{p∈c} V_p u_p / Σ_{p∈c} V_p,   σ_p ← σ_p + (u_p − ū_c) I,   u_p ← ū_c,
 //!
-//! The points are grouped by the cell that holds them when the system runs (after the
+//!   their effective stress σ′_p = σ_p + u_p I untouched (σ total, tension positive; u
+//!   compression positive).
+//!
+//! With u one value a cell before the step, the step adds to it K_f times the cell's mean
+//! volume change. The pressure's power in the nodal forces, Σ_p V_p ū_c tr D_p =
+//! ū_c V_c θ_c, is the power the update stores: the mean makes or loses no energy. A point
+//! that flows into another cell brings its pressure into that cell's mean, which smooths the
+//! field by as much as the soil moves past the cells.
+//!
+//! Both are needed. With the pressure's mean alone, each point's skeleton straining at its
+//! own rate, a point's volume drifted from its neighbours' in a cell, where neither the mean
+//! pressure nor the nodal forces resist it: beside a piezocone's apex the clay lost a
+//! quarter of its volume under a suction, and a heavily overconsolidated clay was squeezed
+//! to no voids left. With the shared rate alone, each point keeping its own pressure
+//! (K_f times its own volume change), the points that cross different cells at different
+//! times gather different volume changes: round a cylindrical cavity the points a cell or
+//! two off the wall held −174 to +356 kPa where the closed form gives 139–141 kPa
+//! (docs/performance.md, tried and dropped). Keeping each point's own accumulated pressure apart and giving the
+//! stress its cell's mean of those was dropped too (the own pressures drift apart in the
+//! modes the mean does not see), and so was a nodal projection of the pressure.
+//!
+//! The points that carry a traction (a `PointLoad` column) keep their own rate and
+//! pressure: they pass their load to the grid as point forces, not through their stress,
+//! and in a cell with them the mean would let the loaded points expand to zero effective
+//! stress while the ones under them compress (an undrained oedometer loaded at its top
+//! settled 7 times the element test's; docs/verification.md).
+//!
+//! The points are grouped by the cell that holds them when each system runs (after the
 //! points moved in USL and MUSL, before in USF), as the cell means against locking do.
 //! Points of other materials take no part. Over MPI ranks the cells of the shared node
 //! layers are summed across the ranks first, so every rank holds the whole mean.
@@ -48,7 +65,7 @@ use crate::materials::{visit_states, MaterialState, StateVisitor};
 use crate::parallel::{SlabCache, CHUNK};
 use crate::schedule::System;
 use crate::shape::Shape;
-use crate::systems::node_pairs::NodePairs;
+use crate::systems::node_pairs::{set_volumetric_rates_where, NodePairs};
 use crate::systems::shared::averaged_points;
 use crate::tensor::{StoredSym, Sym3};
 use hecs::Archetype;
@@ -184,5 +201,66 @@ impl<D: Dim> StateVisitor for Spread<'_, D> {
                     state.set_excess_pore_pressure(u);
                 }
             });
+    }
+}
+
+/// The undrained points' rate of volume change as a cell field (see the module's text).
+#[derive(Debug)]
+pub struct UndrainedStrain<D: Dim, S> {
+    /// Per cell, at its lowest node: Σ V tr L, Σ V; then θ_c in the first entry.
+    sums: NodePairs,
+    _marker: PhantomData<fn() -> (D, S)>,
+}
+
+impl<D: Dim, S> Default for UndrainedStrain<D, S> {
+    fn default() -> Self {
+        UndrainedStrain {
+            sums: NodePairs::default(),
+            _marker: PhantomData,
+        }
+    }
+}
+
+impl<D: Dim, S: Shape> System<D> for UndrainedStrain<D, S> {
+    fn name(&self) -> &str {
+        "undrained_strain"
+    }
+
+    fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
+        // A reset step neither strains nor moves the points.
+        if ctx.motion_dt().is_none() {
+            return Ok(());
+        }
+        let water: Vec<bool> = ctx.materials.iter().map(|m| m.holds_water()).collect();
+        let grid = &ctx.grid;
+        for arch in averaged_points::<D>(&ctx.world) {
+            let (xg, vg, lg, mg) = (
+                col::<Position<D::Vec>>(arch),
+                col::<Volume>(arch),
+                col::<VelocityGradient<D::Mat>>(arch),
+                col::<MaterialId>(arch),
+            );
+            let (vol, mat): (&[Volume], &[MaterialId]) = (&vg, &mg);
+            let l: &[VelocityGradient<D::Mat>] = &lg;
+            let water = &water;
+            self.sums
+                .scatter_cells_where::<D, S>(&mut ctx.slabs, grid, &xg, |p| {
+                    water[mat[p].0 as usize].then(|| [vol[p].0 * D::volumetric_rate(&l[p].0), vol[p].0])
+                });
+        }
+        self.sums.sum_over_ranks(grid, &ctx.comm, &ctx.decomposition);
+        // Every cell an undrained point is in has Σ V > 0; the others are never read.
+        self.sums
+            .map(grid, |s| [if s[1] > 0.0 { s[0] / s[1] } else { 0.0 }, s[1]]);
+        let sums = &self.sums;
+        for arch in averaged_points::<D>(&ctx.world) {
+            let mg = col::<MaterialId>(arch);
+            let mat: &[MaterialId] = &mg;
+            set_volumetric_rates_where::<D>(arch, |p, x| {
+                water[mat[p].0 as usize].then(|| sums.of_cell(grid, x)[0])
+            });
+        }
+        self.sums.clear(grid);
+        Ok(())
     }
 }
