@@ -157,10 +157,7 @@ impl<D: Dim, S: Shape> CellMean<D, S> {
             self.sums
                 .scatter_cells::<D, S>(&mut ctx.slabs, grid, &xg, |p| [vol[p].0 * q(&qs[p]), vol[p].0]);
         }
-        self.sums.sum_over_ranks(grid, &ctx.comm, &ctx.decomposition);
-        // Every cell a point is in has Σ V > 0; the others are never read.
-        self.sums
-            .map(grid, |s| [if s[1] > 0.0 { s[0] / s[1] } else { 0.0 }, s[1]]);
+        self.sums.means_over_ranks(grid, &ctx.comm, &ctx.decomposition);
     }
 
     /// L_p ← L_p + (θ_c − tr L_p) I / n.

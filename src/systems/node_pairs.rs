@@ -152,6 +152,19 @@ impl NodePairs {
         self.combine_over_ranks(grid, comm, decomposition, |l, u| [l[0] + u[0], l[1] + u[1]]);
     }
 
+    /// Cell means of weighted sums: the pairs Σ w q, Σ w [`NodePairs::sum_over_ranks`],
+    /// then each one [Σ w q / Σ w, Σ w]. Every cell a point was scattered into has Σ w > 0;
+    /// the others read 0 and are never asked.
+    pub(crate) fn means_over_ranks<D: Dim>(
+        &mut self,
+        grid: &Grid<D>,
+        comm: &Comm,
+        decomposition: &Decomposition,
+    ) {
+        self.sum_over_ranks(grid, comm, decomposition);
+        self.map(grid, |s| [if s[1] > 0.0 { s[0] / s[1] } else { 0.0 }, s[1]]);
+    }
+
     /// As [`NodePairs::sum_over_ranks`], each shared pair `combine(lower rank's, upper
     /// rank's)` (a sum and a largest value, for mass scaling).
     pub(crate) fn combine_over_ranks<D: Dim>(

@@ -40,9 +40,10 @@
 //! (K_f times its own volume change), the points that cross different cells at different
 //! times gather different volume changes: round a cylindrical cavity the points a cell or
 //! two off the wall held −174 to +356 kPa where the closed form gives 139–141 kPa
-//! (docs/performance.md, tried and dropped). Keeping each point's own accumulated pressure apart and giving the
-//! stress its cell's mean of those was dropped too (the own pressures drift apart in the
-//! modes the mean does not see), and so was a nodal projection of the pressure.
+//! (docs/performance.md, tried and dropped). Keeping each point's own accumulated
+//! pressure apart and giving the stress its cell's mean of those was dropped too (the own
+//! pressures drift apart in the modes the mean does not see), and so was a nodal
+//! projection of the pressure.
 //!
 //! The points that carry a traction (a `PointLoad` column) keep their own rate and
 //! pressure: they pass their load to the grid as point forces, not through their stress,
@@ -112,10 +113,7 @@ impl<D: Dim, S: Shape> System<D> for PorePressureField<D, S> {
             visit_states(&mut gather);
         }
         let grid = &ctx.grid;
-        self.sums.sum_over_ranks(grid, &ctx.comm, &ctx.decomposition);
-        // Every cell an undrained point is in has Σ V > 0; the others are never read.
-        self.sums
-            .map(grid, |s| [if s[1] > 0.0 { s[0] / s[1] } else { 0.0 }, s[1]]);
+        self.sums.means_over_ranks(grid, &ctx.comm, &ctx.decomposition);
         for arch in averaged_points::<D>(&ctx.world) {
             let mut spread = Spread::<D> {
                 arch,
@@ -248,10 +246,7 @@ impl<D: Dim, S: Shape> System<D> for UndrainedStrain<D, S> {
                     water[mat[p].0 as usize].then(|| [vol[p].0 * D::volumetric_rate(&l[p].0), vol[p].0])
                 });
         }
-        self.sums.sum_over_ranks(grid, &ctx.comm, &ctx.decomposition);
-        // Every cell an undrained point is in has Σ V > 0; the others are never read.
-        self.sums
-            .map(grid, |s| [if s[1] > 0.0 { s[0] / s[1] } else { 0.0 }, s[1]]);
+        self.sums.means_over_ranks(grid, &ctx.comm, &ctx.decomposition);
         let sums = &self.sums;
         for arch in averaged_points::<D>(&ctx.world) {
             let mg = col::<MaterialId>(arch);
