@@ -146,9 +146,12 @@ pub fn interrupt(child: std::process::Child, dir: &Path, signal_name: &str) -> s
     o
 }
 
-/// An empty scratch directory for test group `group`, case `name`, unique to this process.
+/// An empty scratch directory for test group `group`, case `name`, in the target
+/// directory's `tmp/` (Cargo's `CARGO_TARGET_TMPDIR`): the next run of the case empties and
+/// reuses it, so a run's files stay there to look at and runs do not pile up, and
+/// `cargo clean` removes them.
 pub fn scratch(group: &str, name: &str) -> std::path::PathBuf {
-    let d = std::env::temp_dir().join(format!("kdmpm-{group}-{}-{name}", std::process::id()));
+    let d = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("{group}-{name}"));
     let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).expect("scratch directory");
     d
