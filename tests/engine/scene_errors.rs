@@ -27,9 +27,7 @@ struct Case {
 }
 
 fn case(name: &str, text: &str) -> Case {
-    let dir = std::env::temp_dir().join(format!("kdmpm-errors-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = crate::common::scratch("errors", name);
     let scene = dir.join("scene.ron");
     std::fs::write(&scene, text).unwrap();
     let out = dir.join("out");
