@@ -317,6 +317,24 @@ impl<D: Dim> Grid<D> {
         m > cutoff || (m > cutoff * 0.5f64.powi(D::N as i32) && m > cutoff * self.node_share(id))
     }
 
+    /// True when node `id` with mass `m` (kg) counts in the force ratio K_F: it carries
+    /// degrees of freedom ([`Grid::carries`]) and, in axisymmetry, `m` exceeds `cutoff`
+    /// times its share of a full node at its own radius, r/h times the reference at r = h
+    /// (volumes per radian grow with r). A node at r = 10 h that gathers a thousandth of the
+    /// reference holds a ten-thousandth of a full node beside it; next to a loaded face such
+    /// a node holds a force, from the gradients of the few points that reach it, which no
+    /// motion of its own balances, and K_F waited on it (the spherical cavity,
+    /// docs/verification.md). It still carries its degrees of freedom: left out of
+    /// the grid, its share of Σ∇w = 0 acts on the points as a spurious force.
+    #[inline(always)]
+    pub fn counts_in_balance(&self, id: usize, m: f64, cutoff: f64) -> bool {
+        if !D::AXISYMMETRIC {
+            return self.carries(id, m, cutoff);
+        }
+        let r = D::vec_to3(self.origin)[0] + self.node_ijk(id)[0] as f64 * self.cell_size;
+        m > cutoff * self.node_share(id) * (r * self.inv_h).max(1.0)
+    }
+
     /// Mass (kg) that accelerates node `id` of mass `m`: at least `floor` (kg, for an interior
     /// node) times the node's share.
     #[inline(always)]
@@ -569,7 +587,7 @@ fn clamped_coordinate(xi: f64, axis: &Axis) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::dim::{Dim2, Dim3};
+    use crate::dim::{Dim2, Dim3, DimAxi};
     use glam::{DVec2, DVec3};
 
     #[test]
@@ -763,5 +781,22 @@ mod tests {
         assert!(g.carries(g.node_id([0, 1, 1]), 0.6, 1.0));
         assert!(!g.carries(g.node_id([2, 1, 1]), 0.6, 1.0));
         assert_eq!(g.inertia(g.node_id([0, 0, 2]), 0.1, 1.0), 0.125);
+    }
+
+    #[test]
+    fn an_axisymmetric_node_counts_in_k_f_by_a_full_node_at_its_radius() {
+        // Per radian a full node at radius r holds r/h times the mass of one at r = h, the
+        // reference of the cut-off: at r = 6 h a node must hold 6 times the cut-off (3 on
+        // a grid face) to count, while it carries degrees of freedom from 1 times.
+        let g = Grid::<DimAxi>::new(DVec2::ZERO, 0.5, [20, 4, 0]);
+        let (at_6h, face_6h, at_h) = (g.node_id([6, 2, 0]), g.node_id([6, 0, 0]), g.node_id([1, 2, 0]));
+        assert!(g.carries(at_6h, 2e-3, 1e-3) && !g.counts_in_balance(at_6h, 2e-3, 1e-3));
+        assert!(g.counts_in_balance(at_6h, 6.1e-3, 1e-3));
+        assert!(!g.counts_in_balance(face_6h, 2.9e-3, 1e-3) && g.counts_in_balance(face_6h, 3.1e-3, 1e-3));
+        assert!(g.counts_in_balance(at_h, 1.1e-3, 1e-3));
+        assert!(g.counts_in_balance(g.node_id([0, 2, 0]), 0.6e-3, 1e-3));
+        // Off the axis the plane grid's rule is unchanged.
+        let g2 = Grid::<Dim2>::new(DVec2::ZERO, 0.5, [20, 4, 0]);
+        assert!(g2.counts_in_balance(g2.node_id([6, 2, 0]), 2e-3, 1e-3));
     }
 }

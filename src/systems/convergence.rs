@@ -48,7 +48,8 @@ fn ratio_or(ratio: f64, digits: usize, undefined: &str) -> String {
     }
 }
 
-/// Force-ratio norms over the free degrees of freedom of nodes that carry mass.
+/// Force-ratio norms over the free degrees of freedom of nodes that carry mass
+/// ([`Grid::counts_in_balance`](crate::grid::Grid::counts_in_balance)).
 ///
 /// Fixed components are left out (their reaction keeps K_F near 1 for ever), and so are
 /// massless nodes (they carry no degree of freedom). A component driven by a prescribed
@@ -101,7 +102,7 @@ pub fn force_norms<D: Dim>(ctx: &Context<D>) -> ForceNorms {
     let parts = grid_pass(grid, ctx.state.active_nodes, &(), |b, (), _| {
         let (mut max_u, mut max_e, mut sum_u, mut sum_e) = (0.0f64, 0.0f64, 0.0, 0.0);
         for i in b.rows(grid).flatten() {
-            if !grid.carries(i, nm[i].0, min_mass) || owned.is_some_and(|o| !o.contains(&i)) {
+            if !grid.counts_in_balance(i, nm[i].0, min_mass) || owned.is_some_and(|o| !o.contains(&i)) {
                 continue;
             }
             for a in 0..D::N {
