@@ -299,7 +299,12 @@ impl<D: Dim> Grid<D> {
     /// mass of an interior node in the same material.
     #[inline]
     pub fn node_share(&self, id: usize) -> f64 {
-        let ijk = self.node_ijk(id);
+        self.share_at(self.node_ijk(id))
+    }
+
+    /// [`Grid::node_share`] of the node at `ijk`.
+    #[inline]
+    fn share_at(&self, ijk: [usize; 3]) -> f64 {
         let mut share = 1.0;
         for (a, &i) in ijk.iter().enumerate().take(D::N) {
             if i == 0 || i == self.axes[a].cells {
@@ -331,8 +336,9 @@ impl<D: Dim> Grid<D> {
         if !D::AXISYMMETRIC {
             return self.carries(id, m, cutoff);
         }
-        let r = D::vec_to3(self.origin)[0] + self.node_ijk(id)[0] as f64 * self.cell_size;
-        m > cutoff * self.node_share(id) * (r * self.inv_h).max(1.0)
+        let ijk = self.node_ijk(id);
+        let r = D::vec_to3(self.node_position(ijk))[0];
+        m > cutoff * self.share_at(ijk) * (r * self.inv_h).max(1.0)
     }
 
     /// Mass (kg) that accelerates node `id` of mass `m`: at least `floor` (kg, for an interior
