@@ -30,8 +30,8 @@
 //! is its nodes' (each node's share of what every constraint pushed into it, split among
 //! the samples that reach it by weight) when that is more than its own: the inside nodes
 //! carry much of a body's normal force, and a cap of the sample's own impulse held a
-//! block on a rigid base with a hundredth of its friction (docs/performance.md, tried and
-//! dropped). Acting wherever its nodes were
+//! block on a rigid base with a hundredth of its friction (docs/tried-and-dropped.md).
+//! Acting wherever its nodes were
 //! pressed (not only where the sample presses) let a rough T-bar drag the soil behind it
 //! and the solve stop converging.
 

@@ -12,7 +12,7 @@
 //!   r dr dz, whose σ_rr/r term the in-plane divergence of V σ already holds; internal.
 //!
 //! The sources are called directly, not through a table of pointers, so that the point
-//! loop inlines them (docs/performance.md, "Tried and dropped"); a dry plane scene asks
+//! loop inlines them (docs/tried-and-dropped.md); a dry plane scene asks
 //! nothing and pays nothing.
 
 use crate::components::MaterialId;

@@ -40,7 +40,7 @@
 //! (K_f times its own volume change), the points that cross different cells at different
 //! times gather different volume changes: round a cylindrical cavity the points a cell or
 //! two off the wall held −174 to +356 kPa where the closed form gives 139–141 kPa
-//! (docs/performance.md, tried and dropped). Keeping each point's own accumulated
+//! (docs/tried-and-dropped.md). Keeping each point's own accumulated
 //! pressure apart and giving the stress its cell's mean of those was dropped too (the own
 //! pressures drift apart in the modes the mean does not see), and so was a nodal
 //! projection of the pressure.

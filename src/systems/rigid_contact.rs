@@ -24,7 +24,7 @@
 //!
 //! The constraint is held where the body's surface is, between nodes, so a body is as big
 //! as its geometry whatever the grid: holding the nodes inside a body instead makes it
-//! smaller or larger by up to a cell as it moves across the grid (docs/tried-and-dropped).
+//! smaller or larger by up to a cell as it moves across the grid (docs/tried-and-dropped.md).
 //!
 //! The change is made as a force f_c = m̃ Δv/Δt added to the node's force and, since the
 //! body applies it, to its external force (K_F counts it as applied load, W_ext its work).
