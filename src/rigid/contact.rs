@@ -31,9 +31,8 @@
 //! the samples that reach it by weight) when that is more than its own: the inside nodes
 //! carry much of a body's normal force, and a cap of the sample's own impulse held a
 //! block on a rigid base with a hundredth of its friction (docs/tried-and-dropped.md).
-//! Acting wherever its nodes were
-//! pressed (not only where the sample presses) let a rough T-bar drag the soil behind it
-//! and the solve stop converging.
+//! Acting wherever its nodes were pressed (not only where the sample presses) let a rough
+//! T-bar drag the soil behind it and the solve stop converging.
 
 /// Most Gauss–Seidel sweeps over the samples per solve.
 const MAX_SWEEPS: usize = 200;
