@@ -61,8 +61,9 @@ def limit(scale=1.0, offset=0.0):
 def mean(row, start, scale=1.0, offset=0.0, with_start=False):
     """The mean pressure of `row`'s static states from the displacement `start` (m) on,
     (p − offset)/scale: a penetrometer's steady resistance. As docs/verification.md's
-    tables read it: the states after `start` ("over 1–2 D", the twenty states after 1 D of
-    a push in D/20 increments), or from it (`with_start`, as the 3D ball's table)."""
+    tables read it: the states after `start` ("over 1–2 D" of the T-bar, the twenty states
+    after 1 D of a push in D/20 increments), or from it on (`with_start`: the 3D ball's
+    and the cone's tables)."""
 
     def read(out):
         v = [p for n, d, _, _, p in curve(out)
@@ -137,8 +138,9 @@ CASES = [
      (177.5, "Lancellotta"), 4),
     ("passive_wall_cphi", "run", "passive_wall_cphi.ron", [],
      mean("wall", 0.03, scale=0.5e3), "kN/m", 147.5, (139.5, "Lancellotta, exact here"), 4),
-    ("cpt", "run", "cpt.ron", [], mean("cone.tip", 5.0, scale=C_U, offset=SIGMA_V0), "N_kt",
-     11.78, (9.7, "Teh & Houlsby"), 15),
+    ("cpt", "run", "cpt.ron", [],
+     mean("cone.tip", 5.0, scale=C_U, offset=SIGMA_V0, with_start=True), "N_kt", 11.78,
+     (9.7, "Teh & Houlsby"), 15),
     ("cpt_sand", "run", "cpt_sand.ron",
      ["grid.cell_size=0.125", "grid.cells=[40, 208]", "tractions[0].min=[0.5, 13.875]"],
      mean("cone.tip", 3.75, scale=SIGMA_V0), "q_c/p0", 24.75,
