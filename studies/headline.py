@@ -63,7 +63,7 @@ def mean(row, start, scale=1.0, offset=0.0, with_start=False):
     (p − offset)/scale: a penetrometer's steady resistance. As docs/verification.md's
     tables read it: the states after `start` ("over 1–2 D" of the T-bar, the twenty states
     after 1 D of a push in D/20 increments), or from it on (`with_start`: the 3D ball's
-    and the cone's tables)."""
+    and the cones' tables)."""
 
     def read(out):
         v = [p for n, d, _, _, p in curve(out)
@@ -143,7 +143,7 @@ CASES = [
      (9.7, "Teh & Houlsby"), 15),
     ("cpt_sand", "run", "cpt_sand.ron",
      ["grid.cell_size=0.125", "grid.cells=[40, 208]", "tractions[0].min=[0.5, 13.875]"],
-     mean("cone.tip", 3.75, scale=SIGMA_V0), "q_c/p0", 24.75,
+     mean("cone.tip", 3.75, scale=SIGMA_V0, with_start=True), "q_c/p0", 24.75,
      (None, "between 13.9 and 51, Vesić 1972 and 1977"), 12),
     ("cptu_clay", "run", "cptu_clay.ron", [], piezocone_n_kt, "N_kt", 12.20,
      (9.49, "SCE-CSSM (Mayne 1991)"), 25),
