@@ -31,6 +31,8 @@ import subprocess
 import sys
 import time
 
+import cptu_cssm
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 
@@ -97,11 +99,9 @@ def factor(out):
 
 
 def piezocone_n_kt(out):
-    """The mean N_kt of the log's last four rows (cpt.csv), as docs/verification.md reads
-    the piezocone."""
-    with open(os.path.join(out, "cpt.csv")) as f:
-        rows = list(csv.DictReader(f))
-    v = [float(r["N_kt"]) for r in rows[-4:]]
+    """The mean N_kt of the log's last four rows with all three readings, as
+    `studies/cptu_cssm.py` and docs/verification.md read the piezocone."""
+    v = [n_kt for _, n_kt, _, _ in cptu_cssm.logged(out)[-4:]]
     return sum(v) / len(v)
 
 
@@ -146,7 +146,7 @@ CASES = [
      mean("cone.tip", 3.75, scale=SIGMA_V0, with_start=True), "q_c/p0", 24.75,
      (None, "between 13.9 and 51, Vesić 1972 and 1977"), 9.5),
     ("cptu_clay", "run", "cptu_clay.ron", [], piezocone_n_kt, "N_kt", 12.20,
-     (9.49, "SCE-CSSM (Mayne 1991)"), 4.5),
+     (cptu_cssm.readings(1.0)[2], "SCE-CSSM (Mayne 1991), at R = 1"), 4.5),
     ("pile_jacking", "run", "pile_jacking.ron", [],
      mean("pile.base", 5.0, scale=C_U, offset=SIGMA_V0, with_start=True), "N_c", 13.62,
      (9.0, "Skempton"), 11),
