@@ -46,7 +46,8 @@ for scheme in Musl Usl; do
         k=$(field "$work/k/summary.json" particle_steps_per_second)
         rm -f "$work/t.json"
         "$py" "$peer" --size 1M --precision f64 --threads "$threads" --scheme "$lower" \
-            --min-time 4 --json "$work/t.json" > /dev/null 2>&1
+            --min-time 4 --json "$work/t.json" > "$work/peer.log" 2>&1 \
+            || { cat "$work/peer.log" >&2; exit 1; }
         t=$(field "$work/t.json" pstep_per_s)
         own=$(field "$work/t.json" own_cores)
         others=$(field "$work/t.json" foreign_cores)
