@@ -25,17 +25,6 @@ kdmpm=$root/target/release/kdmpm
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 
-# A field of a JSON file (summary.json), or of its last line (the peer's --json log).
-field() {
-    python3 -c "import json, sys
-text = open(sys.argv[1]).read()
-try:
-    doc = json.loads(text)
-except ValueError:
-    doc = json.loads(text.splitlines()[-1])
-print(doc[sys.argv[2]])" "$@"
-}
-
 printf '%-5s %5s %9s %9s %7s %10s %10s\n' scheme round kdmpm peer ratio peer_cores others
 for scheme in Musl Usl; do
     lower=$(echo "$scheme" | tr '[:upper:]' '[:lower:]')
@@ -43,16 +32,18 @@ for scheme in Musl Usl; do
         rm -rf "$work/k"
         "$kdmpm" run "$root/scenes/block_1m.ron" --threads "$threads" --quiet \
             --set solver.max_steps=30 --set "solver.scheme=$scheme" --out "$work/k"
-        k=$(field "$work/k/summary.json" particle_steps_per_second)
         rm -f "$work/t.json"
         "$py" "$peer" --size 1M --precision f64 --threads "$threads" --scheme "$lower" \
             --min-time 4 --json "$work/t.json" > "$work/peer.log" 2>&1 \
             || { cat "$work/peer.log" >&2; exit 1; }
-        t=$(field "$work/t.json" pstep_per_s)
-        own=$(field "$work/t.json" own_cores)
-        others=$(field "$work/t.json" foreign_cores)
-        python3 -c "import sys; k, t = float(sys.argv[1]) / 1e6, float(sys.argv[2]) / 1e6; \
-print(f'{sys.argv[3]:<5} {sys.argv[4]:>5} {k:9.2f} {t:9.2f} {k / t:6.2f}x {sys.argv[5]:>10} {sys.argv[6]:>10}')" \
-            "$k" "$t" "$lower" "$r" "$own" "$others"
+        # One row from kdmpm's summary.json and the peer's one-line JSON log.
+        python3 - "$work/k/summary.json" "$work/t.json" "$lower" "$r" <<'PY'
+import json, sys
+k = json.load(open(sys.argv[1]))["particle_steps_per_second"] / 1e6
+peer = json.load(open(sys.argv[2]))
+t = peer["pstep_per_s"] / 1e6
+print(f"{sys.argv[3]:<5} {sys.argv[4]:>5} {k:9.2f} {t:9.2f} {k / t:6.2f}x "
+      f"{peer['own_cores']:>10} {peer['foreign_cores']:>10}")
+PY
     done
 done
