@@ -10,6 +10,7 @@ use crate::infra::traffic::Traffic;
 use crate::materials::{update_lane_by_lane, visit_states, MaterialModel, MaterialState, StateVisitor};
 use crate::parallel::CHUNK;
 use crate::schedule::System;
+use crate::systems::volume_update::volume_ratio;
 use crate::tensor::{StoredSym, Sym3x4};
 use hecs::{Archetype, ArchetypeColumnMut};
 use rayon::prelude::*;
@@ -21,8 +22,22 @@ use std::marker::PhantomData;
 /// Points go four at a time, one per SIMD lane ([`crate::infra::lanes`]): the rotation always, and
 /// the material's update when the four share a material (each gets the bits it would get
 /// alone); the gain is in docs/performance.md ("Figures behind the code").
+///
+/// With `volume` set it also updates each point's volume, V ← V det(I + LΔt), in the same
+/// pass over L: in a schedule without `volume_update`, which does it on its own otherwise
+/// (with the same arithmetic and bits; `systems::volume_read_after_stress` says when the
+/// default schedule holds it).
 #[derive(Debug, Default)]
-pub struct StressUpdate;
+pub struct StressUpdate {
+    volume: bool,
+}
+
+impl StressUpdate {
+    /// The stress update, carrying the volume update when `volume` is set.
+    pub fn new(volume: bool) -> Self {
+        StressUpdate { volume }
+    }
+}
 
 impl<D: Dim> System<D> for StressUpdate {
     fn name(&self) -> &str {
@@ -38,6 +53,7 @@ impl<D: Dim> System<D> for StressUpdate {
                 arch,
                 materials: &ctx.materials,
                 dt,
+                volume: self.volume,
                 done: false,
                 dim: PhantomData,
             };
@@ -57,6 +73,10 @@ impl<D: Dim> System<D> for StressUpdate {
             .read_points::<VelocityGradient<D::Mat>>(w)
             .read_points::<MaterialId>(w)
             .update_points::<Stress<D::Stress>>(w);
+        let traffic = match self.volume {
+            true => traffic.update_points::<Volume>(w),
+            false => traffic,
+        };
         // Each archetype's material state column, read and written.
         let mut states = StateTraffic { world: w, traffic };
         visit_states(&mut states);
@@ -83,6 +103,8 @@ struct ArchetypeUpdate<'a, D> {
     arch: &'a Archetype,
     materials: &'a [MaterialModel],
     dt: f64,
+    /// Update the volumes too.
+    volume: bool,
     /// True once the archetype's state column was found and the update ran.
     done: bool,
     dim: PhantomData<D>,
@@ -107,7 +129,14 @@ impl<D: Dim> ArchetypeUpdate<'_, D> {
         let kernel = |stress: &mut [Stress<D::Stress>],
                       l: &[VelocityGradient<D::Mat>],
                       mat: &[MaterialId],
-                      state: &mut [S]| {
+                      state: &mut [S],
+                      vol: Option<&mut [Volume]>| {
+            // The volumes first, while the chunk's L is in the cache for the stresses.
+            if let Some(vol) = vol {
+                for (v, l) in vol.iter_mut().zip(l) {
+                    v.0 *= volume_ratio::<D>(&l.0, dt);
+                }
+            }
             let full = stress.len() / LANES * LANES;
             for g in (0..full).step_by(LANES) {
                 let at = g..g + LANES;
@@ -137,17 +166,24 @@ impl<D: Dim> ArchetypeUpdate<'_, D> {
         let arch = self.arch;
         let (lg, mg) = (col::<VelocityGradient<D::Mat>>(arch), col::<MaterialId>(arch));
         let mut sg = col_mut::<Stress<D::Stress>>(arch);
+        let mut vg = self.volume.then(|| col_mut::<Volume>(arch));
+        // One entry a chunk: its volumes, or nothing when `volume_update` does them.
+        let vol_chunks: Vec<Option<&mut [Volume]>> = match vg.as_deref_mut() {
+            Some(v) => v.chunks_mut(CHUNK).map(Some).collect(),
+            None => (0..sg.len().div_ceil(CHUNK)).map(|_| None).collect(),
+        };
         let chunks = sg
             .par_chunks_mut(CHUNK)
             .zip(lg.par_chunks(CHUNK))
-            .zip(mg.par_chunks(CHUNK));
+            .zip(mg.par_chunks(CHUNK))
+            .zip(vol_chunks.into_par_iter());
         match states {
             Some(mut e) => chunks
                 .zip(e.par_chunks_mut(CHUNK))
-                .for_each(|(((s, l), m), e)| kernel(s, l, m, e)),
-            None => chunks.for_each(|((s, l), m)| {
+                .for_each(|((((s, l), m), v), e)| kernel(s, l, m, e, v)),
+            None => chunks.for_each(|(((s, l), m), v)| {
                 // A state of no size: the slice costs no memory.
-                kernel(s, l, m, &mut vec![S::default(); s.len()])
+                kernel(s, l, m, &mut vec![S::default(); s.len()], v)
             }),
         }
     }

@@ -29,7 +29,7 @@ impl<D: Dim> System<D> for VolumeUpdate {
                 .zip(lg.par_chunks(CHUNK))
                 .for_each(|(vol, l)| {
                     for (v, l) in vol.iter_mut().zip(l) {
-                        v.0 *= ratio::<D>(&l.0, dt);
+                        v.0 *= volume_ratio::<D>(&l.0, dt);
                     }
                 });
         }
@@ -54,6 +54,6 @@ impl<D: Dim> System<D> for VolumeUpdate {
 /// here made the pass four times slower than one point at a time (docs/performance.md).
 /// The arithmetic, and so the bits, are the same either way.
 #[inline(never)]
-fn ratio<D: Dim>(l: &D::Mat, dt: f64) -> f64 {
+pub(crate) fn volume_ratio<D: Dim>(l: &D::Mat, dt: f64) -> f64 {
     D::volume_ratio(l, dt)
 }
