@@ -130,16 +130,19 @@ impl<D: Dim> ArchetypeUpdate<'_, D> {
                       l: &[VelocityGradient<D::Mat>],
                       mat: &[MaterialId],
                       state: &mut [S],
-                      vol: Option<&mut [Volume]>| {
-            // The volumes first, while the chunk's L is in the cache for the stresses.
-            if let Some(vol) = vol {
-                for (v, l) in vol.iter_mut().zip(l) {
-                    v.0 *= volume_ratio::<D>(&l.0, dt);
+                      mut vol: Option<&mut [Volume]>| {
+            // Each group's volumes beside its stresses, while their L is in the cache.
+            let mut volumes = |at: std::ops::Range<usize>| {
+                if let Some(vol) = vol.as_deref_mut() {
+                    for (v, l) in vol[at.clone()].iter_mut().zip(&l[at]) {
+                        v.0 *= volume_ratio::<D>(&l.0, dt);
+                    }
                 }
-            }
+            };
             let full = stress.len() / LANES * LANES;
             for g in (0..full).step_by(LANES) {
                 let at = g..g + LANES;
+                volumes(at.clone());
                 update_group::<D, S>(
                     materials,
                     dt,
@@ -150,6 +153,7 @@ impl<D: Dim> ArchetypeUpdate<'_, D> {
                 );
             }
             let n = stress.len() - full;
+            volumes(full..stress.len());
             if n > 0 {
                 // The last few points; the spare lanes repeat the last one, and their results
                 // are dropped.
