@@ -48,7 +48,8 @@ impl<D: Dim> System<D> for VolumeUpdate {
     }
 }
 
-/// det(I + L Δt) of one point, kept out of line so that the loop above is not vectorised
+/// det(I + L Δt) of one point (here and in `stress_update`, which does the volumes where
+/// no `volume_update` is scheduled), kept out of line so that the loop above is not vectorised
 /// across points: with the build's `target-cpu=native` the compiler loads four points'
 /// gradients (72 bytes apart) into vector lanes by gathers, which on the AMD cores measured
 /// here made the pass four times slower than one point at a time (docs/performance.md).
