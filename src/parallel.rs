@@ -15,6 +15,16 @@ use std::ops::Range;
 /// Points per chunk in point-local loops.
 pub const CHUNK: usize = 2048;
 
+/// A column that not every archetype has, cut into the [`CHUNK`]s of a loop over `len`
+/// points: its chunks, or one `None` a chunk where the column is absent, to zip beside the
+/// columns every archetype has.
+pub fn optional_chunks<T>(column: Option<&mut [T]>, len: usize) -> Vec<Option<&mut [T]>> {
+    match column {
+        Some(c) => c.chunks_mut(CHUNK).map(Some).collect(),
+        None => (0..len.div_ceil(CHUNK)).map(|_| None).collect(),
+    }
+}
+
 /// Points grouped into slabs of one cell row along the grid's slab axis (its slowest), so
 /// that each slab scatters into its own contiguous range of node ids.
 #[derive(Debug, Default)]

@@ -7,7 +7,7 @@ use crate::dim::{Dim, Vector};
 use crate::error::StepError;
 use crate::infra::columns::{col, col_mut, nodes, points_with};
 use crate::infra::traffic::Traffic;
-use crate::parallel::CHUNK;
+use crate::parallel::{optional_chunks, CHUNK};
 use crate::schedule::System;
 use crate::shape::{for_each_node, Shape};
 use rayon::prelude::*;
@@ -78,10 +78,7 @@ impl<D: Dim, S: Shape> System<D> for Kinematics<D, S> {
             let mut lg = col_mut::<VelocityGradient<D::Mat>>(arch);
             let mut ug = arch.get::<&mut Displacement<D::Vec>>();
             // Displacements are kept only when the scene asks for them.
-            let u_chunks: Vec<Option<&mut [Displacement<D::Vec>]>> = match ug.as_deref_mut() {
-                Some(u) => u.chunks_mut(CHUNK).map(Some).collect(),
-                None => (0..xg.len().div_ceil(CHUNK)).map(|_| None).collect(),
-            };
+            let u_chunks = optional_chunks(ug.as_deref_mut(), xg.len());
             // Each chunk reports whether a point changed cell and the first point that left
             // the grid; the first in chunk order wins, so the error is the same for any
             // thread count.

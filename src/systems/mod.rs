@@ -236,6 +236,7 @@ const INTEGRATED: &str = "points move with the integrated velocity";
 pub fn registry<D: Dim, S: Shape>() -> Vec<Entry<D>> {
     let mut all = mapping::<D, S>();
     all.extend(straining::<D, S>());
+    all.extend(projecting::<D, S>());
     all.extend(loading::<D, S>());
     all.extend(relaxing::<D, S>());
     all
@@ -308,7 +309,7 @@ fn mapping<D: Dim, S: Shape>() -> Vec<Entry<D>> {
     ]
 }
 
-/// The points' strain, stress and volume (and USF's internal force).
+/// The points' strain and stress.
 fn straining<D: Dim, S: Shape>() -> Vec<Entry<D>> {
     use Stage as St;
     use When::*;
@@ -384,6 +385,15 @@ fn straining<D: Dim, S: Shape>() -> Vec<Entry<D>> {
             "Jaumann rotation + material law (and V ← V det(I + LΔt) without `volume_update`)",
             |_, _, names| Box::new(StressUpdate::new(!names.iter().any(|n| n == "volume_update"))),
         ),
+    ]
+}
+
+/// The stress's projections onto the cells, the volume update where it runs on its own,
+/// and USF's internal force.
+fn projecting<D: Dim, S: Shape>() -> Vec<Entry<D>> {
+    use Stage as St;
+    use When::*;
+    vec![
         e(
             "cell_mean_stress",
             St::Project,
@@ -746,17 +756,15 @@ pub fn check_names(names: &[String], numerics: &Numerics, model: &Model, needs: 
                     e.name
                 ))
             }
-            When::Needed(needed, why) => {
+            When::Needed(needed, why) | When::RequiredWhen(needed, why) => {
                 let needed = needed(numerics, model, needs);
                 if needed && !has(e.name) {
                     return Err(format!("`{}` is required because {why}", e.name));
                 }
-                if !needed && has(e.name) {
+                // A system the scene does not need may be listed only when it is optional.
+                if !needed && has(e.name) && matches!(e.when, When::Needed(..)) {
                     return Err(format!("`{}` is scheduled but only belongs when {why}", e.name));
                 }
-            }
-            When::RequiredWhen(needed, why) if !has(e.name) && needed(numerics, model, needs) => {
-                return Err(format!("`{}` is required because {why}", e.name));
             }
             _ => {}
         }

@@ -8,7 +8,7 @@ use crate::infra::columns::{col, col_mut, points_with};
 use crate::infra::lanes::{gather, F64x4, LANES};
 use crate::infra::traffic::Traffic;
 use crate::materials::{update_lane_by_lane, visit_states, MaterialModel, MaterialState, StateVisitor};
-use crate::parallel::CHUNK;
+use crate::parallel::{optional_chunks, CHUNK};
 use crate::schedule::System;
 use crate::systems::volume_update::volume_ratio;
 use crate::tensor::{StoredSym, Sym3x4};
@@ -172,10 +172,7 @@ impl<D: Dim> ArchetypeUpdate<'_, D> {
         let mut sg = col_mut::<Stress<D::Stress>>(arch);
         let mut vg = self.volume.then(|| col_mut::<Volume>(arch));
         // One entry a chunk: its volumes, or nothing when `volume_update` does them.
-        let vol_chunks: Vec<Option<&mut [Volume]>> = match vg.as_deref_mut() {
-            Some(v) => v.chunks_mut(CHUNK).map(Some).collect(),
-            None => (0..sg.len().div_ceil(CHUNK)).map(|_| None).collect(),
-        };
+        let vol_chunks = optional_chunks(vg.as_deref_mut(), sg.len());
         let chunks = sg
             .par_chunks_mut(CHUNK)
             .zip(lg.par_chunks(CHUNK))
