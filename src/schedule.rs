@@ -26,6 +26,14 @@ pub trait System<D: Dim>: Send {
         let _ = ctx;
         Ok(())
     }
+    /// Told the names of the schedule's systems, in order, before the first step it runs
+    /// and whenever the list changes (before `prepare`): a system whose work depends on its
+    /// neighbours decides it here (g2p gathers kinematics' sums where only the peak watch
+    /// runs between them; the stress update updates the volumes where no `volume_update`
+    /// does). Nothing by default.
+    fn schedule_changed(&mut self, names: &[String]) {
+        let _ = names;
+    }
     /// Whether every rank of a run over MPI runs this system (the engine's systems do):
     /// its failure on one rank then stops every rank at it. A system that only some ranks
     /// run (rank 0's history writer) says false: its failure stops every rank at the next
@@ -173,6 +181,10 @@ impl<D: Dim> Schedule<D> {
         // A failure of a system that not every rank runs, held for the next check.
         let mut held = None;
         if !self.prepared {
+            let names = self.names();
+            for system in &mut self.systems {
+                system.schedule_changed(&names);
+            }
             for system in &mut self.systems {
                 let result = system.prepare(ctx);
                 every_rank(ctx, system.on_every_rank(), result, &mut held)?;

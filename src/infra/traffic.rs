@@ -71,6 +71,20 @@ impl Traffic {
         self.read_points::<T>(world).write_points::<T>(world)
     }
 
+    /// A value of type `V` kept beside the columns (a system's scratch) for every point
+    /// that has column `T`, read.
+    pub fn read_per_point<T: Component, V>(mut self, world: &World) -> Self {
+        self.read += point_rows::<T>(world) * std::mem::size_of::<V>() as u64;
+        self
+    }
+
+    /// A value of type `V` kept beside the columns for every point that has column `T`,
+    /// written without being read.
+    pub fn write_per_point<T: Component, V>(mut self, world: &World) -> Self {
+        self.written += point_rows::<T>(world) * std::mem::size_of::<V>() as u64;
+        self
+    }
+
     /// Column `T` of `nodes` nodes, read.
     pub fn read_nodes<T: Component>(mut self, nodes: usize) -> Self {
         self.read += node_bytes::<T>(nodes);

@@ -372,6 +372,7 @@ fn build_dim<D: Dim>(
         comm: Default::default(),
         decomposition,
         exchanged: 0,
+        point_grid_velocity: Vec::new(),
     };
     Ok((
         Simulation {

@@ -46,14 +46,16 @@ impl Shape for QuadraticBSpline {
     /// and outer product; this is a third of the multiply-adds in 3D (docs/performance.md),
     /// equal to them up to round-off.
     #[inline(always)]
-    fn gather_with_gradient<D: Dim>(
+    fn gather_with_gradient_visiting<D: Dim>(
         grid: &Grid<D>,
         x: D::Vec,
         v: impl Fn(usize) -> D::Vec,
+        mut visit: impl FnMut(&Stencil1, usize, f64),
     ) -> (D::Mat, D::Vec) {
         let mut acc = GradientSum::default();
         let k = F64x4::splat;
         for_each_row::<D, Self>(grid, x, |sx, first, w, dw_dy, dw_dz| {
+            visit(sx, first, w);
             let (v0, v1, v2) = (
                 in_lanes::<D>(v(first)),
                 in_lanes::<D>(v(first + 1)),

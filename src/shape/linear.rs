@@ -33,13 +33,15 @@ impl Shape for Linear {
     /// v̄ ∂w_r/∂z to the others and v̄ w_r to the velocity: about half the arithmetic of two
     /// nodes' outer products (docs/performance.md).
     #[inline(always)]
-    fn gather_with_gradient<D: Dim>(
+    fn gather_with_gradient_visiting<D: Dim>(
         grid: &Grid<D>,
         x: D::Vec,
         v: impl Fn(usize) -> D::Vec,
+        mut visit: impl FnMut(&Stencil1, usize, f64),
     ) -> (D::Mat, D::Vec) {
         let mut acc = GradientSum::default();
         for_each_row::<D, Self>(grid, x, |sx, first, w, dw_dy, dw_dz| {
+            visit(sx, first, w);
             let v0 = in_lanes::<D>(v(first));
             let dv = in_lanes::<D>(v(first + 1)) - v0;
             let mean = Lanes::madd(dv, F64x4::splat(sx.w[1]), v0);

@@ -4,11 +4,14 @@ use crate::components::*;
 use crate::context::Context;
 use crate::dim::{Dim, Vector};
 use crate::error::StepError;
+use crate::grid::Grid;
 use crate::infra::columns::{col, col_mut, nodes, points_with};
 use crate::infra::traffic::Traffic;
 use crate::parallel::CHUNK;
 use crate::schedule::System;
 use crate::shape::{for_each_node, Shape};
+use crate::systems::g2p_gathers_strain;
+use crate::systems::kinematics::gradient_and_velocity;
 use rayon::prelude::*;
 use std::marker::PhantomData;
 
@@ -28,18 +31,34 @@ fn first_non_finite_velocity<D: Dim>(world: &hecs::World) -> String {
 
 /// v_p ← α (v_p + Δt Σ_i w_ip a_i) + (1 − α) Σ_i w_ip v_i (FLIP for α = 1, PIC for α = 0),
 /// then E_k = ½ Σ m_p v_p·v_p.
+///
+/// Where nothing between g2p and kinematics changes the nodal velocity (USL:
+/// [`g2p_gathers_strain`]) the same visit of a point's nodes also gathers
+/// what kinematics would: the velocity gradient L_p = Σ_i v_i ⊗ ∇w_ip into its column and
+/// the nodal velocity at the point, Σ_i w_ip v_i, into [`Context::point_grid_velocity`],
+/// which kinematics then moves the point by unless the peak watch resets the step. The sums
+/// are kinematics' own, so the bits are those of the two passes.
 #[derive(Debug)]
-pub struct G2p<D, S>(PhantomData<fn() -> (D, S)>);
+pub struct G2p<D, S> {
+    strain: bool,
+    _marker: PhantomData<fn() -> (D, S)>,
+}
 
 impl<D, S> Default for G2p<D, S> {
     fn default() -> Self {
-        G2p(PhantomData)
+        G2p {
+            strain: false,
+            _marker: PhantomData,
+        }
     }
 }
 
 impl<D: Dim, S: Shape> System<D> for G2p<D, S> {
     fn name(&self) -> &str {
         "g2p"
+    }
+    fn schedule_changed(&mut self, names: &[String]) {
+        self.strain = g2p_gathers_strain(names);
     }
     fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
         let (grid, dt) = (&ctx.grid, ctx.numerics.dt);
@@ -51,35 +70,44 @@ impl<D: Dim, S: Shape> System<D> for G2p<D, S> {
         let flip = ctx.numerics.flip;
         // Pure FLIP (the default) never reads the interpolated nodal velocity.
         let pic = flip < 1.0;
+        let strain = self.strain;
+        let carried = &mut ctx.point_grid_velocity;
+        if strain {
+            let rows = points_with::<Velocity<D::Vec>>(&ctx.world)
+                .map(|a| a.len() as usize)
+                .sum();
+            carried.resize(rows, D::Vec::ZERO);
+        }
+        let mut carried: &mut [D::Vec] = carried;
         let mut twice_ek = 0.0;
         for arch in points_with::<Velocity<D::Vec>>(&ctx.world) {
             let (xg, mg) = (col::<Position<D::Vec>>(arch), col::<Mass>(arch));
-            let (x, m): (&[Position<D::Vec>], &[Mass]) = (&xg, &mg);
+            let fields = Fields::<D, S> {
+                grid,
+                x: &xg,
+                m: &mg,
+                na,
+                nv,
+                dt,
+                flip,
+                shape: PhantomData,
+            };
             let mut vg = col_mut::<Velocity<D::Vec>>(arch);
-            let parts: Vec<f64> = vg
-                .par_chunks_mut(CHUNK)
-                .enumerate()
-                .map(|(c, v)| {
-                    let mut e = 0.0;
-                    for (k, vp) in v.iter_mut().enumerate() {
-                        let p = c * CHUNK + k;
-                        let mut a = D::Vec::ZERO;
-                        vp.0 = if pic {
-                            let mut vg = D::Vec::ZERO;
-                            for_each_node::<D, S>(grid, x[p].0, |i, w, _| {
-                                a = na[i].0.madd(w, a);
-                                vg = nv[i].0.madd(w, vg);
-                            });
-                            (vp.0 + a * dt) * flip + vg * (1.0 - flip)
-                        } else {
-                            for_each_node::<D, S>(grid, x[p].0, |i, w, _| a = na[i].0.madd(w, a));
-                            vp.0 + a * dt
-                        };
-                        e += m[p].0 * vp.0.dot(vp.0);
+            // Kinematics' columns, written only with `strain`.
+            let mut lg = strain.then(|| col_mut::<VelocityGradient<D::Mat>>(arch));
+            let (mine, rest) = std::mem::take(&mut carried).split_at_mut(if strain { vg.len() } else { 0 });
+            carried = rest;
+            let parts = match lg.as_deref_mut() {
+                Some(l) if !pic => fields.velocities_and_strain(&mut vg, l, mine),
+                l => {
+                    let parts = fields.velocities(&mut vg);
+                    // PIC keeps its own sums; kinematics' follow in a pass of their own.
+                    if let Some(l) = l {
+                        fields.strain(l, mine);
                     }
-                    e
-                })
-                .collect();
+                    parts
+                }
+            };
             // Partial sums added in chunk order: the same bits for any thread count.
             twice_ek += parts.iter().sum::<f64>();
         }
@@ -109,11 +137,105 @@ impl<D: Dim, S: Shape> System<D> for G2p<D, S> {
             .read_points::<Mass>(w)
             .update_points::<Velocity<D::Vec>>(w)
             .read_nodes::<NodeAcceleration<D::Vec>>(n);
-        // PIC's share reads the nodal velocity too.
-        Some(if ctx.numerics.flip < 1.0 {
+        // PIC's share and kinematics' gathers read the nodal velocity too.
+        let t = if ctx.numerics.flip < 1.0 || self.strain {
             t.read_nodes::<NodeVelocity<D::Vec>>(n)
         } else {
             t
+        };
+        Some(if self.strain {
+            t.write_points::<VelocityGradient<D::Mat>>(w)
+                .write_per_point::<Velocity<D::Vec>, D::Vec>(w)
+        } else {
+            t
         })
+    }
+}
+
+/// What g2p reads for one archetype of points: the grid, their positions and masses, the
+/// nodal accelerations and velocities, Δt and the FLIP share.
+struct Fields<'a, D: Dim, S> {
+    grid: &'a Grid<D>,
+    x: &'a [Position<D::Vec>],
+    m: &'a [Mass],
+    na: &'a [NodeAcceleration<D::Vec>],
+    nv: &'a [NodeVelocity<D::Vec>],
+    dt: f64,
+    flip: f64,
+    shape: PhantomData<S>,
+}
+
+impl<D: Dim, S: Shape> Fields<'_, D, S> {
+    /// The velocity update of the points `v`; each chunk's Σ m v·v.
+    fn velocities(&self, v: &mut [Velocity<D::Vec>]) -> Vec<f64> {
+        let (grid, x, m, na, nv, dt, flip) =
+            (self.grid, self.x, self.m, self.na, self.nv, self.dt, self.flip);
+        // Pure FLIP (the default) never reads the interpolated nodal velocity.
+        let pic = flip < 1.0;
+        v.par_chunks_mut(CHUNK)
+            .enumerate()
+            .map(|(c, v)| {
+                let mut e = 0.0;
+                for (k, vp) in v.iter_mut().enumerate() {
+                    let p = c * CHUNK + k;
+                    let mut a = D::Vec::ZERO;
+                    vp.0 = if pic {
+                        let mut vg = D::Vec::ZERO;
+                        for_each_node::<D, S>(grid, x[p].0, |i, w, _| {
+                            a = na[i].0.madd(w, a);
+                            vg = nv[i].0.madd(w, vg);
+                        });
+                        (vp.0 + a * dt) * flip + vg * (1.0 - flip)
+                    } else {
+                        for_each_node::<D, S>(grid, x[p].0, |i, w, _| a = na[i].0.madd(w, a));
+                        vp.0 + a * dt
+                    };
+                    e += m[p].0 * vp.0.dot(vp.0);
+                }
+                e
+            })
+            .collect()
+    }
+
+    /// The FLIP velocity update of the points `v` and, in the same visit of each point's
+    /// rows of nodes, kinematics' velocity gradient `l` and nodal velocity `g`; each
+    /// chunk's Σ m v·v.
+    fn velocities_and_strain(
+        &self,
+        v: &mut [Velocity<D::Vec>],
+        l: &mut [VelocityGradient<D::Mat>],
+        g: &mut [D::Vec],
+    ) -> Vec<f64> {
+        let (grid, x, m, na, nv, dt) = (self.grid, self.x, self.m, self.na, self.nv, self.dt);
+        v.par_chunks_mut(CHUNK)
+            .zip(l.par_chunks_mut(CHUNK).zip(g.par_chunks_mut(CHUNK)))
+            .enumerate()
+            .map(|(c, (v, (l, g)))| {
+                let mut e = 0.0;
+                for (k, vp) in v.iter_mut().enumerate() {
+                    let p = c * CHUNK + k;
+                    let (mut lp, vel, a) =
+                        S::gather_with_gradient_and(grid, x[p].0, |i| nv[i].0, |i| na[i].0);
+                    D::complete_gradient(&mut lp, x[p].0, vel);
+                    (l[k].0, g[k], vp.0) = (lp, vel, vp.0 + a * dt);
+                    e += m[p].0 * vp.0.dot(vp.0);
+                }
+                e
+            })
+            .collect()
+    }
+
+    /// Kinematics' velocity gradient `l` and nodal velocity `g` of every point, on their own.
+    fn strain(&self, l: &mut [VelocityGradient<D::Mat>], g: &mut [D::Vec]) {
+        let (grid, x, nv) = (self.grid, self.x, self.nv);
+        l.par_chunks_mut(CHUNK)
+            .zip(g.par_chunks_mut(CHUNK))
+            .enumerate()
+            .for_each(|(c, (l, g))| {
+                for k in 0..l.len() {
+                    let p = c * CHUNK + k;
+                    (l[k].0, g[k]) = gradient_and_velocity::<D, S>(grid, x[p].0, nv);
+                }
+            });
     }
 }

@@ -28,7 +28,25 @@ use std::marker::PhantomData;
 pub struct Kinematics<D, S> {
     gradient: bool,
     motion: bool,
+    /// With both: move by the nodal velocity g2p gathered ([`Context::point_grid_velocity`])
+    /// instead of gathering it again, g2p having written the velocity gradient too
+    /// ([`crate::systems::g2p_gathers_strain`]).
+    carried: bool,
     _marker: PhantomData<fn() -> (D, S)>,
+}
+
+/// The velocity gradient L_p = Σ_i v_i ⊗ ∇w_ip (with the hoop rate in axisymmetry) and the
+/// nodal velocity at the point, Σ_i w_ip v_i, of the field `nv` at `x`: what kinematics
+/// strains and moves a point with, and what g2p gathers in its place where it may.
+#[inline(always)]
+pub fn gradient_and_velocity<D: Dim, S: Shape>(
+    grid: &crate::grid::Grid<D>,
+    x: D::Vec,
+    nv: &[NodeVelocity<D::Vec>],
+) -> (D::Mat, D::Vec) {
+    let (mut l, vel) = S::gather_with_gradient(grid, x, |i| nv[i].0);
+    D::complete_gradient(&mut l, x, vel);
+    (l, vel)
 }
 
 impl<D: Dim, S: Shape> Kinematics<D, S> {
@@ -37,14 +55,17 @@ impl<D: Dim, S: Shape> Kinematics<D, S> {
         Kinematics {
             gradient: true,
             motion: true,
+            carried: false,
             _marker: PhantomData,
         }
     }
+
     /// Velocity gradient only (USF, start of step).
     pub fn gradient_only() -> Self {
         Kinematics {
             gradient: true,
             motion: false,
+            carried: false,
             _marker: PhantomData,
         }
     }
@@ -53,6 +74,7 @@ impl<D: Dim, S: Shape> Kinematics<D, S> {
         Kinematics {
             gradient: false,
             motion: true,
+            carried: false,
             _marker: PhantomData,
         }
     }
@@ -63,20 +85,38 @@ impl<D: Dim, S: Shape> System<D> for Kinematics<D, S> {
         self.name_static()
     }
 
+    fn schedule_changed(&mut self, names: &[String]) {
+        self.carried = self.gradient && self.motion && crate::systems::g2p_gathers_strain(names);
+    }
+
     fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
         let Some(dt) = ctx.motion_dt() else {
             return Ok(());
         };
         let (grid, step) = (&ctx.grid, ctx.state.clock.step);
         let name = self.name_static();
-        let (gradient, motion) = (self.gradient, self.motion);
+        let (gradient, motion, carried) = (self.gradient, self.motion, self.carried);
         let n = nodes(&ctx.world);
         let nvg = col::<NodeVelocity<D::Vec>>(n);
         let nv: &[NodeVelocity<D::Vec>] = &nvg;
-        for arch in points_with::<Position<D::Vec>>(&ctx.world) {
+        // g2p's gathers, in its order of the points (`points_with::<Velocity>`).
+        let mut gathered: &[D::Vec] = &ctx.point_grid_velocity;
+        let archs: Vec<_> = if carried {
+            points_with::<Velocity<D::Vec>>(&ctx.world).collect()
+        } else {
+            points_with::<Position<D::Vec>>(&ctx.world).collect()
+        };
+        for arch in archs {
             let mut xg = col_mut::<Position<D::Vec>>(arch);
             let mut lg = col_mut::<VelocityGradient<D::Mat>>(arch);
             let mut ug = arch.get::<&mut Displacement<D::Vec>>();
+            let mine: &[D::Vec] = if carried {
+                let (mine, rest) = gathered.split_at(xg.len());
+                gathered = rest;
+                mine
+            } else {
+                &[]
+            };
             // Displacements are kept only when the scene asks for them.
             let u_chunks = optional_chunks(ug.as_deref_mut(), xg.len());
             // Each chunk reports whether a point changed cell and the first point that left
@@ -92,9 +132,10 @@ impl<D: Dim, S: Shape> System<D> for Kinematics<D, S> {
                     for k in 0..x.len() {
                         let mut vel = D::Vec::ZERO;
                         // One loop per case, so that the node loop holds no branch.
-                        if gradient {
-                            (l[k].0, vel) = S::gather_with_gradient(grid, x[k].0, |i| nv[i].0);
-                            D::complete_gradient(&mut l[k].0, x[k].0, vel);
+                        if carried {
+                            vel = mine[c * CHUNK + k];
+                        } else if gradient {
+                            (l[k].0, vel) = gradient_and_velocity::<D, S>(grid, x[k].0, nv);
                         } else {
                             for_each_node::<D, S>(grid, x[k].0, |i, w, _| vel = nv[i].0.madd(w, vel));
                         }
@@ -146,8 +187,12 @@ impl<D: Dim, S: Shape> System<D> for Kinematics<D, S> {
             return Some(Traffic::NONE);
         }
         let w = &ctx.world;
-        let mut t = Traffic::NONE.read_nodes::<NodeVelocity<D::Vec>>(ctx.state.active_nodes.len());
-        if self.gradient {
+        let mut t = if self.carried {
+            Traffic::NONE.read_per_point::<Velocity<D::Vec>, D::Vec>(w)
+        } else {
+            Traffic::NONE.read_nodes::<NodeVelocity<D::Vec>>(ctx.state.active_nodes.len())
+        };
+        if self.gradient && !self.carried {
             t = t.write_points::<VelocityGradient<D::Mat>>(w);
         }
         Some(if self.motion {

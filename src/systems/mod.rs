@@ -198,9 +198,9 @@ pub enum When {
     RequiredWhen(fn(&Numerics, &Model, Needs) -> bool, &'static str),
 }
 
-/// Builds a system for a run's numerics and model, given the names of the systems its
-/// schedule holds (the stress update carries the volume update where the schedule has none).
-pub type Build<D> = fn(&Numerics, &Model, &[String]) -> Box<dyn System<D>>;
+/// Builds a system for a run's numerics and model. What it does may also depend on the
+/// systems around it, which the schedule tells it ([`System::schedule_changed`]).
+pub type Build<D> = fn(&Numerics, &Model) -> Box<dyn System<D>>;
 
 /// One system: everything the schedule, its checks and the docs know about it.
 pub struct Entry<D: Dim> {
@@ -214,7 +214,7 @@ pub struct Entry<D: Dim> {
     pub after: &'static [(&'static str, &'static str)],
     /// What it does, one line (the docs' list and `kdmpm check`).
     pub does: &'static str,
-    /// Builds it for a run's numerics and model and its schedule's names.
+    /// Builds it for a run's numerics and model.
     pub build: Build<D>,
 }
 
@@ -272,7 +272,7 @@ fn mapping<D: Dim, S: Shape>() -> Vec<Entry<D>> {
             Always,
             &[],
             "empty, undeformed grid",
-            |_, _, _| Box::new(GridReset::default()),
+            |_, _| Box::new(GridReset::default()),
         ),
         e(
             "spatial_sort",
@@ -280,7 +280,7 @@ fn mapping<D: Dim, S: Shape>() -> Vec<Entry<D>> {
             Needed(|n, _, _| n.sort_every > 0, "solver.sort_every is above 0"),
             &[],
             "points back in cell order (every N steps)",
-            |n, _, _| Box::new(SpatialSort::new(n.sort_every)),
+            |n, _| Box::new(SpatialSort::new(n.sort_every)),
         ),
         e(
             "p2g",
@@ -288,7 +288,7 @@ fn mapping<D: Dim, S: Shape>() -> Vec<Entry<D>> {
             Schemes(MUSL_USL),
             &[SORTED],
             "mass, momentum, internal force (and each point's other forces, `point_forces.rs`) to the nodes",
-            |_, _, _| Box::new(P2g::<D, S>::new(P2gPart::All)),
+            |_, _| Box::new(P2g::<D, S>::new(P2gPart::All)),
         ),
         e(
             "p2g_momentum",
@@ -296,7 +296,7 @@ fn mapping<D: Dim, S: Shape>() -> Vec<Entry<D>> {
             Schemes(USF),
             &[SORTED],
             "USF: mass and momentum to the nodes",
-            |_, _, _| Box::new(P2g::<D, S>::new(P2gPart::MassMomentum)),
+            |_, _| Box::new(P2g::<D, S>::new(P2gPart::MassMomentum)),
         ),
         e(
             "nodal_velocity",
@@ -304,7 +304,7 @@ fn mapping<D: Dim, S: Shape>() -> Vec<Entry<D>> {
             Schemes(USF),
             &[("p2g_momentum", "the nodal velocity needs the mapped momentum")],
             "USF: nodal velocity from momentum",
-            |_, _, _| Box::new(NodalVelocity),
+            |_, _| Box::new(NodalVelocity),
         ),
     ]
 }
@@ -331,7 +331,7 @@ fn straining<D: Dim, S: Shape>() -> Vec<Entry<D>> {
                 ),
             ],
             "velocity gradient, position update",
-            |_, _, _| Box::new(Kinematics::<D, S>::both()),
+            |_, _| Box::new(Kinematics::<D, S>::both()),
         ),
         e(
             "velocity_gradient",
@@ -339,7 +339,7 @@ fn straining<D: Dim, S: Shape>() -> Vec<Entry<D>> {
             Schemes(USF),
             &[("nodal_velocity", "the velocity gradient needs the nodal velocity")],
             "USF: velocity gradient",
-            |_, _, _| Box::new(Kinematics::<D, S>::gradient_only()),
+            |_, _| Box::new(Kinematics::<D, S>::gradient_only()),
         ),
         e(
             "volumetric_smoothing",
@@ -350,7 +350,7 @@ fn straining<D: Dim, S: Shape>() -> Vec<Entry<D>> {
             ),
             &[("kinematics", SMOOTHED), ("velocity_gradient", SMOOTHED)],
             "volumetric strain rate smoothed through the nodes",
-            |_, _, _| Box::new(VolumetricSmoothing::<D, S>::default()),
+            |_, _| Box::new(VolumetricSmoothing::<D, S>::default()),
         ),
         e(
             "cell_mean_strain",
@@ -361,7 +361,7 @@ fn straining<D: Dim, S: Shape>() -> Vec<Entry<D>> {
             ),
             &[("kinematics", SMOOTHED), ("velocity_gradient", SMOOTHED)],
             "cell mean of the volumetric strain rate",
-            |_, _, _| Box::new(CellMean::<D, S>::new(CellMeanPart::Strain)),
+            |_, _| Box::new(CellMean::<D, S>::new(CellMeanPart::Strain)),
         ),
         e(
             "undrained_strain",
@@ -369,7 +369,7 @@ fn straining<D: Dim, S: Shape>() -> Vec<Entry<D>> {
             Needed(|_, _, n| n.undrained, "a material holds undrained water"),
             &[("kinematics", SMOOTHED), ("velocity_gradient", SMOOTHED)],
             "cell mean of the undrained points' volumetric strain rate",
-            |_, _, _| Box::new(UndrainedStrain::<D, S>::default()),
+            |_, _| Box::new(UndrainedStrain::<D, S>::default()),
         ),
         e(
             "stress_update",
@@ -383,7 +383,7 @@ fn straining<D: Dim, S: Shape>() -> Vec<Entry<D>> {
                 ("undrained_strain", "the stress must see the cell's strain"),
             ],
             "Jaumann rotation + material law (and V ← V det(I + LΔt) without `volume_update`)",
-            |_, _, names| Box::new(StressUpdate::new(!names.iter().any(|n| n == "volume_update"))),
+            |_, _| Box::new(StressUpdate::default()),
         ),
     ]
 }
@@ -403,7 +403,7 @@ fn projecting<D: Dim, S: Shape>() -> Vec<Entry<D>> {
             ),
             &[("stress_update", "it projects the updated stress")],
             "cell mean of the mean stress",
-            |_, _, _| Box::new(CellMean::<D, S>::new(CellMeanPart::Stress)),
+            |_, _| Box::new(CellMean::<D, S>::new(CellMeanPart::Stress)),
         ),
         e(
             "pore_pressure_field",
@@ -414,7 +414,7 @@ fn projecting<D: Dim, S: Shape>() -> Vec<Entry<D>> {
                 ("cell_mean_stress", "it projects the projected stress's water"),
             ],
             "cell mean of the undrained points' excess pore pressure",
-            |_, _, _| Box::new(PorePressureField::<D, S>::default()),
+            |_, _| Box::new(PorePressureField::<D, S>::default()),
         ),
         e(
             "volume_update",
@@ -425,7 +425,7 @@ fn projecting<D: Dim, S: Shape>() -> Vec<Entry<D>> {
             ),
             &[("stress_update", "the volume update follows the stress update")],
             "V ← V det(I + LΔt)",
-            |_, _, _| Box::new(VolumeUpdate),
+            |_, _| Box::new(VolumeUpdate),
         ),
         e(
             "p2g_force",
@@ -437,7 +437,7 @@ fn projecting<D: Dim, S: Shape>() -> Vec<Entry<D>> {
                 ("pore_pressure_field", "p2g_force maps the water's cell pressure"),
             ],
             "USF: internal force of the updated stress (and each point's other forces)",
-            |_, _, _| Box::new(P2g::<D, S>::new(P2gPart::InternalForce)),
+            |_, _| Box::new(P2g::<D, S>::new(P2gPart::InternalForce)),
         ),
     ]
 }
@@ -459,7 +459,7 @@ fn loading<D: Dim, S: Shape>() -> Vec<Entry<D>> {
                 ),
             ],
             "body force m_i g",
-            |_, _, _| Box::new(Gravity),
+            |_, _| Box::new(Gravity),
         ),
         e(
             "point_loads",
@@ -470,7 +470,7 @@ fn loading<D: Dim, S: Shape>() -> Vec<Entry<D>> {
                 ("p2g_momentum", "point loads go to nodes that carry mapped mass"),
             ],
             "concentrated loads",
-            |_, _, _| Box::new(PointLoads::<D, S>::default()),
+            |_, _| Box::new(PointLoads::<D, S>::default()),
         ),
         e(
             "rigid_contact",
@@ -483,7 +483,7 @@ fn loading<D: Dim, S: Shape>() -> Vec<Entry<D>> {
                 ("point_loads", COMPLETE),
             ],
             "soil–body contact: no entry, friction; the bodies' forces",
-            |_, _, _| Box::new(RigidContact::<D, S>::default()),
+            |_, _| Box::new(RigidContact::<D, S>::default()),
         ),
         e(
             "boundary",
@@ -500,7 +500,7 @@ fn loading<D: Dim, S: Shape>() -> Vec<Entry<D>> {
                 ),
             ],
             "held components: fixed at zero, or at a motion's velocity",
-            |_, _, _| Box::new(Boundary::default()),
+            |_, _| Box::new(Boundary::default()),
         ),
         e(
             "integrate",
@@ -508,7 +508,7 @@ fn loading<D: Dim, S: Shape>() -> Vec<Entry<D>> {
             Always,
             &[("boundary", "integration needs constrained momentum and force")],
             "nodal acceleration and velocity (+ viscous or local damping)",
-            |_, _, _| Box::new(Integrate),
+            |_, _| Box::new(Integrate),
         ),
         e(
             "mass_scaling",
@@ -516,7 +516,7 @@ fn loading<D: Dim, S: Shape>() -> Vec<Entry<D>> {
             Needed(|_, m, _| m.mass_scaling(), "solver.mass_scaling is true"),
             &[("integrate", "mass scaling rescales the integrated accelerations")],
             "fictitious inertia",
-            |_, _, _| Box::new(MassScaling::<D, S>::default()),
+            |_, _| Box::new(MassScaling::<D, S>::default()),
         ),
         e(
             "g2p",
@@ -527,7 +527,7 @@ fn loading<D: Dim, S: Shape>() -> Vec<Entry<D>> {
                 ("mass_scaling", "g2p interpolates the rescaled accelerations"),
             ],
             "point velocities, kinetic energy",
-            |_, _, _| Box::new(G2p::<D, S>::default()),
+            |_, _| Box::new(G2p::<D, S>::default()),
         ),
     ]
 }
@@ -546,7 +546,7 @@ fn relaxing<D: Dim, S: Shape>() -> Vec<Entry<D>> {
             ),
             &[("g2p", "the peak watch reads the kinetic energy g2p computes")],
             "kinetic damping reset",
-            |_, _, _| Box::new(PeakWatch),
+            |_, _| Box::new(PeakWatch),
         ),
         e(
             "remap",
@@ -560,7 +560,7 @@ fn relaxing<D: Dim, S: Shape>() -> Vec<Entry<D>> {
                 ),
             ],
             "MUSL: point velocities back to the grid",
-            |_, _, _| Box::new(Remap::<D, S>::default()),
+            |_, _| Box::new(Remap::<D, S>::default()),
         ),
         e(
             "remap_contact",
@@ -571,7 +571,7 @@ fn relaxing<D: Dim, S: Shape>() -> Vec<Entry<D>> {
             ),
             &[("remap", "it holds the contacts on the remapped velocities")],
             "MUSL: the rigid bodies' contacts held again on the remapped velocities",
-            |_, _, _| Box::new(RemapContact),
+            |_, _| Box::new(RemapContact),
         ),
         e(
             "move_points",
@@ -579,7 +579,7 @@ fn relaxing<D: Dim, S: Shape>() -> Vec<Entry<D>> {
             Schemes(USF),
             &[("integrate", INTEGRATED), ("peak_watch", NOT_IN_RESET)],
             "USF: position update",
-            |_, _, _| Box::new(Kinematics::<D, S>::motion_only()),
+            |_, _| Box::new(Kinematics::<D, S>::motion_only()),
         ),
         e(
             "convergence",
@@ -587,7 +587,7 @@ fn relaxing<D: Dim, S: Shape>() -> Vec<Entry<D>> {
             Always,
             &[],
             "K_F, W_ext, K_E, stopping rule",
-            |_, _, _| Box::new(Convergence),
+            |_, _| Box::new(Convergence),
         ),
         e(
             "prescribed_motion",
@@ -595,7 +595,7 @@ fn relaxing<D: Dim, S: Shape>() -> Vec<Entry<D>> {
             Needed(|_, m, _| !m.motions.is_empty(), "the scene has motions"),
             &[("convergence", "it acts on the step's static state")],
             "displacement control: travel, hold, curve of static states",
-            |_, m, _| Box::new(PrescribedMotion::new(m.motions.clone())),
+            |_, m| Box::new(PrescribedMotion::new(m.motions.clone())),
         ),
         e(
             "rigid_control",
@@ -606,7 +606,7 @@ fn relaxing<D: Dim, S: Shape>() -> Vec<Entry<D>> {
                 ("prescribed_motion", "the bodies' rows follow the motions'"),
             ],
             "rigid bodies: travel or carry a load, hold, curve of static states",
-            |_, m, _| {
+            |_, m| {
                 Box::new(RigidControl::new(
                     m.bodies.iter().map(|b| b.spec.clone()).collect(),
                     &m.stages,
@@ -626,7 +626,7 @@ fn relaxing<D: Dim, S: Shape>() -> Vec<Entry<D>> {
                 ("rigid_control", "a load increment follows the bodies' last"),
             ],
             "load control: the next load increment at each static state",
-            |_, _, _| Box::new(LoadControl),
+            |_, _| Box::new(LoadControl),
         ),
         e(
             "stages",
@@ -639,7 +639,7 @@ fn relaxing<D: Dim, S: Shape>() -> Vec<Entry<D>> {
                 ("load_steps", "a stage ends once its load increments are done"),
             ],
             "loading stages: the next stage at each static state",
-            |_, _, _| Box::new(Stages),
+            |_, _| Box::new(Stages),
         ),
     ]
 }
@@ -651,6 +651,19 @@ fn relaxing<D: Dim, S: Shape>() -> Vec<Entry<D>> {
 /// its own pass over the velocity gradient (one read of L instead of two, the same bits).
 pub fn volume_read_after_stress(numerics: &Numerics, _: &Model, needs: Needs) -> bool {
     numerics.anti_locking == AntiLocking::CellMean || needs.undrained
+}
+
+/// True when `kinematics` strains and moves the points with the very nodal velocity g2p
+/// reads: nothing but the peak watch runs between them (USL; MUSL's remap maps a new
+/// one). g2p then gathers the velocity gradient and the points' nodal velocity in its own
+/// visit of their nodes, and kinematics only moves the points, unless the step is a reset
+/// (the same bits as the two passes).
+pub fn g2p_gathers_strain(names: &[String]) -> bool {
+    let at = |name: &str| names.iter().position(|n| n == name);
+    match (at("g2p"), at("kinematics")) {
+        (Some(g), Some(k)) if g < k => names[g + 1..k].iter().all(|n| n == "peak_watch"),
+        _ => false,
+    }
 }
 
 /// The registry's names, kinds and rules; they do not depend on the dimension or shape.
@@ -834,7 +847,7 @@ pub fn schedule_from_names<D: Dim>(
             .iter()
             .find(|e| e.name == n)
             .unwrap_or_else(|| unreachable!("checked by check_names: {n}"));
-        s.push_boxed((e.build)(numerics, model, names));
+        s.push_boxed((e.build)(numerics, model));
     }
     s
 }
@@ -877,6 +890,21 @@ mod tests {
 
     fn names(v: &[&str]) -> Vec<String> {
         v.iter().map(|s| s.to_string()).collect()
+    }
+
+    #[test]
+    fn g2p_gathers_kinematics_sums_only_with_the_peak_watch_between() {
+        let gathers = |scheme, damping| {
+            let st = settings(scheme, damping, true);
+            g2p_gathers_strain(&names(&default_names(&st.0, &st.1, Needs::default())))
+        };
+        assert!(gathers(Scheme::Usl, Damping::Kinetic));
+        assert!(gathers(Scheme::Usl, Damping::None));
+        // MUSL's remap maps a new nodal velocity between them; USF has no `kinematics`.
+        assert!(!gathers(Scheme::Musl, Damping::Kinetic));
+        assert!(!gathers(Scheme::Usf, Damping::Kinetic));
+        let between = names(&["g2p", "peak_watch", "probe", "kinematics"]);
+        assert!(!g2p_gathers_strain(&between));
     }
 
     #[test]

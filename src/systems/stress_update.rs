@@ -23,25 +23,21 @@ use std::marker::PhantomData;
 /// the material's update when the four share a material (each gets the bits it would get
 /// alone); the gain is in docs/performance.md ("Figures behind the code").
 ///
-/// With `volume` set it also updates each point's volume, V ← V det(I + LΔt), in the same
-/// pass over L: in a schedule without `volume_update`, which does it on its own otherwise
-/// (with the same arithmetic and bits; `systems::volume_read_after_stress` says when the
-/// default schedule holds it).
+/// In a schedule without `volume_update` it also updates each point's volume,
+/// V ← V det(I + LΔt), in the same pass over L (`volume_update` does it on its own
+/// otherwise, with the same arithmetic and bits; `systems::volume_read_after_stress` says
+/// when the default schedule holds it).
 #[derive(Debug, Default)]
 pub struct StressUpdate {
     volume: bool,
 }
 
-impl StressUpdate {
-    /// The stress update, carrying the volume update when `volume` is set.
-    pub fn new(volume: bool) -> Self {
-        StressUpdate { volume }
-    }
-}
-
 impl<D: Dim> System<D> for StressUpdate {
     fn name(&self) -> &str {
         "stress_update"
+    }
+    fn schedule_changed(&mut self, names: &[String]) {
+        self.volume = !names.iter().any(|n| n == "volume_update");
     }
     fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
         let Some(dt) = ctx.motion_dt() else {

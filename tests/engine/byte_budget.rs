@@ -15,6 +15,17 @@ fn block(scheme: &str) -> kdmpm::Simulation<kdmpm::Dim3> {
     sim
 }
 
+/// The bytes system `name` counted over the calls so far.
+fn bytes_of(sim: &kdmpm::Simulation<kdmpm::Dim3>, name: &str) -> kdmpm::infra::traffic::Traffic {
+    let t = sim
+        .schedule
+        .timings()
+        .into_iter()
+        .find(|t| t.name == name)
+        .unwrap();
+    t.bytes.unwrap()
+}
+
 #[test]
 fn every_system_of_a_plain_step_counts_its_bytes() {
     for scheme in ["Musl", "Usl", "Usf"] {
@@ -35,15 +46,7 @@ fn the_block_moves_its_columns_bytes_a_musl_step() {
     sim.step().unwrap();
     let (points, nodes) = (sim.point_count() as u64, sim.ctx.state.active_nodes.len() as u64);
     assert_eq!((points, nodes), (10_648, 12 * 12 * 12));
-    let bytes = |name: &str| {
-        let t = sim
-            .schedule
-            .timings()
-            .into_iter()
-            .find(|t| t.name == name)
-            .unwrap();
-        t.bytes.unwrap()
-    };
+    let bytes = |name: &str| bytes_of(&sim, name);
     // Particle-to-grid reads the scatter's order (4 B), position (24), mass (8), velocity
     // (24), stress (48) and volume (8) of each point, and adds into each node's mass (8),
     // momentum (24) and force (24).
@@ -60,4 +63,23 @@ fn the_block_moves_its_columns_bytes_a_musl_step() {
         (points * (72 + 2 + 48 + 8), points * (48 + 8))
     );
     assert!(sim.schedule.timings().iter().all(|t| t.name != "volume_update"));
+}
+
+/// USL: g2p gathers the velocity gradient and the points' nodal velocity beside their
+/// accelerations, and kinematics only moves the points by what it left.
+#[test]
+fn a_usl_step_gathers_the_velocity_gradient_in_g2p() {
+    let mut sim = block("Usl");
+    sim.step().unwrap();
+    let (points, nodes) = (sim.point_count() as u64, sim.ctx.state.active_nodes.len() as u64);
+    let bytes = |name: &str| bytes_of(&sim, name);
+    // Position (24), mass (8) and velocity (24) of each point, each node's acceleration and
+    // velocity (24 each); the velocity, the velocity gradient (72) and the nodal velocity at
+    // the point (24) written.
+    let g2p = bytes("g2p");
+    assert_eq!(g2p.read, points * (24 + 8 + 24) + nodes * 48);
+    assert_eq!(g2p.written, points * (24 + 72 + 24));
+    // The nodal velocity at the point read, the position read and written.
+    let kinematics = bytes("kinematics");
+    assert_eq!((kinematics.read, kinematics.written), (points * 48, points * 24));
 }

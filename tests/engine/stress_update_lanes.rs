@@ -94,7 +94,7 @@ fn points_updated_four_at_a_time_get_the_bits_of_points_updated_one_at_a_time() 
         mixed_groups >= 4,
         "the scene must mix materials within groups: {mixed_groups}"
     );
-    StressUpdate::new(false).run(ctx).expect("stress update");
+    StressUpdate::default().run(ctx).expect("stress update");
     let mut got = Vec::new();
     for arch in points_with::<Stress<Sym3>>(&ctx.world) {
         let s = col::<Stress<Sym3>>(arch);
