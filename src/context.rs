@@ -36,9 +36,10 @@ pub struct Context<D: Dim> {
     /// Node columns already summed over the ranks this step (bits of
     /// [`crate::systems::exchange`]); cleared by the grid reset.
     pub exchanged: u8,
-    /// The nodal velocity at each point, Σ_i w_ip v_i (m/s), where g2p gathers it for
-    /// kinematics (USL, [`crate::systems::g2p_gathers_strain`]): the points of
-    /// `points_with::<Velocity>` in order; empty otherwise.
+    /// The nodal velocity at each point, Σ_i w_ip v_i (m/s), where g2p gathers it for the
+    /// system that moves the points (USL's kinematics, USF's `move_points`:
+    /// [`crate::systems::g2p_gathers`]): the points of `points_with::<Velocity>` in order;
+    /// empty otherwise.
     pub point_grid_velocity: Vec<D::Vec>,
 }
 

@@ -28,9 +28,9 @@ pub trait System<D: Dim>: Send {
     }
     /// Told the names of the schedule's systems, in order, before the first step it runs
     /// and whenever the list changes (before `prepare`): a system whose work depends on its
-    /// neighbours decides it here (g2p gathers kinematics' sums where only the peak watch
-    /// runs between them; the stress update updates the volumes where no `volume_update`
-    /// does). Nothing by default.
+    /// neighbours decides it here (g2p gathers the sums of the system that moves the points
+    /// where only the peak watch runs between them; the stress update updates the volumes
+    /// where no `volume_update` does). Nothing by default.
     fn schedule_changed(&mut self, names: &[String]) {
         let _ = names;
     }

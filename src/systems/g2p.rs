@@ -10,8 +10,8 @@ use crate::infra::traffic::Traffic;
 use crate::parallel::CHUNK;
 use crate::schedule::System;
 use crate::shape::{for_each_node, Shape};
-use crate::systems::g2p_gathers_strain;
 use crate::systems::kinematics::gradient_and_velocity;
+use crate::systems::{g2p_gathers, Gathered};
 use rayon::prelude::*;
 use std::marker::PhantomData;
 
@@ -32,22 +32,22 @@ fn first_non_finite_velocity<D: Dim>(world: &hecs::World) -> String {
 /// v_p ← α (v_p + Δt Σ_i w_ip a_i) + (1 − α) Σ_i w_ip v_i (FLIP for α = 1, PIC for α = 0),
 /// then E_k = ½ Σ m_p v_p·v_p.
 ///
-/// Where nothing between g2p and kinematics changes the nodal velocity (USL:
-/// [`g2p_gathers_strain`]) the same visit of a point's nodes also gathers
-/// what kinematics would: the velocity gradient L_p = Σ_i v_i ⊗ ∇w_ip into its column and
-/// the nodal velocity at the point, Σ_i w_ip v_i, into [`Context::point_grid_velocity`],
-/// which kinematics then moves the point by unless the peak watch resets the step. The sums
-/// are kinematics' own, so the bits are those of the two passes.
+/// Where only the peak watch runs between g2p and the system that moves the points
+/// ([`g2p_gathers`]), the same visit of a point's nodes also gathers what that system
+/// would: the nodal velocity at the point, Σ_i w_ip v_i, into
+/// [`Context::point_grid_velocity`], which it then moves the point by unless the peak watch
+/// resets the step, and for USL's kinematics the velocity gradient L_p = Σ_i v_i ⊗ ∇w_ip
+/// into its column. The sums are that system's own, so the bits are those of two passes.
 #[derive(Debug)]
 pub struct G2p<D, S> {
-    strain: bool,
+    gathers: Gathered,
     _marker: PhantomData<fn() -> (D, S)>,
 }
 
 impl<D, S> Default for G2p<D, S> {
     fn default() -> Self {
         G2p {
-            strain: false,
+            gathers: Gathered::Nothing,
             _marker: PhantomData,
         }
     }
@@ -58,7 +58,7 @@ impl<D: Dim, S: Shape> System<D> for G2p<D, S> {
         "g2p"
     }
     fn schedule_changed(&mut self, names: &[String]) {
-        self.strain = g2p_gathers_strain(names);
+        self.gathers = g2p_gathers(names);
     }
     fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {
         let (grid, dt) = (&ctx.grid, ctx.numerics.dt);
@@ -70,9 +70,10 @@ impl<D: Dim, S: Shape> System<D> for G2p<D, S> {
         let flip = ctx.numerics.flip;
         // Pure FLIP (the default) never reads the interpolated nodal velocity.
         let pic = flip < 1.0;
-        let strain = self.strain;
+        let (gathers, strain) = (self.gathers, self.gathers == Gathered::Strain);
+        let carry = gathers != Gathered::Nothing;
         let carried = &mut ctx.point_grid_velocity;
-        if strain {
+        if carry {
             let rows = points_with::<Velocity<D::Vec>>(&ctx.world)
                 .map(|a| a.len() as usize)
                 .sum();
@@ -95,10 +96,11 @@ impl<D: Dim, S: Shape> System<D> for G2p<D, S> {
             let mut vg = col_mut::<Velocity<D::Vec>>(arch);
             // Kinematics' columns, written only with `strain`.
             let mut lg = strain.then(|| col_mut::<VelocityGradient<D::Mat>>(arch));
-            let (mine, rest) = std::mem::take(&mut carried).split_at_mut(if strain { vg.len() } else { 0 });
+            let (mine, rest) = std::mem::take(&mut carried).split_at_mut(if carry { vg.len() } else { 0 });
             carried = rest;
             let parts = match lg.as_deref_mut() {
                 Some(l) if !pic => fields.velocities_and_strain(&mut vg, l, mine),
+                None if carry => fields.velocities_and_nodal(&mut vg, mine),
                 l => {
                     let parts = fields.velocities(&mut vg);
                     // PIC keeps its own sums; kinematics' follow in a pass of their own.
@@ -137,17 +139,18 @@ impl<D: Dim, S: Shape> System<D> for G2p<D, S> {
             .read_points::<Mass>(w)
             .update_points::<Velocity<D::Vec>>(w)
             .read_nodes::<NodeAcceleration<D::Vec>>(n);
-        // PIC's share and kinematics' gathers read the nodal velocity too.
-        let t = if ctx.numerics.flip < 1.0 || self.strain {
+        // PIC's share and the motion's gathers read the nodal velocity too.
+        let t = if ctx.numerics.flip < 1.0 || self.gathers != Gathered::Nothing {
             t.read_nodes::<NodeVelocity<D::Vec>>(n)
         } else {
             t
         };
-        Some(if self.strain {
-            t.write_points::<VelocityGradient<D::Mat>>(w)
-                .write_per_point::<Velocity<D::Vec>, D::Vec>(w)
-        } else {
-            t
+        Some(match self.gathers {
+            Gathered::Nothing => t,
+            Gathered::Velocity => t.write_per_point::<Velocity<D::Vec>, D::Vec>(w),
+            Gathered::Strain => t
+                .write_points::<VelocityGradient<D::Mat>>(w)
+                .write_per_point::<Velocity<D::Vec>, D::Vec>(w),
         })
     }
 }
@@ -190,6 +193,38 @@ impl<D: Dim, S: Shape> Fields<'_, D, S> {
                         for_each_node::<D, S>(grid, x[p].0, |i, w, _| a = na[i].0.madd(w, a));
                         vp.0 + a * dt
                     };
+                    e += m[p].0 * vp.0.dot(vp.0);
+                }
+                e
+            })
+            .collect()
+    }
+
+    /// The velocity update of the points `v` and, in the same visit of each point's nodes,
+    /// the nodal velocity `g` at each (node by node, as `move_points` sums it); each
+    /// chunk's Σ m v·v.
+    fn velocities_and_nodal(&self, v: &mut [Velocity<D::Vec>], g: &mut [D::Vec]) -> Vec<f64> {
+        let (grid, x, m, na, nv, dt, flip) =
+            (self.grid, self.x, self.m, self.na, self.nv, self.dt, self.flip);
+        let pic = flip < 1.0;
+        v.par_chunks_mut(CHUNK)
+            .zip(g.par_chunks_mut(CHUNK))
+            .enumerate()
+            .map(|(c, (v, g))| {
+                let mut e = 0.0;
+                for (k, vp) in v.iter_mut().enumerate() {
+                    let p = c * CHUNK + k;
+                    let (mut a, mut vg) = (D::Vec::ZERO, D::Vec::ZERO);
+                    for_each_node::<D, S>(grid, x[p].0, |i, w, _| {
+                        a = na[i].0.madd(w, a);
+                        vg = nv[i].0.madd(w, vg);
+                    });
+                    vp.0 = if pic {
+                        (vp.0 + a * dt) * flip + vg * (1.0 - flip)
+                    } else {
+                        vp.0 + a * dt
+                    };
+                    g[k] = vg;
                     e += m[p].0 * vp.0.dot(vp.0);
                 }
                 e

@@ -10,6 +10,7 @@ use crate::infra::traffic::Traffic;
 use crate::parallel::{optional_chunks, CHUNK};
 use crate::schedule::System;
 use crate::shape::{for_each_node, Shape};
+use crate::systems::{g2p_gathers, Gathered};
 use rayon::prelude::*;
 use std::marker::PhantomData;
 
@@ -28,9 +29,9 @@ use std::marker::PhantomData;
 pub struct Kinematics<D, S> {
     gradient: bool,
     motion: bool,
-    /// With both: move by the nodal velocity g2p gathered ([`Context::point_grid_velocity`])
-    /// instead of gathering it again, g2p having written the velocity gradient too
-    /// ([`crate::systems::g2p_gathers_strain`]).
+    /// Move by the nodal velocity g2p gathered ([`Context::point_grid_velocity`]) instead of
+    /// gathering it again, g2p having written the velocity gradient too where this pass
+    /// has one ([`g2p_gathers`]).
     carried: bool,
     _marker: PhantomData<fn() -> (D, S)>,
 }
@@ -86,7 +87,12 @@ impl<D: Dim, S: Shape> System<D> for Kinematics<D, S> {
     }
 
     fn schedule_changed(&mut self, names: &[String]) {
-        self.carried = self.gradient && self.motion && crate::systems::g2p_gathers_strain(names);
+        self.carried = self.motion
+            && match g2p_gathers(names) {
+                Gathered::Strain => self.gradient,
+                Gathered::Velocity => !self.gradient,
+                Gathered::Nothing => false,
+            };
     }
 
     fn run(&mut self, ctx: &mut Context<D>) -> Result<(), StepError> {

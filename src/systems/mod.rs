@@ -653,16 +653,38 @@ pub fn volume_read_after_stress(numerics: &Numerics, _: &Model, needs: Needs) ->
     numerics.anti_locking == AntiLocking::CellMean || needs.undrained
 }
 
-/// True when `kinematics` strains and moves the points with the very nodal velocity g2p
-/// reads: nothing but the peak watch runs between them (USL; MUSL's remap maps a new
-/// one). g2p then gathers the velocity gradient and the points' nodal velocity in its own
-/// visit of their nodes, and kinematics only moves the points, unless the step is a reset
-/// (the same bits as the two passes).
-pub fn g2p_gathers_strain(names: &[String]) -> bool {
-    let at = |name: &str| names.iter().position(|n| n == name);
-    match (at("g2p"), at("kinematics")) {
-        (Some(g), Some(k)) if g < k => names[g + 1..k].iter().all(|n| n == "peak_watch"),
-        _ => false,
+/// What g2p gathers, in its own visit of each point's nodes, for the system after it that
+/// moves the points ([`g2p_gathers`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Gathered {
+    /// Nothing: the points move with another nodal velocity (MUSL's remap maps a new one),
+    /// or a system between them might change it.
+    Nothing,
+    /// The nodal velocity at each point, Σ_i w_ip v_i, which USF's `move_points` moves the
+    /// points by.
+    Velocity,
+    /// The velocity gradient and the nodal velocity at each point, which USL's `kinematics`
+    /// strains and moves the points with.
+    Strain,
+}
+
+/// What g2p gathers for the system that moves the points: where the first system after
+/// g2p but the peak watch is `kinematics` (USL) or `move_points` (USF), they read the very
+/// nodal velocity g2p reads, so g2p gathers what they need in its own visit of the nodes,
+/// and they only move the points by it unless the step is a reset (the same bits as two
+/// passes).
+pub fn g2p_gathers(names: &[String]) -> Gathered {
+    let Some(g) = names.iter().position(|n| n == "g2p") else {
+        return Gathered::Nothing;
+    };
+    match names[g + 1..]
+        .iter()
+        .find(|n| *n != "peak_watch")
+        .map(String::as_str)
+    {
+        Some("kinematics") => Gathered::Strain,
+        Some("move_points") => Gathered::Velocity,
+        _ => Gathered::Nothing,
     }
 }
 
@@ -893,18 +915,18 @@ mod tests {
     }
 
     #[test]
-    fn g2p_gathers_kinematics_sums_only_with_the_peak_watch_between() {
+    fn g2p_gathers_for_the_motion_only_with_the_peak_watch_between() {
         let gathers = |scheme, damping| {
             let st = settings(scheme, damping, true);
-            g2p_gathers_strain(&names(&default_names(&st.0, &st.1, Needs::default())))
+            g2p_gathers(&names(&default_names(&st.0, &st.1, Needs::default())))
         };
-        assert!(gathers(Scheme::Usl, Damping::Kinetic));
-        assert!(gathers(Scheme::Usl, Damping::None));
-        // MUSL's remap maps a new nodal velocity between them; USF has no `kinematics`.
-        assert!(!gathers(Scheme::Musl, Damping::Kinetic));
-        assert!(!gathers(Scheme::Usf, Damping::Kinetic));
+        assert_eq!(gathers(Scheme::Usl, Damping::Kinetic), Gathered::Strain);
+        assert_eq!(gathers(Scheme::Usl, Damping::None), Gathered::Strain);
+        assert_eq!(gathers(Scheme::Usf, Damping::Kinetic), Gathered::Velocity);
+        // MUSL's remap maps a new nodal velocity between them.
+        assert_eq!(gathers(Scheme::Musl, Damping::Kinetic), Gathered::Nothing);
         let between = names(&["g2p", "peak_watch", "probe", "kinematics"]);
-        assert!(!g2p_gathers_strain(&between));
+        assert_eq!(g2p_gathers(&between), Gathered::Nothing);
     }
 
     #[test]

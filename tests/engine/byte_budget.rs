@@ -83,3 +83,20 @@ fn a_usl_step_gathers_the_velocity_gradient_in_g2p() {
     let kinematics = bytes("kinematics");
     assert_eq!((kinematics.read, kinematics.written), (points * 48, points * 24));
 }
+
+/// USF: g2p gathers the points' nodal velocity beside their accelerations, and
+/// `move_points` only moves them by what it left.
+#[test]
+fn a_usf_step_moves_the_points_by_the_nodal_velocity_g2p_gathered() {
+    let mut sim = block("Usf");
+    sim.step().unwrap();
+    let (points, nodes) = (sim.point_count() as u64, sim.ctx.state.active_nodes.len() as u64);
+    let bytes = |name: &str| bytes_of(&sim, name);
+    // Position, mass and velocity read, each node's acceleration and velocity; the velocity
+    // and the nodal velocity at the point (24) written.
+    let g2p = bytes("g2p");
+    assert_eq!(g2p.read, points * (24 + 8 + 24) + nodes * 48);
+    assert_eq!(g2p.written, points * (24 + 24));
+    let moved = bytes("move_points");
+    assert_eq!((moved.read, moved.written), (points * 48, points * 24));
+}
