@@ -65,38 +65,29 @@ fn the_block_moves_its_columns_bytes_a_musl_step() {
     assert!(sim.schedule.timings().iter().all(|t| t.name != "volume_update"));
 }
 
-/// USL: g2p gathers the velocity gradient and the points' nodal velocity beside their
-/// accelerations, and kinematics only moves the points by what it left.
+/// USL and USF: g2p gathers the points' nodal velocity (and under USL their velocity
+/// gradient) beside their accelerations, and the system that moves the points after it
+/// only moves them by what it left.
 #[test]
-fn a_usl_step_gathers_the_velocity_gradient_in_g2p() {
-    let mut sim = block("Usl");
-    sim.step().unwrap();
-    let (points, nodes) = (sim.point_count() as u64, sim.ctx.state.active_nodes.len() as u64);
-    let bytes = |name: &str| bytes_of(&sim, name);
-    // Position (24), mass (8) and velocity (24) of each point, each node's acceleration and
-    // velocity (24 each); the velocity, the velocity gradient (72) and the nodal velocity at
-    // the point (24) written.
-    let g2p = bytes("g2p");
-    assert_eq!(g2p.read, points * (24 + 8 + 24) + nodes * 48);
-    assert_eq!(g2p.written, points * (24 + 72 + 24));
-    // The nodal velocity at the point read, the position read and written.
-    let kinematics = bytes("kinematics");
-    assert_eq!((kinematics.read, kinematics.written), (points * 48, points * 24));
-}
-
-/// USF: g2p gathers the points' nodal velocity beside their accelerations, and
-/// `move_points` only moves them by what it left.
-#[test]
-fn a_usf_step_moves_the_points_by_the_nodal_velocity_g2p_gathered() {
-    let mut sim = block("Usf");
-    sim.step().unwrap();
-    let (points, nodes) = (sim.point_count() as u64, sim.ctx.state.active_nodes.len() as u64);
-    let bytes = |name: &str| bytes_of(&sim, name);
-    // Position, mass and velocity read, each node's acceleration and velocity; the velocity
-    // and the nodal velocity at the point (24) written.
-    let g2p = bytes("g2p");
-    assert_eq!(g2p.read, points * (24 + 8 + 24) + nodes * 48);
-    assert_eq!(g2p.written, points * (24 + 24));
-    let moved = bytes("move_points");
-    assert_eq!((moved.read, moved.written), (points * 48, points * 24));
+fn usl_and_usf_steps_gather_the_motion_in_g2p() {
+    // The scheme, the system that moves the points, and what g2p writes a point besides
+    // the velocity (24 B) and the nodal velocity at the point (24): USL's velocity
+    // gradient (72).
+    for (scheme, mover, gradient) in [("Usl", "kinematics", 72), ("Usf", "move_points", 0)] {
+        let mut sim = block(scheme);
+        sim.step().unwrap();
+        let (points, nodes) = (sim.point_count() as u64, sim.ctx.state.active_nodes.len() as u64);
+        // Position (24), mass (8) and velocity (24) of each point, each node's acceleration
+        // and velocity (24 each).
+        let g2p = bytes_of(&sim, "g2p");
+        assert_eq!(g2p.read, points * (24 + 8 + 24) + nodes * 48, "{scheme}");
+        assert_eq!(g2p.written, points * (24 + gradient + 24), "{scheme}");
+        // The nodal velocity at the point read, the position read and written.
+        let moved = bytes_of(&sim, mover);
+        assert_eq!(
+            (moved.read, moved.written),
+            (points * 48, points * 24),
+            "{scheme}"
+        );
+    }
 }
