@@ -526,7 +526,7 @@ fn loading<D: Dim, S: Shape>() -> Vec<Entry<D>> {
                 ("integrate", "g2p interpolates the nodal accelerations"),
                 ("mass_scaling", "g2p interpolates the rescaled accelerations"),
             ],
-            "point velocities, kinetic energy",
+            "point velocities, kinetic energy (and what USL's kinematics or USF's move_points moves the points by)",
             |_, _| Box::new(G2p::<D, S>::default()),
         ),
     ]
