@@ -69,9 +69,10 @@ impl<D: Dim> System<D> for StressUpdate {
             .read_points::<VelocityGradient<D::Mat>>(w)
             .read_points::<MaterialId>(w)
             .update_points::<Stress<D::Stress>>(w);
-        let traffic = match self.volume {
-            true => traffic.update_points::<Volume>(w),
-            false => traffic,
+        let traffic = if self.volume {
+            traffic.update_points::<Volume>(w)
+        } else {
+            traffic
         };
         // Each archetype's material state column, read and written.
         let mut states = StateTraffic { world: w, traffic };
